@@ -1,0 +1,46 @@
+#pragma once
+// An RGB float image. Row 0 is the TOP row, as OpenEXR stores it and as a raster image
+// is read; the cameras flip the row index when turning a pixel into a ray.
+
+#include <cstddef>
+#include <vector>
+
+#include "core/color.h"
+
+namespace octray {
+
+class Image {
+public:
+    Image() = default;
+    Image(int width, int height)
+        : width_(width), height_(height),
+          pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {}
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+    std::size_t pixel_count() const { return pixels_.size(); }
+
+    // Column x (0 = left), row y (0 = top).
+    Rgb& at(int x, int y) { return pixels_[index(x, y)]; }
+    const Rgb& at(int x, int y) const { return pixels_[index(x, y)]; }
+
+    Rgb* data() { return pixels_.data(); }
+    const Rgb* data() const { return pixels_.data(); }
+    const std::vector<Rgb>& pixels() const { return pixels_; }
+
+    friend bool operator==(const Image& a, const Image& b) {
+        return a.width_ == b.width_ && a.height_ == b.height_ && a.pixels_ == b.pixels_;
+    }
+
+private:
+    std::size_t index(int x, int y) const {
+        return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+               static_cast<std::size_t>(x);
+    }
+
+    int width_ = 0;
+    int height_ = 0;
+    std::vector<Rgb> pixels_;
+};
+
+}  // namespace octray

@@ -1,0 +1,30 @@
+#pragma once
+// The built-in scenes of shared/spec/scene-format.md.
+
+#include <optional>
+#include <string>
+
+#include "scene/scene.h"
+
+namespace octray {
+
+// True if the spec's name (text before ':' or ',') is a built-in: whitted, random,
+// sphereflake.
+bool is_builtin_scene(const std::string& spec);
+
+// Builds "whitted", "random:N", "sphereflake:L", each optionally followed by
+// ",key=value" overrides (width, height, spp, seed, max_depth). Throws SceneError.
+Scene make_builtin_scene(const std::string& spec);
+
+// The splitmix64 generator that random:N is specified with.
+class SplitMix64 {
+public:
+    explicit SplitMix64(std::uint64_t state) : state_(state) {}
+    std::uint64_t next();
+    float next_float();  // (next() >> 40) * 2^-24, in [0, 1)
+
+private:
+    std::uint64_t state_;
+};
+
+}  // namespace octray

@@ -1,0 +1,31 @@
+#pragma once
+// Scenes from the command line: a JSON file (shared/spec/scene-format.md) or a built-in
+// generator spec ("whitted", "random:1024,width=640", "sphereflake:4").
+
+#include <string>
+#include <string_view>
+
+#include "scene/scene.h"
+#include "scene/scene_error.h"
+
+namespace octray {
+
+// Parses a JSON scene. `source` names the file in error messages. Throws SceneError.
+Scene parse_scene_json(std::string_view json_text, const std::string& source);
+
+// Reads and parses a JSON scene file. Throws SceneError (unreadable file included).
+Scene load_scene_file(const std::string& path);
+
+// A built-in spec if `spec` names one (a word before an optional ':'), else a file path.
+// Throws SceneError.
+Scene load_scene(const std::string& spec);
+
+// Checks the whole scene (camera frame, radii, normals, materials, image size, ...).
+// The loaders call it; call it again after changing a scene. Throws SceneError.
+void validate_scene(const Scene& scene);
+
+// Writes the scene as JSON that parse_scene_json reads back to an identical scene
+// (floats printed round-trip exact), so rendering it gives a bit-identical image.
+std::string scene_to_json(const Scene& scene);
+
+}  // namespace octray

@@ -1,0 +1,79 @@
+#include "scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "scene/camera.h"
+
+namespace {
+constexpr float kHuge = 3.0e38f;
+}
+
+namespace octray {
+
+float self_intersection_epsilon(const Scene& scene) {
+    if (scene.render.epsilon) return *scene.render.epsilon;
+    bool any_sphere = false;
+    Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
+    for (const Object& o : scene.objects) {
+        if (o.type != ObjectType::sphere) continue;
+        const Vec3 r{o.radius, o.radius, o.radius};
+        lo = min(lo, o.center - r);
+        hi = max(hi, o.center + r);
+        any_sphere = true;
+    }
+    const float extent = any_sphere ? length(hi - lo) : 0.0f;
+    return 1e-4f * std::max(1.0f, extent);
+}
+
+TangentBasis checker_basis(Vec3 n) {
+    const float ax = std::fabs(n.x), ay = std::fabs(n.y), az = std::fabs(n.z);
+    Vec3 axis{1.0f, 0.0f, 0.0f};
+    if (ay < ax && ay <= az) {
+        axis = {0.0f, 1.0f, 0.0f};
+    } else if (az < ax && az < ay) {
+        axis = {0.0f, 0.0f, 1.0f};
+    }
+    // Gram-Schmidt: remove the normal's share of the axis.
+    const Vec3 t1 = normalize(axis - n * dot(axis, n));
+    return {t1, cross(t1, n)};
+}
+
+CameraFrame make_camera_frame(const Camera& camera, int width, int height) {
+    CameraFrame f;
+    f.type = camera.type;
+    f.eye = camera.eye;
+    f.aspect = static_cast<float>(width) / static_cast<float>(height);
+    const Vec3 view = camera.lookat - camera.eye;
+    if (!(length(view) > 0.0f)) throw std::invalid_argument("eye and lookat coincide");
+    f.ln = normalize(view);
+    const Vec3 side = cross(f.ln, camera.up);
+    if (!(length(side) > 1e-6f * length(camera.up)) || !(length(camera.up) > 0.0f))
+        throw std::invalid_argument("up vector is parallel to the view direction");
+    f.u_hat = normalize(side);
+    f.v_hat = normalize(cross(f.u_hat, f.ln));
+
+    const float max_fov = camera.type == CameraType::fisheye ? 360.0f : 180.0f;
+    const bool fov_ok = camera.type == CameraType::fisheye
+                            ? (camera.fov > 0.0f && camera.fov <= 360.0f)
+                            : (camera.fov > 0.0f && camera.fov < 180.0f);
+    if (camera.type != CameraType::orthographic && !fov_ok)
+        throw std::invalid_argument(
+            "field of view must lie in (0, " + std::to_string(static_cast<int>(max_fov)) +
+            (camera.type == CameraType::fisheye ? "]" : ")") + " degrees");
+
+    const float half_fov = camera.fov * (std::numbers::pi_v<float> / 180.0f) * 0.5f;
+    const float tan_half = std::tan(half_fov);
+    f.u = f.u_hat * tan_half;
+    f.v = f.v_hat * (tan_half / f.aspect);
+    f.half_fov_radians = half_fov;
+    f.half_width = camera.width * 0.5f;
+    f.half_height = camera.width / (2.0f * f.aspect);
+    f.aperture = camera.aperture;
+    f.focus_distance = camera.focus_distance;
+    return f;
+}
+
+}  // namespace octray
