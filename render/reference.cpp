@@ -1,1 +1,303 @@
-// (in progress)
+// The scalar reference renderer. Each function follows shared/spec/rendering-model.md
+// step by step; render/README.md lists the few choices the model leaves open.
+
+#include "render/reference.h"
+
+#include <oneapi/tbb/blocked_range2d.h>
+#include <oneapi/tbb/combinable.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "core/random.h"
+
+namespace octray {
+namespace {
+
+// A new ray whose weight is below this in every channel is not traced.
+constexpr float kMinRayWeight = 1e-3f;
+// A plane whose normal is this close to perpendicular to the ray is missed.
+constexpr float kPlaneParallelEpsilon = 1e-12f;
+
+// Ray-sphere (rendering model, "Sphere"): with O' = O - c, b = O'.V, c' = O'.O' - r^2,
+// disc = b^2 - (V.V) c'; the nearer root in (t_min, t_max) counts, a double root too.
+std::optional<float> intersect_sphere(const Object& s, const Ray& ray) {
+    const Vec3 oc = ray.origin - s.center;
+    const float b = dot(oc, ray.direction);
+    const float c = dot(oc, oc) - s.radius * s.radius;
+    const float a = dot(ray.direction, ray.direction);
+    const float disc = b * b - a * c;
+    if (disc < 0.0f) return std::nullopt;
+    const float root = std::sqrt(disc);
+    const float t_near = (-b - root) / a;
+    if (ray.live(t_near)) return t_near;
+    const float t_far = (-b + root) / a;
+    if (ray.live(t_far)) return t_far;
+    return std::nullopt;
+}
+
+// Ray-plane: t = ((P0 - O).N) / (V.N), computed as (d - O.N) / (V.N) with d = P0.N, the
+// form the SoA plane arrays store (so both paths round identically). A denominator below
+// 1e-12 in magnitude is a miss; so is a t outside the live interval (behind the origin).
+std::optional<float> intersect_plane(const Object& p, const Ray& ray) {
+    const float denom = dot(ray.direction, p.normal);
+    if (!(std::fabs(denom) >= kPlaneParallelEpsilon)) return std::nullopt;
+    const float t = (dot(p.point, p.normal) - dot(ray.origin, p.normal)) / denom;
+    if (ray.live(t)) return t;
+    return std::nullopt;
+}
+
+// Parity of floor(x) as 0 or 1, exact for every finite float (above 2^24 all floats are
+// even integers, and x - 2 floor(x/2) has no rounding).
+float floor_parity(float x) {
+    const float f = std::floor(x);
+    return f - 2.0f * std::floor(f * 0.5f);
+}
+
+}  // namespace
+
+ReferenceTracer::ReferenceTracer(const Scene& scene)
+    : scene_(scene),
+      camera_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)),
+      background_up_(normalize(scene.camera.up)),
+      epsilon_(self_intersection_epsilon(scene)) {
+    checker_bases_.reserve(scene.objects.size());
+    for (const Object& o : scene.objects)
+        checker_bases_.push_back(o.type == ObjectType::plane ? checker_basis(o.normal)
+                                                             : TangentBasis{});
+}
+
+std::optional<Ray> ReferenceTracer::camera_ray(int i, int j, std::uint32_t sample,
+                                               std::uint32_t frame) const {
+    const auto ui = static_cast<std::uint32_t>(i), uj = static_cast<std::uint32_t>(j);
+    const PixelOffset o = pixel_sample_offset(
+        frame, ui, uj, sample, static_cast<std::uint32_t>(scene_.image.spp), scene_.render.seed);
+    const float x = film_x(i, o.ox, scene_.image.width);
+    const float y = film_y(j, o.oy, scene_.image.height);
+    const CameraFrame& c = camera_;
+
+    Ray ray;
+    ray.t_min = epsilon_;
+    ray.t_max = kInfinity;
+    switch (c.type) {
+        case CameraType::pinhole:
+            ray.origin = c.eye;
+            ray.direction = normalize(c.ln + c.u * x + c.v * y);
+            break;
+        case CameraType::orthographic:
+            ray.origin = c.eye + c.u_hat * (x * c.half_width) + c.v_hat * (y * c.half_height);
+            ray.direction = c.ln;
+            break;
+        case CameraType::thinlens: {
+            // Aim at the pinhole ray's point on the focal plane (perpendicular to ln at
+            // focus_distance) from a point on the lens disk (polar mapping, r = a sqrt(u)).
+            const Vec3 d = normalize(c.ln + c.u * x + c.v * y);
+            const Vec3 focus = c.eye + d * (c.focus_distance / dot(d, c.ln));
+            const float lu = sample_uniform(frame, ui, uj, sample, kDimLensU, scene_.render.seed);
+            const float lv = sample_uniform(frame, ui, uj, sample, kDimLensV, scene_.render.seed);
+            const float r = c.aperture * std::sqrt(lu);
+            const float phi = 2.0f * std::numbers::pi_v<float> * lv;
+            ray.origin = c.eye + c.u_hat * (r * std::cos(phi)) + c.v_hat * (r * std::sin(phi));
+            ray.direction = normalize(focus - ray.origin);
+            break;
+        }
+        case CameraType::fisheye: {
+            // Equidistant: angle from the axis grows linearly with the film radius.
+            const float ya = y / c.aspect;
+            const float r = std::sqrt(x * x + ya * ya);
+            if (r > 1.0f) return std::nullopt;  // outside the image circle: black
+            const float psi = r * c.half_fov_radians;
+            const float phi = std::atan2(ya, x);
+            ray.origin = c.eye;
+            ray.direction = c.ln * std::cos(psi) +
+                            (c.u_hat * std::cos(phi) + c.v_hat * std::sin(phi)) * std::sin(psi);
+            break;
+        }
+    }
+    return ray;
+}
+
+std::optional<SurfaceHit> ReferenceTracer::intersect(const Ray& ray) const {
+    std::optional<SurfaceHit> best;
+    Ray live = ray;  // shrink t_max as hits are found: strict '<' keeps the first listed
+    for (std::uint32_t k = 0; k < scene_.objects.size(); ++k) {
+        const Object& o = scene_.objects[k];
+        const std::optional<float> t =
+            o.type == ObjectType::sphere ? intersect_sphere(o, live) : intersect_plane(o, live);
+        if (!t) continue;
+        live.t_max = *t;
+        best = SurfaceHit{*t, k, {}, {}};
+    }
+    if (!best) return best;
+    const Object& o = scene_.objects[best->object];
+    best->point = ray.at(best->t);
+    best->normal = o.type == ObjectType::sphere ? (best->point - o.center) / o.radius : o.normal;
+    return best;
+}
+
+bool ReferenceTracer::occluded(const Ray& ray) const {
+    for (const Object& o : scene_.objects) {
+        const std::optional<float> t =
+            o.type == ObjectType::sphere ? intersect_sphere(o, ray) : intersect_plane(o, ray);
+        if (t) return true;
+    }
+    return false;
+}
+
+Rgb ReferenceTracer::background(Vec3 direction) const {
+    const Background& bg = scene_.background;
+    if (bg.type == BackgroundType::constant) return bg.color;
+    // Vertical gradient by the direction's component along the camera's up as given.
+    const float s = 0.5f * (dot(normalize(direction), background_up_) + 1.0f);
+    return mix(bg.bottom, bg.top, s);
+}
+
+Rgb ReferenceTracer::trace(const Ray& ray, int depth, Rgb weight, RayCounts& counts) const {
+    const std::optional<SurfaceHit> hit = intersect(ray);
+    if (!hit) return background(ray.direction);
+    return shade(ray, *hit, depth, weight, counts);
+}
+
+Rgb ReferenceTracer::shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb weight,
+                           RayCounts& counts) const {
+    const Object& object = scene_.objects[hit.object];
+    const Material& m = scene_.materials[object.material].material;
+    const Vec3 v_hat = normalize(ray.direction);
+    const Vec3 p = hit.point;
+    // The normal facing the incoming ray; refraction below still uses hit.normal.
+    const Vec3 n = dot(hit.normal, ray.direction) > 0.0f ? -hit.normal : hit.normal;
+    const Vec3 w = -v_hat;
+
+    // Surface color: Cd, or the checker's second color on odd squares (planes only).
+    Rgb cd = m.color;
+    if (m.checker && object.type == ObjectType::plane) {
+        const TangentBasis& tb = checker_bases_[hit.object];
+        const float parity = floor_parity(dot(p, tb.t1) / m.checker->size) +
+                             floor_parity(dot(p, tb.t2) / m.checker->size);
+        if (parity == 1.0f) cd = m.checker->color;
+    }
+
+    // Ambient term.
+    Rgb color = scene_.ambient * (cd * m.kd);
+
+    // Direct light: Phong diffuse + highlight, gated by a shadow ray.
+    const Vec3 shadow_origin = p + n * epsilon_;
+    for (const Light& light : scene_.lights) {
+        Vec3 to_light, l;
+        float dist2 = 0.0f;
+        Ray shadow;
+        shadow.origin = shadow_origin;
+        shadow.t_min = 0.0f;
+        if (light.type == LightType::point) {
+            to_light = light.position - p;
+            dist2 = dot(to_light, to_light);
+            l = normalize(to_light);
+            shadow.direction = to_light;  // not normalised: the light sits at t = 1
+            shadow.t_max = 1.0f;
+        } else {
+            l = -normalize(light.direction);
+            shadow.direction = l;
+            shadow.t_max = kInfinity;
+        }
+        const float n_dot_l = dot(n, l);
+        if (!(n_dot_l > 0.0f)) continue;  // light behind the surface: no term, no shadow ray
+        ++counts.shadow;
+        if (occluded(shadow)) continue;
+
+        Rgb radiance = light.color;
+        if (light.type == LightType::point && light.inverse_square) radiance = radiance / dist2;
+        const Vec3 r = n * (2.0f * n_dot_l) - l;  // R_l = 2(N.l)N - l
+        const float r_dot_w = std::max(0.0f, dot(r, w));
+        const float highlight = m.ks * std::pow(r_dot_w, m.shininess);
+        color += radiance * (cd * (m.kd * n_dot_l) + Rgb(highlight));
+    }
+
+    // Refraction direction first: total internal reflection moves kt onto the mirror ray.
+    Rgb kr = m.reflect;
+    std::optional<Vec3> refracted;
+    if (m.transmit > 0.0f) {
+        // Snell's law with the unflipped normal: entering when V.N < 0.
+        const float cos_i = dot(v_hat, hit.normal);
+        const bool entering = cos_i < 0.0f;
+        const float eta = entering ? 1.0f / m.ior : m.ior;
+        const Vec3 nt = entering ? hit.normal : -hit.normal;
+        const float c = entering ? -cos_i : cos_i;
+        const float k = 1.0f - eta * eta * (1.0f - c * c);
+        if (k < 0.0f) {
+            kr = kr + Rgb(m.transmit);  // TIR
+        } else {
+            refracted = v_hat * eta + nt * (eta * c - std::sqrt(k));
+        }
+    }
+
+    // A secondary ray: traced when within max_depth and heavy enough, else it sees the
+    // background along its direction.
+    const auto secondary = [&](Vec3 origin, Vec3 direction, Rgb factor,
+                               std::uint64_t& counter) {
+        const Rgb child_weight = weight * factor;
+        if (depth + 1 > scene_.render.max_depth || !(max_component(child_weight) >= kMinRayWeight))
+            return factor * background(direction);
+        ++counter;
+        const Ray child{origin, direction, 0.0f, kInfinity};
+        return factor * trace(child, depth + 1, child_weight, counts);
+    };
+
+    if (max_component(kr) > 0.0f) {
+        const Vec3 reflected = ray.direction - hit.normal * (2.0f * dot(hit.normal, ray.direction));
+        color += secondary(p + n * epsilon_, reflected, kr, counts.reflected);
+    }
+    if (refracted) {
+        color += secondary(p - n * epsilon_, *refracted, Rgb(m.transmit), counts.refracted);
+    }
+    return color;
+}
+
+Rgb ReferenceTracer::render_pixel(int i, int j, std::uint32_t frame, RayCounts& counts) const {
+    Rgb sum;
+    const int spp = scene_.image.spp;
+    for (int s = 0; s < spp; ++s) {
+        const std::optional<Ray> ray = camera_ray(i, j, static_cast<std::uint32_t>(s), frame);
+        if (!ray) continue;  // fisheye sample outside the image circle: black
+        ++counts.primary;
+        sum += trace(*ray, 0, Rgb(1.0f), counts);
+    }
+    return sum / static_cast<float>(spp);
+}
+
+RenderResult render_reference(const Scene& scene, const RenderOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    const ReferenceTracer tracer(scene);
+    RenderResult result;
+    result.image = Image(scene.image.width, scene.image.height);
+    tbb::combinable<RayCounts> counts;
+
+    const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
+    const auto render_tiles = [&] {
+        // Each pixel depends only on its own counters, so any split gives the same bits.
+        tbb::parallel_for(
+            tbb::blocked_range2d<int>(0, scene.image.height, th, 0, scene.image.width, tw),
+            [&](const tbb::blocked_range2d<int>& tile) {
+                RayCounts& local = counts.local();
+                for (int j = tile.rows().begin(); j < tile.rows().end(); ++j)
+                    for (int i = tile.cols().begin(); i < tile.cols().end(); ++i)
+                        result.image.at(i, j) = tracer.render_pixel(i, j, options.frame, local);
+            },
+            tbb::simple_partitioner());
+    };
+    if (options.threads > 0) {
+        tbb::task_arena arena(options.threads);
+        arena.execute(render_tiles);
+    } else {
+        render_tiles();
+    }
+    counts.combine_each([&](const RayCounts& c) { result.rays += c; });
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace octray

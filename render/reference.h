@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "core/ray.h"
 #include "render/types.h"
@@ -54,6 +55,7 @@ private:
     CameraFrame camera_;
     Vec3 background_up_;  // the camera's up as given, normalised (gradient background)
     float epsilon_;
+    std::vector<TangentBasis> checker_bases_;  // per object; planes only
 };
 
 // Renders the whole image; tiles may run in parallel (TBB), one ray at a time per thread.
