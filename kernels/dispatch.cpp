@@ -1,0 +1,154 @@
+// Baseline code (no ISA flags): it runs before we know what the CPU has.
+
+#include "kernels/dispatch.h"
+
+#include <stdexcept>
+#include <xsimd/xsimd.hpp>
+
+namespace octray {
+
+const char* isa_name(Isa isa) {
+    switch (isa) {
+        case Isa::automatic:
+            return "auto";
+        case Isa::sse2:
+            return "sse2";
+        case Isa::sse4_1:
+            return "sse4.1";
+        case Isa::avx2:
+            return "avx2";
+    }
+    return "?";
+}
+
+std::optional<Isa> parse_isa(std::string_view name) {
+    for (Isa isa : {Isa::automatic, Isa::sse2, Isa::sse4_1, Isa::avx2})
+        if (name == isa_name(isa)) return isa;
+    return std::nullopt;
+}
+
+CpuSupport cpu_support() {
+    const auto arch = xsimd::available_architectures();
+    CpuSupport s;
+    s.sse2 = arch.sse2;
+    s.sse4_1 = arch.sse4_1;
+    s.avx2 = arch.avx2;
+    s.fma = arch.fma3_avx2;  // xsimd: AVX2 and the FMA3 CPUID bit
+    return s;
+}
+
+bool isa_supported(Isa isa) {
+    const CpuSupport s = cpu_support();
+    switch (isa) {
+        case Isa::automatic:
+            return true;
+        case Isa::sse2:
+            return s.sse2;
+        case Isa::sse4_1:
+            return s.sse4_1;
+        case Isa::avx2:
+            return s.avx2 && s.fma;
+    }
+    return false;
+}
+
+std::vector<Isa> compiled_isas() { return {Isa::sse2, Isa::sse4_1, Isa::avx2}; }
+
+std::vector<Isa> supported_isas() {
+    std::vector<Isa> out;
+    for (Isa isa : compiled_isas())
+        if (isa_supported(isa)) out.push_back(isa);
+    return out;
+}
+
+Isa resolve_isa(Isa requested) {
+    if (requested != Isa::automatic) {
+        if (!isa_supported(requested))
+            throw std::runtime_error(std::string("this CPU does not support --isa ") +
+                                     isa_name(requested));
+        return requested;
+    }
+    const std::vector<Isa> supported = supported_isas();
+    if (supported.empty()) throw std::runtime_error("this CPU lacks even SSE2");
+    return supported.back();
+}
+
+const kernels::KernelTable& kernel_table(Isa isa) {
+    switch (isa) {
+        case Isa::sse2:
+            return kernels::kKernelsSse2;
+        case Isa::sse4_1:
+            return kernels::kKernelsSse41;
+        case Isa::avx2:
+            return kernels::kKernelsAvx2;
+        case Isa::automatic:
+            break;
+    }
+    throw std::logic_error("kernel_table() needs a resolved ISA");
+}
+
+kernels::SceneView make_scene_view(const CompiledScene& c) {
+    kernels::SceneView v{};
+    const CompiledSpheres& s = c.spheres;
+    v.sphere_count = s.count;
+    v.sphere_cx = s.cx.data(), v.sphere_cy = s.cy.data(), v.sphere_cz = s.cz.data();
+    v.sphere_r2 = s.r2.data();
+    v.sphere_object = s.object.data();
+
+    const CompiledPlanes& p = c.planes;
+    v.plane_count = p.count;
+    v.plane_nx = p.nx.data(), v.plane_ny = p.ny.data(), v.plane_nz = p.nz.data();
+    v.plane_d = p.d.data();
+    v.plane_object = p.object.data();
+
+    const CompiledObjects& o = c.objects;
+    v.object_count = o.count;
+    v.object_is_plane = o.is_plane.data(), v.object_material = o.material.data();
+    v.object_checker = o.checker.data();
+    v.object_cx = o.cx.data(), v.object_cy = o.cy.data(), v.object_cz = o.cz.data();
+    v.object_radius = o.radius.data();
+    v.object_nx = o.nx.data(), v.object_ny = o.ny.data(), v.object_nz = o.nz.data();
+    v.object_t1x = o.t1x.data(), v.object_t1y = o.t1y.data(), v.object_t1z = o.t1z.data();
+    v.object_t2x = o.t2x.data(), v.object_t2y = o.t2y.data(), v.object_t2z = o.t2z.data();
+
+    const CompiledMaterials& m = c.materials;
+    v.mat_cd_r = m.cd_r.data(), v.mat_cd_g = m.cd_g.data(), v.mat_cd_b = m.cd_b.data();
+    v.mat_kd = m.kd.data(), v.mat_ks = m.ks.data(), v.mat_shininess = m.shininess.data();
+    v.mat_kr_r = m.kr_r.data(), v.mat_kr_g = m.kr_g.data(), v.mat_kr_b = m.kr_b.data();
+    v.mat_kt = m.kt.data(), v.mat_ior = m.ior.data();
+    v.mat_pow_zero_below = m.pow_zero_below.data();
+    v.mat_checker_r = m.checker_r.data(), v.mat_checker_g = m.checker_g.data();
+    v.mat_checker_b = m.checker_b.data(), v.mat_checker_size = m.checker_size.data();
+
+    const CompiledLights& l = c.lights;
+    v.light_count = l.count;
+    v.light_directional = l.directional.data(),
+    v.light_inverse_square = l.inverse_square.data();
+    v.light_px = l.px.data(), v.light_py = l.py.data(), v.light_pz = l.pz.data();
+    v.light_lx = l.lx.data(), v.light_ly = l.ly.data(), v.light_lz = l.lz.data();
+    v.light_r = l.r.data(), v.light_g = l.g.data(), v.light_b = l.b.data();
+
+    const CameraFrame& f = c.camera;
+    v.camera = static_cast<kernels::CameraKind>(static_cast<int>(f.type));
+    const auto put = [](float(&dst)[3], Vec3 a) { dst[0] = a.x, dst[1] = a.y, dst[2] = a.z; };
+    const auto put_rgb = [](float(&dst)[3], Rgb a) {
+        dst[0] = a.r, dst[1] = a.g, dst[2] = a.b;
+    };
+    put(v.eye, f.eye), put(v.ln, f.ln), put(v.u_hat, f.u_hat), put(v.v_hat, f.v_hat);
+    put(v.u, f.u), put(v.v, f.v);
+    v.aspect = f.aspect, v.half_width = f.half_width, v.half_height = f.half_height;
+    v.half_fov_radians = f.half_fov_radians, v.aperture = f.aperture;
+    v.focus_distance = f.focus_distance;
+
+    v.background = c.background.type == BackgroundType::constant
+                       ? kernels::BackgroundKind::constant
+                       : kernels::BackgroundKind::gradient;
+    put_rgb(v.bg_color, c.background.color), put_rgb(v.bg_bottom, c.background.bottom);
+    put_rgb(v.bg_top, c.background.top), put(v.bg_up, c.background_up);
+    put_rgb(v.ambient, c.ambient);
+    v.epsilon = c.epsilon;
+    v.max_depth = c.max_depth;
+    return v;
+}
+
+}  // namespace octray

@@ -1,0 +1,40 @@
+#pragma once
+// One table of kernel entry points per ISA, each defined in its own translation unit
+// (kernels_avx2.cpp, kernels_sse41.cpp, kernels_sse2.cpp) and picked at run time by
+// kernels/dispatch.h. Plain data only (see kernels/README.md, "the ODR rule").
+
+#include <cstdint>
+
+#include "kernels/isa.h"
+#include "kernels/kernel_types.h"
+
+namespace octray::kernels {
+
+struct KernelTable {
+    Isa isa;
+    const char* name;
+    std::uint32_t lanes_per_register;  // 8 (AVX2) or 4 (SSE): registers per packet = 8 / this
+
+    // Primary rays for `count` camera samples; returns how many rays it wrote (the
+    // fisheye drops samples outside its image circle). Weights are 1.
+    std::uint32_t (*camera_rays)(const SceneView& scene, const CameraSamples& samples,
+                                 std::uint32_t count, const RayStream& out);
+
+    // Closest hit on (t_min, inf) for `count` rays.
+    void (*closest_hit)(const SceneView& scene, const RayStream& rays, std::uint32_t count,
+                        float t_min, const HitStream& hits);
+
+    // occluded[i] = 1 when shadow ray i hits anything on (0, t_max), else 0.
+    void (*any_hit)(const SceneView& scene, const ShadowStream& rays, std::uint32_t count,
+                    std::uint32_t* occluded);
+
+    // Shades a generation: per-ray colors, shadow rays, the next generation.
+    ShadeCounts (*shade)(const SceneView& scene, const ShadeInput& in, const ShadeOutput& out);
+};
+
+// Defined in the per-ISA translation units.
+extern const KernelTable kKernelsSse2;
+extern const KernelTable kKernelsSse41;
+extern const KernelTable kKernelsAvx2;
+
+}  // namespace octray::kernels

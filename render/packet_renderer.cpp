@@ -1,0 +1,356 @@
+// The packet renderer: per tile, camera samples -> primary rays -> (closest hit -> shade ->
+// shadow any-hit -> accumulate) per generation until no ray is left. Everything numeric
+// happens in the kernels; this file owns memory, order and threads.
+
+#include "render/packet_renderer.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/enumerable_thread_specific.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "core/aligned.h"
+#include "core/random.h"
+#include "kernels/dispatch.h"
+#include "scene/camera.h"
+
+namespace octray {
+namespace {
+
+using kernels::kPacketWidth;
+
+// Rounds a stream length up to whole packets, with one spare packet.
+std::size_t stream_capacity(std::size_t n) {
+    return (n + kPacketWidth - 1) / kPacketWidth * kPacketWidth + kPacketWidth;
+}
+
+// Grows (never shrinks) a set of SoA columns: steady state allocates nothing.
+template <class... Columns>
+void grow(std::size_t n, Columns&... columns) {
+    const std::size_t capacity = stream_capacity(n);
+    ((columns.size() < capacity ? columns.resize(capacity) : void()), ...);
+}
+
+struct SampleStorage {
+    AlignedVector<float> x, y, lens_u, lens_v;
+    AlignedVector<std::uint32_t> pixel;
+    void reserve(std::size_t n) { grow(n, x, y, lens_u, lens_v, pixel); }
+    kernels::CameraSamples view() const {
+        return {x.data(), y.data(), lens_u.data(), lens_v.data(), pixel.data()};
+    }
+};
+
+struct RayStorage {
+    AlignedVector<float> ox, oy, oz, dx, dy, dz, wr, wg, wb;
+    AlignedVector<std::uint32_t> pixel;
+    void reserve(std::size_t n) { grow(n, ox, oy, oz, dx, dy, dz, wr, wg, wb, pixel); }
+    kernels::RayStream view() {
+        return {ox.data(), oy.data(), oz.data(), dx.data(), dy.data(),
+                dz.data(), wr.data(), wg.data(), wb.data(), pixel.data()};
+    }
+};
+
+struct HitStorage {
+    AlignedVector<float> t;
+    AlignedVector<std::int32_t> object;
+    void reserve(std::size_t n) { grow(n, t, object); }
+    kernels::HitStream view() { return {t.data(), object.data()}; }
+};
+
+struct ShadowStorage {
+    AlignedVector<float> ox, oy, oz, dx, dy, dz, t_max, term_r, term_g, term_b;
+    AlignedVector<std::uint32_t> parent, occluded;
+    void reserve(std::size_t n) {
+        grow(n, ox, oy, oz, dx, dy, dz, t_max, term_r, term_g, term_b, parent, occluded);
+    }
+    kernels::ShadowStream view() {
+        return {ox.data(),     oy.data(),     oz.data(),    dx.data(),
+                dy.data(),     dz.data(),     t_max.data(), term_r.data(),
+                term_g.data(), term_b.data(), parent.data()};
+    }
+};
+
+struct ColorStorage {
+    AlignedVector<float> local_r, local_g, local_b, refl_r, refl_g, refl_b, refr_r, refr_g,
+        refr_b;
+    void reserve(std::size_t n) {
+        grow(n, local_r, local_g, local_b, refl_r, refl_g, refl_b, refr_r, refr_g, refr_b);
+    }
+    kernels::SurfaceColor view() {
+        return {local_r.data(), local_g.data(), local_b.data(), refl_r.data(), refl_g.data(),
+                refl_b.data(),  refr_r.data(),  refr_g.data(),  refr_b.data()};
+    }
+};
+
+// One generation of a tile's ray tree: each ray's color parts and, for secondary rays,
+// the link to the parent whose color they complete.
+struct Generation {
+    std::uint32_t count = 0;
+    ColorStorage color;
+    AlignedVector<std::uint32_t> parent;  // 2 * parent slot + (0 mirror, 1 refracted)
+    AlignedVector<float> factor_r, factor_g, factor_b;
+    void reserve_links(std::size_t n) { grow(n, parent, factor_r, factor_g, factor_b); }
+    kernels::ChildLinks links() {
+        return {parent.data(), factor_r.data(), factor_g.data(), factor_b.data()};
+    }
+};
+
+// Per-thread scratch, reused tile after tile.
+struct TileScratch {
+    SampleStorage samples;
+    RayStorage rays, next;
+    HitStorage hits;
+    ShadowStorage shadows;
+    std::vector<Generation> generations;  // grows to the deepest tree seen, never shrinks
+    AlignedVector<std::uint32_t> primary_pixel;  // tile pixel of each primary ray
+    AlignedVector<float> acc_r, acc_g, acc_b;    // the tile's sums of samples
+    RayCounts counts;
+};
+
+// Adds each unoccluded shadow ray's light term to its parent's color. Shadow rays of one
+// parent come in light order, so the terms are summed in the reference's order.
+void add_visible_terms(const ShadowStorage& shadows, std::uint32_t count,
+                       const kernels::SurfaceColor& color) {
+    const std::uint32_t* occluded = shadows.occluded.data();
+    const std::uint32_t* parent = shadows.parent.data();
+    const float *tr = shadows.term_r.data(), *tg = shadows.term_g.data(),
+                *tb = shadows.term_b.data();
+    for (std::uint32_t k = 0; k < count; ++k) {
+        if (occluded[k] != 0) continue;
+        const std::uint32_t p = parent[k];
+        color.local_r[p] += tr[k];
+        color.local_g[p] += tg[k];
+        color.local_b[p] += tb[k];
+    }
+}
+
+// A generation's colors ((local + mirror tail) + refraction tail) times their factor into
+// their parents' tails: the reference's factor * trace(child).
+void resolve_into_parents(const kernels::SurfaceColor& c, const kernels::ChildLinks& links,
+                          std::uint32_t count, const kernels::SurfaceColor& up) {
+    for (std::uint32_t r = 0; r < count; ++r) {
+        const float cr = (c.local_r[r] + c.tail_reflect_r[r]) + c.tail_refract_r[r];
+        const float cg = (c.local_g[r] + c.tail_reflect_g[r]) + c.tail_refract_g[r];
+        const float cb = (c.local_b[r] + c.tail_reflect_b[r]) + c.tail_refract_b[r];
+        const std::uint32_t slot = links.parent[r] >> 1;
+        if ((links.parent[r] & 1u) != 0) {
+            up.tail_refract_r[slot] = links.factor_r[r] * cr;
+            up.tail_refract_g[slot] = links.factor_g[r] * cg;
+            up.tail_refract_b[slot] = links.factor_b[r] * cb;
+        } else {
+            up.tail_reflect_r[slot] = links.factor_r[r] * cr;
+            up.tail_reflect_g[slot] = links.factor_g[r] * cg;
+            up.tail_reflect_b[slot] = links.factor_b[r] * cb;
+        }
+    }
+}
+
+struct Tile {
+    int x0, y0, width, height;
+};
+
+// Pixel blocks of 4 x 2 inside a tile: eight neighbouring pixels fill one packet at one
+// sample per pixel.
+constexpr int kBlockWidth = 4;
+constexpr int kBlockHeight = 2;
+
+class PacketTracer {
+  public:
+    PacketTracer(const CompiledScene& scene, const kernels::KernelTable& table,
+                 std::uint32_t frame)
+        : scene_(scene), view_(make_scene_view(scene)), k_(table), frame_(frame) {
+        // One sample per pixel sits at the pixel center: the film position of a column
+        // (row) is the same for every row (column), computed once.
+        for (int i = 0; i < scene.width; ++i) center_x_.push_back(film_x(i, 0.5f, scene.width));
+        for (int j = 0; j < scene.height; ++j)
+            center_y_.push_back(film_y(j, 0.5f, scene.height));
+    }
+
+    void render_tile(const Tile& tile, TileScratch& s, Image& image) const {
+        const int spp = scene_.spp;
+        const std::size_t pixels = static_cast<std::size_t>(tile.width) * tile.height;
+        const std::size_t samples = pixels * static_cast<std::size_t>(spp);
+        s.acc_r.assign(pixels, 0.0f);
+        s.acc_g.assign(pixels, 0.0f);
+        s.acc_b.assign(pixels, 0.0f);
+
+        // Camera samples: block by block, pixel by pixel, sample by sample. Every stream
+        // below keeps this order per pixel, so a pixel's contributions arrive in the same
+        // order whatever the tile size.
+        s.samples.reserve(samples);
+        const bool lens = scene_.camera.type == CameraType::thinlens;
+        float *sx = s.samples.x.data(), *sy = s.samples.y.data();
+        float *su = s.samples.lens_u.data(), *sv = s.samples.lens_v.data();
+        std::uint32_t* spixel = s.samples.pixel.data();
+        std::size_t n = 0;
+        for (int by = 0; by < tile.height; by += kBlockHeight)
+            for (int bx = 0; bx < tile.width; bx += kBlockWidth)
+                for (int y = by; y < std::min(by + kBlockHeight, tile.height); ++y)
+                    for (int x = bx; x < std::min(bx + kBlockWidth, tile.width); ++x) {
+                        const int i = tile.x0 + x, j = tile.y0 + y;
+                        const auto ui = static_cast<std::uint32_t>(i);
+                        const auto uj = static_cast<std::uint32_t>(j);
+                        if (spp == 1 && !lens) {
+                            sx[n] = center_x_[static_cast<std::size_t>(i)];
+                            sy[n] = center_y_[static_cast<std::size_t>(j)];
+                            su[n] = sv[n] = 0.0f;
+                            spixel[n++] = static_cast<std::uint32_t>(y * tile.width + x);
+                            continue;
+                        }
+                        for (int k = 0; k < spp; ++k, ++n) {
+                            const auto sample = static_cast<std::uint32_t>(k);
+                            const PixelOffset o = pixel_sample_offset(
+                                frame_, ui, uj, sample, static_cast<std::uint32_t>(spp),
+                                scene_.seed);
+                            sx[n] = film_x(i, o.ox, scene_.width);
+                            sy[n] = film_y(j, o.oy, scene_.height);
+                            su[n] = lens ? sample_uniform(frame_, ui, uj, sample, kDimLensU,
+                                                          scene_.seed)
+                                         : 0.0f;
+                            sv[n] = lens ? sample_uniform(frame_, ui, uj, sample, kDimLensV,
+                                                          scene_.seed)
+                                         : 0.0f;
+                            spixel[n] = static_cast<std::uint32_t>(y * tile.width + x);
+                        }
+                    }
+        // Padding lanes: a harmless film position.
+        for (std::size_t k = n; k < s.samples.x.size(); ++k) {
+            s.samples.x[k] = s.samples.y[k] = s.samples.lens_u[k] = s.samples.lens_v[k] = 0.0f;
+            s.samples.pixel[k] = 0;
+        }
+
+        s.rays.reserve(samples);
+        std::uint32_t count = k_.camera_rays(
+            view_, s.samples.view(), static_cast<std::uint32_t>(samples), s.rays.view());
+        s.counts.primary += count;
+
+        s.primary_pixel.assign(s.rays.pixel.begin(), s.rays.pixel.begin() + count);
+
+        // Generations, breadth first: primary rays live on (ε_s, inf), secondary ones on
+        // (0, inf). Each generation's colors are kept until the tree is complete.
+        float t_min = scene_.epsilon;
+        int depth = 0;
+        for (; count > 0; ++depth, t_min = 0.0f) {
+            if (s.generations.size() < static_cast<std::size_t>(depth) + 2)
+                s.generations.resize(static_cast<std::size_t>(depth) + 2);
+            Generation& gen = s.generations[static_cast<std::size_t>(depth)];
+            Generation& children = s.generations[static_cast<std::size_t>(depth) + 1];
+            gen.count = count;
+            s.hits.reserve(count);
+            s.shadows.reserve(static_cast<std::size_t>(count) * scene_.lights.count);
+            gen.color.reserve(count);
+            s.next.reserve(2 * static_cast<std::size_t>(count));
+            children.reserve_links(2 * static_cast<std::size_t>(count));
+
+            const kernels::RayStream rays = s.rays.view();
+            k_.closest_hit(view_, rays, count, t_min, s.hits.view());
+            const kernels::ShadeCounts shaded =
+                k_.shade(view_, kernels::ShadeInput{rays, s.hits.view(), count, depth},
+                         kernels::ShadeOutput{gen.color.view(), s.shadows.view(), s.next.view(),
+                                              children.links()});
+            k_.any_hit(view_, s.shadows.view(), shaded.shadow, s.shadows.occluded.data());
+            s.counts.shadow += shaded.shadow;
+            s.counts.reflected += shaded.reflected;
+            s.counts.refracted += shaded.refracted;
+
+            // Visible light terms join their parent's color in light order.
+            add_visible_terms(s.shadows, shaded.shadow, gen.color.view());
+            std::swap(s.rays, s.next);
+            count = shaded.next;
+        }
+
+        // Resolve the tree last generation first: a ray's color is
+        // ((local + mirror tail) + refraction tail), the reference's order of terms, and a
+        // traced child's tail is factor * (the child's color), as the reference's
+        // factor * trace(child). The images agree bit for bit.
+        for (int d = depth - 1; d >= 1; --d) {
+            Generation& gen = s.generations[static_cast<std::size_t>(d)];
+            resolve_into_parents(gen.color.view(), gen.links(), gen.count,
+                                 s.generations[static_cast<std::size_t>(d) - 1].color.view());
+        }
+        // Primary rays into their pixels, sample after sample.
+        if (depth > 0) {
+            const kernels::SurfaceColor c = s.generations[0].color.view();
+            const std::uint32_t* pixel = s.primary_pixel.data();
+            float *acc_r = s.acc_r.data(), *acc_g = s.acc_g.data(), *acc_b = s.acc_b.data();
+            for (std::uint32_t r = 0, n0 = s.generations[0].count; r < n0; ++r) {
+                const std::uint32_t p = pixel[r];
+                acc_r[p] += (c.local_r[r] + c.tail_reflect_r[r]) + c.tail_refract_r[r];
+                acc_g[p] += (c.local_g[r] + c.tail_reflect_g[r]) + c.tail_refract_g[r];
+                acc_b[p] += (c.local_b[r] + c.tail_reflect_b[r]) + c.tail_refract_b[r];
+            }
+        }
+
+        // The mean of the samples.
+        const auto inv = static_cast<float>(spp);
+        for (int y = 0; y < tile.height; ++y)
+            for (int x = 0; x < tile.width; ++x) {
+                const std::size_t p = static_cast<std::size_t>(y) * tile.width + x;
+                image.at(tile.x0 + x, tile.y0 + y) =
+                    Rgb(s.acc_r[p], s.acc_g[p], s.acc_b[p]) / inv;
+            }
+    }
+
+  private:
+    const CompiledScene& scene_;
+    kernels::SceneView view_;
+    const kernels::KernelTable& k_;
+    std::uint32_t frame_;
+    std::vector<float> center_x_, center_y_;
+};
+
+}  // namespace
+
+RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options, Isa isa) {
+    const auto start = std::chrono::steady_clock::now();
+    const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
+    const PacketTracer tracer(scene, table, options.frame);
+
+    RenderResult result;
+    result.image = Image(scene.width, scene.height);
+    const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
+    const int tiles_x = (scene.width + tw - 1) / tw, tiles_y = (scene.height + th - 1) / th;
+    tbb::enumerable_thread_specific<TileScratch> scratch;
+
+    const auto render_tiles = [&] {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
+            [&](const tbb::blocked_range<int>& range) {
+                TileScratch& s = scratch.local();
+                for (int t = range.begin(); t < range.end(); ++t) {
+                    const int x0 = (t % tiles_x) * tw, y0 = (t / tiles_x) * th;
+                    const Tile tile{x0, y0, std::min(tw, scene.width - x0),
+                                    std::min(th, scene.height - y0)};
+                    tracer.render_tile(tile, s, result.image);
+                }
+            },
+            tbb::simple_partitioner());
+    };
+    if (options.threads > 0) {
+        tbb::task_arena arena(options.threads);
+        arena.execute(render_tiles);
+    } else {
+        render_tiles();
+    }
+    for (const TileScratch& s : scratch) result.rays += s.counts;
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+RenderResult render_packet(const Scene& scene, const RenderOptions& options, Isa isa) {
+    const auto start = std::chrono::steady_clock::now();
+    const CompiledScene compiled = compile_scene(scene);
+    RenderResult result = render_packet(compiled, options, isa);
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace octray

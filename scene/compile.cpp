@@ -1,0 +1,173 @@
+#include "scene/compile.h"
+
+#include <math.h>
+
+#include <bit>
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+
+namespace octray {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// At least one full packet, so that a kernel gathering for a lane that missed can always
+// read entry 0.
+std::uint32_t padded(std::uint32_t n) {
+    const std::uint32_t rounded =
+        (n + kCompiledPadding - 1) / kCompiledPadding * kCompiledPadding;
+    return rounded > 0 ? rounded : kCompiledPadding;
+}
+
+// Grows every array to the padded size with the given filler (NaN geometry never hits).
+template <class T>
+void pad(AlignedVector<T>& v, std::uint32_t n, T filler) {
+    v.resize(n, filler);
+}
+
+// The largest x in [0, 1] with powf(x, n) == 0, by bisection over the float bit patterns
+// (powf is monotonic in x on [0, 1] for n > 0); -1 when powf(0, n) is not 0 (n <= 0).
+float pow_zero_below(float n) {
+    if (!(powf(0.0f, n) == 0.0f)) return -1.0f;
+    std::uint32_t lo = 0, hi = std::bit_cast<std::uint32_t>(1.0f);  // powf(lo) == 0
+    if (powf(1.0f, n) == 0.0f) return 1.0f;
+    while (hi - lo > 1) {
+        const std::uint32_t mid = lo + (hi - lo) / 2;
+        if (powf(std::bit_cast<float>(mid), n) == 0.0f)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return std::bit_cast<float>(lo);
+}
+
+}  // namespace
+
+CompiledScene compile_scene(const Scene& scene) {
+    const auto start = std::chrono::steady_clock::now();
+    if (scene.objects.size() > (1u << 24))
+        throw std::invalid_argument("more than 2^24 objects cannot be compiled");
+
+    CompiledScene out;
+    out.camera = make_camera_frame(scene.camera, scene.image.width, scene.image.height);
+    out.background = scene.background;
+    out.background_up = normalize(scene.camera.up);
+    out.ambient = scene.ambient;
+    out.epsilon = self_intersection_epsilon(scene);
+    out.max_depth = scene.render.max_depth;
+    out.spp = scene.image.spp;
+    out.seed = scene.render.seed;
+    out.width = scene.image.width;
+    out.height = scene.image.height;
+
+    // Geometry: spheres and planes each in file order, and the per-object table.
+    CompiledSpheres& s = out.spheres;
+    CompiledPlanes& p = out.planes;
+    CompiledObjects& o = out.objects;
+    for (std::uint32_t k = 0; k < scene.objects.size(); ++k) {
+        const Object& obj = scene.objects[k];
+        const Material& m = scene.materials[obj.material].material;
+        const bool plane = obj.type == ObjectType::plane;
+        o.is_plane.push_back(plane ? 1u : 0u);
+        o.material.push_back(obj.material);
+        o.checker.push_back(plane && m.checker ? 1u : 0u);
+        if (plane) {
+            p.nx.push_back(obj.normal.x);
+            p.ny.push_back(obj.normal.y);
+            p.nz.push_back(obj.normal.z);
+            p.d.push_back(dot(obj.point, obj.normal));
+            p.material.push_back(obj.material);
+            p.object.push_back(k);
+            const TangentBasis tb = checker_basis(obj.normal);
+            o.cx.push_back(0.0f), o.cy.push_back(0.0f), o.cz.push_back(0.0f);
+            o.radius.push_back(1.0f);
+            o.nx.push_back(obj.normal.x), o.ny.push_back(obj.normal.y);
+            o.nz.push_back(obj.normal.z);
+            o.t1x.push_back(tb.t1.x), o.t1y.push_back(tb.t1.y), o.t1z.push_back(tb.t1.z);
+            o.t2x.push_back(tb.t2.x), o.t2y.push_back(tb.t2.y), o.t2z.push_back(tb.t2.z);
+        } else {
+            s.cx.push_back(obj.center.x);
+            s.cy.push_back(obj.center.y);
+            s.cz.push_back(obj.center.z);
+            s.r2.push_back(obj.radius * obj.radius);
+            s.radius.push_back(obj.radius);
+            s.material.push_back(obj.material);
+            s.object.push_back(k);
+            o.cx.push_back(obj.center.x), o.cy.push_back(obj.center.y);
+            o.cz.push_back(obj.center.z);
+            o.radius.push_back(obj.radius);
+            o.nx.push_back(0.0f), o.ny.push_back(0.0f), o.nz.push_back(0.0f);
+            o.t1x.push_back(0.0f), o.t1y.push_back(0.0f), o.t1z.push_back(0.0f);
+            o.t2x.push_back(0.0f), o.t2y.push_back(0.0f), o.t2z.push_back(0.0f);
+        }
+    }
+    s.count = static_cast<std::uint32_t>(s.cx.size());
+    s.padded_count = padded(s.count);
+    for (auto* v : {&s.cx, &s.cy, &s.cz, &s.r2, &s.radius}) pad(*v, s.padded_count, kNaN);
+    pad(s.material, s.padded_count, 0u);
+    pad(s.object, s.padded_count, std::numeric_limits<std::uint32_t>::max());
+
+    p.count = static_cast<std::uint32_t>(p.nx.size());
+    p.padded_count = padded(p.count);
+    for (auto* v : {&p.nx, &p.ny, &p.nz, &p.d}) pad(*v, p.padded_count, kNaN);
+    pad(p.material, p.padded_count, 0u);
+    pad(p.object, p.padded_count, std::numeric_limits<std::uint32_t>::max());
+
+    o.count = static_cast<std::uint32_t>(scene.objects.size());
+    o.padded_count = padded(o.count);
+    for (auto* v : {&o.is_plane, &o.material, &o.checker}) pad(*v, o.padded_count, 0u);
+    for (auto* v : {&o.cx, &o.cy, &o.cz, &o.nx, &o.ny, &o.nz, &o.t1x, &o.t1y, &o.t1z, &o.t2x,
+                    &o.t2y, &o.t2z})
+        pad(*v, o.padded_count, 0.0f);
+    pad(o.radius, o.padded_count, 1.0f);
+
+    // Materials.
+    CompiledMaterials& m = out.materials;
+    for (const NamedMaterial& nm : scene.materials) {
+        const Material& mat = nm.material;
+        m.cd_r.push_back(mat.color.r), m.cd_g.push_back(mat.color.g);
+        m.cd_b.push_back(mat.color.b);
+        m.kd.push_back(mat.kd), m.ks.push_back(mat.ks), m.shininess.push_back(mat.shininess);
+        m.kr_r.push_back(mat.reflect.r), m.kr_g.push_back(mat.reflect.g);
+        m.kr_b.push_back(mat.reflect.b);
+        m.kt.push_back(mat.transmit), m.ior.push_back(mat.ior);
+        m.pow_zero_below.push_back(pow_zero_below(mat.shininess));
+        const Checker checker = mat.checker.value_or(Checker{mat.color, 1.0f});
+        m.checker_r.push_back(checker.color.r), m.checker_g.push_back(checker.color.g);
+        m.checker_b.push_back(checker.color.b), m.checker_size.push_back(checker.size);
+    }
+    m.count = static_cast<std::uint32_t>(scene.materials.size());
+    m.padded_count = padded(m.count);
+    for (auto* v : {&m.cd_r, &m.cd_g, &m.cd_b, &m.kd, &m.ks, &m.shininess, &m.kr_r, &m.kr_g,
+                    &m.kr_b, &m.kt, &m.checker_r, &m.checker_g, &m.checker_b})
+        pad(*v, m.padded_count, 0.0f);
+    pad(m.ior, m.padded_count, 1.0f);
+    pad(m.pow_zero_below, m.padded_count, -1.0f);
+    pad(m.checker_size, m.padded_count, 1.0f);
+
+    // Lights.
+    CompiledLights& l = out.lights;
+    for (const Light& light : scene.lights) {
+        const bool directional = light.type == LightType::directional;
+        l.directional.push_back(directional ? 1u : 0u);
+        l.inverse_square.push_back(!directional && light.inverse_square ? 1u : 0u);
+        l.px.push_back(light.position.x), l.py.push_back(light.position.y);
+        l.pz.push_back(light.position.z);
+        const Vec3 dir = directional ? -normalize(light.direction) : Vec3{};
+        l.lx.push_back(dir.x), l.ly.push_back(dir.y), l.lz.push_back(dir.z);
+        l.r.push_back(light.color.r), l.g.push_back(light.color.g),
+            l.b.push_back(light.color.b);
+    }
+    l.count = static_cast<std::uint32_t>(scene.lights.size());
+    l.padded_count = padded(l.count);
+    for (auto* v : {&l.directional, &l.inverse_square}) pad(*v, l.padded_count, 0u);
+    for (auto* v : {&l.px, &l.py, &l.pz, &l.lx, &l.ly, &l.lz, &l.r, &l.g, &l.b})
+        pad(*v, l.padded_count, 0.0f);
+
+    out.compile_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+}  // namespace octray

@@ -1,0 +1,107 @@
+#pragma once
+// compile_scene(): the authored scene turned into the flat layout the packet kernels
+// stream through. Every per-primitive array is structure-of-arrays, 64-byte aligned
+// (core/aligned.h) and padded to a multiple of kCompiledPadding with entries that can
+// never be hit (NaN geometry: every comparison against NaN is false).
+//
+// The values stored are exactly the ones the scalar reference computes on the fly
+// (r^2 = r * r, d = P0.N, the checker basis, -normalize(direction) for directional
+// lights, ...), so a kernel that reads them performs the same IEEE operations in the same
+// order as render/reference.cpp and gets the same bits.
+
+#include <cstdint>
+
+#include "core/aligned.h"
+#include "core/color.h"
+#include "core/vec3.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+namespace octray {
+
+// Arrays are padded to a multiple of this many entries (one 8-wide packet, or two cache
+// lines of floats).
+inline constexpr std::uint32_t kCompiledPadding = 8;
+
+// Spheres in file order (among spheres). `object` is the index in Scene::objects, the key
+// that breaks ties between a sphere and a plane at the same t (the first listed wins).
+struct CompiledSpheres {
+    std::uint32_t count = 0;
+    std::uint32_t padded_count = 0;
+    AlignedVector<float> cx, cy, cz;
+    AlignedVector<float> r2;      // radius * radius, as the reference computes it
+    AlignedVector<float> radius;  // the normal divides by the radius
+    AlignedVector<std::uint32_t> material, object;
+};
+
+// Planes in file order (among planes): N normalised on load, d = P0.N.
+struct CompiledPlanes {
+    std::uint32_t count = 0;
+    std::uint32_t padded_count = 0;
+    AlignedVector<float> nx, ny, nz, d;
+    AlignedVector<std::uint32_t> material, object;
+};
+
+// Everything shading needs per object, indexed by the object's index in the file (the id
+// a hit carries). Spheres have radius > 0 and a zero normal; planes radius 1 and center 0,
+// so that evaluating both normal formulas for every lane never divides by zero.
+struct CompiledObjects {
+    std::uint32_t count = 0;
+    std::uint32_t padded_count = 0;
+    AlignedVector<std::uint32_t> is_plane;  // 0 sphere, 1 plane
+    AlignedVector<std::uint32_t> material;
+    AlignedVector<std::uint32_t> checker;  // 1: a plane whose material has a checker
+    AlignedVector<float> cx, cy, cz, radius;
+    AlignedVector<float> nx, ny, nz;
+    AlignedVector<float> t1x, t1y, t1z, t2x, t2y, t2z;  // checker tangent basis (planes)
+};
+
+struct CompiledMaterials {
+    std::uint32_t count = 0;
+    std::uint32_t padded_count = 0;
+    AlignedVector<float> cd_r, cd_g, cd_b;
+    AlignedVector<float> kd, ks, shininess;
+    AlignedVector<float> kr_r, kr_g, kr_b;
+    AlignedVector<float> kt, ior;
+    // The largest x in [0, 1] with powf(x, shininess) == 0 (-1 when there is none): a
+    // highlight base at or below it needs no powf call to give powf's answer.
+    AlignedVector<float> pow_zero_below;
+    AlignedVector<float> checker_r, checker_g, checker_b, checker_size;
+};
+
+struct CompiledLights {
+    std::uint32_t count = 0;
+    std::uint32_t padded_count = 0;
+    AlignedVector<std::uint32_t> directional;  // 0 point, 1 directional
+    AlignedVector<std::uint32_t> inverse_square;
+    AlignedVector<float> px, py, pz;  // point: position
+    AlignedVector<float> lx, ly, lz;  // directional: l = -normalize(direction)
+    AlignedVector<float> r, g, b;     // intensity
+};
+
+struct CompiledScene {
+    CompiledSpheres spheres;
+    CompiledPlanes planes;
+    CompiledObjects objects;
+    CompiledMaterials materials;
+    CompiledLights lights;
+
+    CameraFrame camera;
+    Background background;
+    Vec3 background_up;  // normalize(camera.up): the gradient's axis
+    Rgb ambient;
+    float epsilon = 0.0f;  // ε_s of the self-intersection rule
+    int max_depth = 5;
+    int spp = 1;
+    std::uint64_t seed = 0;
+    int width = 0;
+    int height = 0;
+
+    double compile_seconds = 0.0;  // wall-clock time compile_scene() took
+};
+
+// The scene must have passed validate_scene(). Throws std::invalid_argument for a scene
+// the kernels cannot represent (more than 2^24 objects: hit ids travel as exact floats).
+CompiledScene compile_scene(const Scene& scene);
+
+}  // namespace octray
