@@ -1,0 +1,663 @@
+// `octray bench`: scenes -> ray sets -> (validate, warm up, time) per system and mode ->
+// rows -> table / JSON. Every system reads the same ray arrays and is scheduled the same
+// way: chunks of kChunkRays rays spread over one TBB arena of `threads` threads.
+
+#include "bench/bench_runner.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <thread>
+
+#include "bench/embree_baseline.h"
+#include "core/version.h"
+#include "kernels/dispatch.h"
+#include "render/image_io.h"
+#include "render/packet_renderer.h"
+#include "render/reference.h"
+#include "scene/compile.h"
+#include "scene/load.h"
+
+namespace octray::bench {
+
+const char* trace_path_name(TracePath path) {
+    return path == TracePath::simd ? "simd" : "scalar";
+}
+
+std::optional<TracePath> parse_trace_path(std::string_view name) {
+    if (name == "simd") return TracePath::simd;
+    if (name == "scalar") return TracePath::scalar;
+    return std::nullopt;
+}
+
+const char* workload_name(Workload workload) {
+    switch (workload) {
+        case Workload::primary:
+            return "primary";
+        case Workload::shadow:
+            return "shadow";
+        case Workload::secondary:
+            return "secondary";
+        case Workload::whitted:
+            return "whitted";
+    }
+    return "?";
+}
+
+std::optional<Workload> parse_workload(std::string_view name) {
+    for (Workload w :
+         {Workload::primary, Workload::shadow, Workload::secondary, Workload::whitted})
+        if (name == workload_name(w)) return w;
+    return std::nullopt;
+}
+
+Timing summarize(std::vector<double> seconds, std::uint64_t rays) {
+    Timing t;
+    if (seconds.empty()) return t;
+    std::sort(seconds.begin(), seconds.end());
+    const std::size_t n = seconds.size();
+    t.seconds_min = seconds.front();
+    t.seconds_max = seconds.back();
+    t.seconds_median =
+        n % 2 == 1 ? seconds[n / 2] : 0.5 * (seconds[n / 2 - 1] + seconds[n / 2]);
+    const auto rate = [rays](double s) {
+        return s > 0.0 ? static_cast<double>(rays) / s / 1e6 : 0.0;
+    };
+    t.mrays_median = rate(t.seconds_median);
+    t.mrays_min = rate(t.seconds_max);
+    t.mrays_max = rate(t.seconds_min);
+    return t;
+}
+
+namespace {
+
+// Rays per task: large enough to amortise scheduling, small enough to balance two cores.
+constexpr std::uint32_t kChunkRays = 4096;
+static_assert(kChunkRays % kernels::kPacketWidth == 0);
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// f(first, n) over [0, count) in chunks, on the arena's threads.
+void for_chunks(tbb::task_arena& arena, std::uint32_t count,
+                const std::function<void(std::uint32_t, std::uint32_t)>& f) {
+    const std::uint32_t chunks = (count + kChunkRays - 1) / kChunkRays;
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<std::uint32_t>(0, chunks, 1),
+            [&](const tbb::blocked_range<std::uint32_t>& r) {
+                for (std::uint32_t c = r.begin(); c < r.end(); ++c) {
+                    const std::uint32_t first = c * kChunkRays;
+                    f(first, std::min(kChunkRays, count - first));
+                }
+            },
+            tbb::simple_partitioner());
+    });
+}
+
+// One way of tracing a ray set into a hit set.
+using Tracer = std::function<void(const RaySet&, HitSet&)>;
+
+// Warm-up runs, then `reps` timed runs; the hits of the last run stay in `hits`.
+std::vector<double> time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits, int warmup,
+                              int reps) {
+    for (int i = 0; i < std::max(1, warmup); ++i) trace(rays, hits);
+    std::vector<double> seconds;
+    for (int i = 0; i < reps; ++i) {
+        const auto start = Clock::now();
+        trace(rays, hits);
+        seconds.push_back(seconds_since(start));
+    }
+    return seconds;
+}
+
+// octray's packet kernels over the set: closest_hit, or any_hit into the occluded flags.
+Tracer octray_simd_tracer(tbb::task_arena& arena, const kernels::KernelTable& table,
+                          const kernels::SceneView& view) {
+    return [&arena, &table, view](const RaySet& rays, HitSet& hits) {
+        if (rays.kind == RayKind::shadow) {
+            // any_hit writes 0 / 1 per ray (whole packets); mapped to kNoHit / kOccluded
+            // after timing by occluded_to_hits().
+            auto* flags = reinterpret_cast<std::uint32_t*>(hits.object.data());
+            for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+                table.any_hit(view, rays.shadow_stream(first), n, flags + first);
+            });
+            return;
+        }
+        for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+            table.closest_hit(view, rays.ray_stream(first), n, rays.t_min, hits.stream(first));
+        });
+    };
+}
+
+void occluded_to_hits(HitSet& hits, std::uint32_t count) {
+    for (std::uint32_t i = 0; i < count; ++i)
+        hits.object[i] = hits.object[i] != 0 ? kOccluded : kernels::kNoHit;
+}
+
+// The scalar reference, one ray at a time.
+Tracer octray_scalar_tracer(tbb::task_arena& arena, const ReferenceTracer& tracer) {
+    return [&arena, &tracer](const RaySet& rays, HitSet& hits) {
+        const bool any = rays.kind == RayKind::shadow;
+        for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+            for (std::uint32_t i = first; i < first + n; ++i) {
+                const Ray ray = rays.ray(i);
+                if (any) {
+                    hits.object[i] = tracer.occluded(ray) ? kOccluded : kernels::kNoHit;
+                    continue;
+                }
+                const std::optional<SurfaceHit> hit = tracer.intersect(ray);
+                hits.t[i] = hit ? hit->t : kInfinity;
+                hits.object[i] = hit ? static_cast<std::int32_t>(hit->object) : kernels::kNoHit;
+            }
+        });
+    };
+}
+
+#if OCTRAY_HAVE_EMBREE
+Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMode mode) {
+    return [&arena, &scene, mode](const RaySet& rays, HitSet& hits) {
+        // Camera rays are coherent; shadow and mirror rays are traced as incoherent.
+        const bool coherent = rays.kind == RayKind::primary;
+        const bool any = rays.kind == RayKind::shadow;
+        for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+            if (any)
+                scene.occluded(mode, rays, first, n, hits, coherent);
+            else
+                scene.intersect(mode, rays, first, n, hits, coherent);
+        });
+    };
+}
+#endif
+
+std::string cpu_model() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("model name", 0) == 0) {
+            const std::size_t colon = line.find(':');
+            if (colon != std::string::npos)
+                return line.substr(line.find_first_not_of(' ', colon + 1));
+        }
+    }
+    return "unknown";
+}
+
+double load_average() {
+    std::ifstream in("/proc/loadavg");
+    double load = 0.0;
+    in >> load;
+    return load;
+}
+
+std::string utc_date() {
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char buffer[32];
+    std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    return buffer;
+}
+
+std::string compiler_name() {
+#if defined(__clang__)
+    return std::string("clang ") + __clang_version__;
+#elif defined(__GNUC__)
+    return std::string("g++ ") + __VERSION__;
+#else
+    return "unknown";
+#endif
+}
+
+void log_line(std::ostream* log, const std::string& line) {
+    if (log) *log << line << std::endl;
+}
+
+std::string format(const char* fmt, double a) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, fmt, a);
+    return buffer;
+}
+
+// Loads the spec at the bench's resolution.
+Scene load_bench_scene(const std::string& spec, int width, int height) {
+    Scene scene = load_scene(spec);
+    scene.image.width = width;
+    scene.image.height = height;
+    validate_scene(scene);
+    return scene;
+}
+
+// The packet render of the scene at the validation size equals the reference render,
+// image and ray counts.
+std::string validate_render(const std::string& spec, const BenchOptions& o, Isa isa,
+                            bool& valid) {
+    const Scene small = load_bench_scene(spec, std::min(o.width, o.validate_width),
+                                         std::min(o.height, o.validate_height));
+    RenderOptions ro;
+    ro.threads = o.threads;
+    const RenderResult ref = render_reference(small, ro);
+    const RenderResult simd = render_packet(small, ro, isa);
+    valid = ref.image == simd.image && ref.rays.total() == simd.rays.total();
+    return std::string(valid ? "valid" : "INVALID") + ": packet image " +
+           (ref.image == simd.image ? "equals" : "differs from") + " the reference image at " +
+           std::to_string(small.image.width) + "x" + std::to_string(small.image.height) +
+           ", ray counts " + (ref.rays.total() == simd.rays.total() ? "equal" : "differ");
+}
+
+struct Variant {
+    PixelOrder order;
+    TileSize tile;
+};
+
+}  // namespace
+
+void compute_ratios(std::vector<BenchRow>& rows) {
+    const auto key = [](const BenchRow& r) {
+        return r.scene + '\n' + workload_name(r.workload) + '\n' + r.order + '\n' + r.tile;
+    };
+    std::map<std::string, double> best_embree, best_octray;
+    for (const BenchRow& r : rows) {
+        if (!r.valid) continue;
+        auto& best = r.system == "embree" ? best_embree : best_octray;
+        double& b = best[key(r)];
+        b = std::max(b, r.timing.mrays_median);
+    }
+    for (BenchRow& r : rows) {
+        r.ratio.reset();
+        const auto& other = r.system == "embree" ? best_octray : best_embree;
+        const auto it = other.find(key(r));
+        if (it == other.end() || it->second <= 0.0 || r.timing.mrays_median <= 0.0) continue;
+        r.ratio = r.system == "embree" ? it->second / r.timing.mrays_median
+                                       : r.timing.mrays_median / it->second;
+    }
+}
+
+BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
+    BenchReport report;
+    BenchContext& ctx = report.context;
+    ctx.date = utc_date();
+    ctx.cpu = cpu_model();
+    ctx.logical_cpus = static_cast<int>(std::thread::hardware_concurrency());
+    ctx.threads = o.threads > 0 ? o.threads : tbb::info::default_concurrency();
+    ctx.isa = isa_name(resolve_isa(Isa::automatic));
+    ctx.compiler = compiler_name();
+    ctx.octray_version = kVersion;
+    ctx.embree_available = embree_compiled() && o.embree;
+#if OCTRAY_HAVE_EMBREE
+    ctx.embree = o.embree ? "embree " + EmbreeScene::version() : "disabled (--no-embree)";
+#else
+    ctx.embree = "not built (Embree 3 was not found by CMake)";
+#endif
+    ctx.load_average = load_average();
+    ctx.width = o.width, ctx.height = o.height, ctx.reps = o.reps, ctx.warmup = o.warmup;
+    ctx.validate_rays = o.validate_rays;
+    ctx.command_line = o.command_line;
+
+    // Forced ISAs are checked before any work.
+    std::vector<Isa> isas;
+    for (Isa isa : o.isas) {
+        const Isa resolved = resolve_isa(isa);
+        if (std::find(isas.begin(), isas.end(), resolved) == isas.end())
+            isas.push_back(resolved);
+    }
+
+    tbb::task_arena arena(ctx.threads);
+    const auto wants = [&](Workload w) {
+        return std::find(o.workloads.begin(), o.workloads.end(), w) != o.workloads.end();
+    };
+    const bool ray_sets =
+        wants(Workload::primary) || wants(Workload::shadow) || wants(Workload::secondary);
+
+    // Pixel orders; a tile size matters to the tiled order only.
+    std::vector<Variant> variants;
+    for (PixelOrder order : o.orders) {
+        if (order == PixelOrder::tiled)
+            for (TileSize tile : o.tiles) variants.push_back({order, tile});
+        else
+            variants.push_back({order, o.tiles.front()});
+    }
+
+    for (const std::string& spec : o.scenes) {
+        const Scene scene = load_bench_scene(spec, o.width, o.height);
+        const CompiledScene compiled = compile_scene(scene);
+        const kernels::SceneView view = make_scene_view(compiled);
+        const ReferenceTracer reference(scene);
+
+        SceneInfo info;
+        info.spec = spec;
+        info.objects = static_cast<std::uint32_t>(scene.objects.size());
+        info.spheres = compiled.spheres.count;
+        info.planes = compiled.planes.count;
+        info.lights = compiled.lights.count;
+        info.epsilon = compiled.epsilon;
+        info.compile_ms = compiled.compile_seconds * 1e3;
+
+#if OCTRAY_HAVE_EMBREE
+        std::unique_ptr<EmbreeScene> embree;
+        if (ctx.embree_available && ray_sets) {
+            arena.execute(
+                [&] { embree = std::make_unique<EmbreeScene>(scene, compiled, o.threads); });
+            info.embree_build_ms = embree->build_seconds() * 1e3;
+            if (report.scenes.empty()) ctx.embree = embree->device_info();
+        }
+#endif
+        log_line(log, spec + ": " + std::to_string(info.objects) + " objects, compiled in " +
+                          format("%.3f ms", info.compile_ms) +
+                          (info.embree_build_ms ? ", Embree BVH built in " +
+                                                      format("%.3f ms", *info.embree_build_ms)
+                                                : std::string()));
+
+        const auto base_row = [&](Workload w, const Variant& v) {
+            BenchRow row;
+            row.scene = spec;
+            row.workload = w;
+            row.order = w == Workload::whitted ? "tiled" : pixel_order_name(v.order);
+            row.tile = w == Workload::whitted || v.order == PixelOrder::tiled
+                           ? tile_size_name(v.tile)
+                           : "-";
+            row.threads = ctx.threads;
+            return row;
+        };
+
+        for (const Variant& v : ray_sets ? variants : std::vector<Variant>{}) {
+            const RaySet primary = make_primary_rays(
+                reference, o.width, o.height, pixel_order(o.width, o.height, v.order, v.tile));
+            // Shadow and mirror rays start at the primary hits (octray's packet hits, which
+            // the primary rows validate against the oracle).
+            HitSet primary_hits;
+            primary_hits.resize(static_cast<std::uint32_t>(primary.ox.size()));
+            octray_simd_tracer(arena, kernel_table(isas.back()), view)(primary, primary_hits);
+
+            for (Workload w : {Workload::primary, Workload::shadow, Workload::secondary}) {
+                if (!wants(w)) continue;
+                const RaySet rays = w == Workload::primary ? RaySet{}
+                                    : w == Workload::shadow
+                                        ? make_shadow_rays(scene, primary, primary_hits)
+                                        : make_secondary_rays(scene, primary, primary_hits);
+                const RaySet& set = w == Workload::primary ? primary : rays;
+                (w == Workload::primary  ? info.primary_rays
+                 : w == Workload::shadow ? info.shadow_rays
+                                         : info.secondary_rays) = set.count;
+                OracleHits oracle;
+                arena.execute([&] { oracle = oracle_hits(reference, set, o.validate_rays); });
+
+                const auto measure = [&](BenchRow row, const Tracer& trace,
+                                         const ValidationRule& rule, bool octray_any_hit) {
+                    HitSet hits;
+                    hits.resize(static_cast<std::uint32_t>(set.ox.size()));
+                    row.rays = set.count;
+                    (w == Workload::primary  ? row.counts.primary
+                     : w == Workload::shadow ? row.counts.shadow
+                                             : row.counts.reflected) = set.count;
+                    row.seconds = time_runs(trace, set, hits, o.warmup, o.reps);
+                    if (octray_any_hit) occluded_to_hits(hits, set.count);
+                    row.timing = summarize(row.seconds, row.rays);
+                    row.hit_fraction = hit_fraction(hits, set.count);
+                    const Validation val = validate_hits(hits, oracle, rule);
+                    row.valid = val.valid;
+                    row.validation = std::string(rule.exact ? "exact vs scalar oracle, "
+                                                            : "tolerance vs scalar oracle, ") +
+                                     val.summary();
+                    log_line(log, "  " + std::string(workload_name(w)) + " " + row.system +
+                                      " " + row.mode + " " + row.isa + " " + row.order + " " +
+                                      row.tile + ": " +
+                                      format("%.2f Mrays/s", row.timing.mrays_median) +
+                                      (row.valid ? "" : " (INVALID: " + val.summary() + ")"));
+                    report.rows.push_back(std::move(row));
+                };
+
+#if OCTRAY_HAVE_EMBREE
+                if (embree) {
+                    for (EmbreeMode mode : {EmbreeMode::packet8, EmbreeMode::single}) {
+                        BenchRow row = base_row(w, v);
+                        row.system = "embree";
+                        row.mode = embree_mode_name(mode);
+                        row.isa = "embree";
+                        measure(std::move(row), embree_tracer(arena, *embree, mode),
+                                kToleranceRule, false);
+                    }
+                }
+#endif
+                for (TracePath path : o.paths) {
+                    if (path == TracePath::scalar) {
+                        BenchRow row = base_row(w, v);
+                        row.system = "octray";
+                        row.mode = "single";
+                        row.isa = "scalar";
+                        measure(std::move(row), octray_scalar_tracer(arena, reference),
+                                kExactRule, false);
+                        continue;
+                    }
+                    for (Isa isa : isas) {
+                        BenchRow row = base_row(w, v);
+                        row.system = "octray";
+                        row.mode = "packet8";
+                        row.isa = isa_name(isa);
+                        measure(std::move(row),
+                                octray_simd_tracer(arena, kernel_table(isa), view), kExactRule,
+                                w == Workload::shadow);
+                    }
+                }
+            }
+        }
+
+        // Whole renders: the full Whitted workload, frame after frame.
+        if (wants(Workload::whitted)) {
+            std::map<Isa, std::pair<bool, std::string>> render_validation;
+            for (TileSize tile : o.tiles) {
+                for (TracePath path : o.paths) {
+                    const std::vector<Isa> path_isas =
+                        path == TracePath::simd ? isas : std::vector<Isa>{Isa::automatic};
+                    for (Isa isa : path_isas) {
+                        BenchRow row =
+                            base_row(Workload::whitted, Variant{PixelOrder::tiled, tile});
+                        row.system = "octray";
+                        row.mode = path == TracePath::simd ? "packet8" : "single";
+                        row.isa = path == TracePath::simd ? isa_name(isa) : "scalar";
+                        if (path == TracePath::simd) {
+                            auto it = render_validation.find(isa);
+                            if (it == render_validation.end()) {
+                                bool ok = false;
+                                std::string text = validate_render(spec, o, isa, ok);
+                                it = render_validation.emplace(isa, std::make_pair(ok, text))
+                                         .first;
+                            }
+                            row.valid = it->second.first;
+                            row.validation = it->second.second;
+                        } else {
+                            row.valid = true;
+                            row.validation = "the scalar reference is the oracle";
+                        }
+                        RenderOptions ro;
+                        ro.threads = ctx.threads;
+                        ro.tile_width = tile.width;
+                        ro.tile_height = tile.height;
+                        const auto render = [&] {
+                            return path == TracePath::simd ? render_packet(compiled, ro, isa)
+                                                           : render_reference(scene, ro);
+                        };
+                        RenderResult last;
+                        for (int i = 0; i < std::max(1, o.warmup); ++i) last = render();
+                        for (int i = 0; i < o.reps; ++i) {
+                            last = render();
+                            row.seconds.push_back(last.seconds);
+                        }
+                        row.counts = last.rays;
+                        row.rays = last.rays.total();
+                        row.hit_fraction = std::nan("");
+                        row.timing = summarize(row.seconds, row.rays);
+                        row.frames_per_second = row.timing.seconds_median > 0.0
+                                                    ? 1.0 / row.timing.seconds_median
+                                                    : 0.0;
+                        log_line(log, "  whitted octray " + row.mode + " " + row.isa +
+                                          " tile " + row.tile + ": " +
+                                          format("%.3f frames/s", row.frames_per_second) +
+                                          ", " +
+                                          format("%.2f Mrays/s", row.timing.mrays_median));
+                        report.rows.push_back(std::move(row));
+                    }
+                }
+            }
+        }
+        report.scenes.push_back(std::move(info));
+    }
+    compute_ratios(report.rows);
+    return report;
+}
+
+// ---- Output ------------------------------------------------------------------------------
+
+void print_table(const BenchReport& report, std::ostream& out) {
+    const BenchContext& c = report.context;
+    out << "octray bench " << c.octray_version << "  " << c.date << "\n"
+        << "CPU: " << c.cpu << " (" << c.logical_cpus << " logical), threads " << c.threads
+        << ", octray ISA " << c.isa << ", " << c.compiler << "\n"
+        << "Embree: " << c.embree << "\n"
+        << "frame " << c.width << "x" << c.height << ", " << c.reps << " timed reps after "
+        << c.warmup << " warm-up, load average at start " << format("%.2f", c.load_average)
+        << "\n";
+    if (!c.command_line.empty()) out << "command: " << c.command_line << "\n";
+    for (const SceneInfo& s : report.scenes) {
+        out << "scene " << s.spec << ": " << s.objects << " objects (" << s.spheres
+            << " spheres, " << s.planes << " planes), " << s.lights << " lights; compile "
+            << format("%.3f ms", s.compile_ms);
+        if (s.embree_build_ms) out << ", Embree BVH " << format("%.3f ms", *s.embree_build_ms);
+        if (s.primary_rays || s.shadow_rays || s.secondary_rays)
+            out << "; ray sets: " << s.primary_rays << " primary, " << s.shadow_rays
+                << " shadow, " << s.secondary_rays << " secondary";
+        out << "\n";
+    }
+    out << "\n";
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%-14s %-9s %-6s %-7s %-6s %-8s %-5s %9s %6s %9s %9s %9s %8s %s\n", "scene",
+                  "rays", "system", "mode", "isa", "order", "tile", "count", "hit%", "Mrays/s",
+                  "min", "max", "oct/emb", "valid");
+    out << line;
+    for (const BenchRow& r : report.rows) {
+        const std::string ratio = r.ratio ? format("%.3f", *r.ratio) : "-";
+        const std::string hit =
+            std::isnan(r.hit_fraction) ? "-" : format("%.1f", 100.0 * r.hit_fraction);
+        std::snprintf(
+            line, sizeof line,
+            "%-14s %-9s %-6s %-7s %-6s %-8s %-5s %9llu %6s %9.2f %9.2f %9.2f %8s %s\n",
+            r.scene.c_str(), workload_name(r.workload), r.system.c_str(), r.mode.c_str(),
+            r.isa.c_str(), r.order.c_str(), r.tile.c_str(),
+            static_cast<unsigned long long>(r.rays), hit.c_str(), r.timing.mrays_median,
+            r.timing.mrays_min, r.timing.mrays_max, ratio.c_str(), r.valid ? "yes" : "NO");
+        out << line;
+        if (r.workload == Workload::whitted)
+            out << "               frames/s " << format("%.3f", r.frames_per_second)
+                << "; rays: " << r.counts.primary << " primary, " << r.counts.shadow
+                << " shadow, " << r.counts.reflected << " reflected, " << r.counts.refracted
+                << " refracted\n";
+    }
+    bool any_invalid = false;
+    for (const BenchRow& r : report.rows)
+        if (!r.valid) {
+            if (!any_invalid) out << "\nInvalid rows (their speed means nothing):\n";
+            any_invalid = true;
+            out << "  " << r.scene << " " << workload_name(r.workload) << " " << r.system << " "
+                << r.mode << " " << r.isa << ": " << r.validation << "\n";
+        }
+}
+
+std::string report_json(const BenchReport& report) {
+    using nlohmann::json;
+    const BenchContext& c = report.context;
+    json j;
+    j["context"] = {
+        {"date", c.date},
+        {"cpu", c.cpu},
+        {"logical_cpus", c.logical_cpus},
+        {"threads", c.threads},
+        {"isa", c.isa},
+        {"compiler", c.compiler},
+        {"octray_version", c.octray_version},
+        {"embree", c.embree},
+        {"embree_available", c.embree_available},
+        {"load_average", c.load_average},
+        {"width", c.width},
+        {"height", c.height},
+        {"reps", c.reps},
+        {"warmup", c.warmup},
+        {"validate_rays", c.validate_rays},
+        {"command", c.command_line},
+    };
+    j["scenes"] = json::array();
+    for (const SceneInfo& s : report.scenes) {
+        json js = {{"scene", s.spec},
+                   {"objects", s.objects},
+                   {"spheres", s.spheres},
+                   {"planes", s.planes},
+                   {"lights", s.lights},
+                   {"epsilon", s.epsilon},
+                   {"compile_ms", s.compile_ms},
+                   {"primary_rays", s.primary_rays},
+                   {"shadow_rays", s.shadow_rays},
+                   {"secondary_rays", s.secondary_rays}};
+        js["embree_build_ms"] = s.embree_build_ms ? json(*s.embree_build_ms) : json(nullptr);
+        j["scenes"].push_back(std::move(js));
+    }
+    j["rows"] = json::array();
+    for (const BenchRow& r : report.rows) {
+        json jr = {
+            {"scene", r.scene},
+            {"ray_kind", workload_name(r.workload)},
+            {"system", r.system},
+            {"mode", r.mode},
+            {"isa", r.isa},
+            {"order", r.order},
+            {"tile", r.tile},
+            {"threads", r.threads},
+            {"rays", r.rays},
+            {"mrays_median", r.timing.mrays_median},
+            {"mrays_min", r.timing.mrays_min},
+            {"mrays_max", r.timing.mrays_max},
+            {"seconds", r.seconds},
+            {"valid", r.valid},
+            {"validation", r.validation},
+            {"counts",
+             {{"primary", r.counts.primary},
+              {"shadow", r.counts.shadow},
+              {"reflected", r.counts.reflected},
+              {"refracted", r.counts.refracted}}},
+        };
+        jr["hit_fraction"] = std::isnan(r.hit_fraction) ? json(nullptr) : json(r.hit_fraction);
+        jr["frames_per_second"] =
+            r.workload == Workload::whitted ? json(r.frames_per_second) : json(nullptr);
+        jr["ratio_octray_over_embree"] = r.ratio ? json(*r.ratio) : json(nullptr);
+        j["rows"].push_back(std::move(jr));
+    }
+    return j.dump(2) + "\n";
+}
+
+void write_json_file(const BenchReport& report, const std::string& path) {
+    const std::string text = report_json(report);
+    write_file_atomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        out.close();
+        if (!out) throw IoError("cannot write " + tmp);
+    });
+}
+
+}  // namespace octray::bench

@@ -1,0 +1,126 @@
+#pragma once
+// The engine of `octray bench`: rays per second of octray and Embree side by side on the
+// same scenes and the same rays, each row validated against the scalar oracle before it is
+// timed; whole Whitted renders too. Results as a human-readable table or JSON.
+// How to run it and what each figure means: bench/README.md.
+
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench/ray_sets.h"
+#include "kernels/isa.h"
+#include "render/types.h"
+
+namespace octray::bench {
+
+// Which intersection code octray runs: the SIMD packet kernels, or the scalar reference.
+enum class TracePath { simd, scalar };
+const char* trace_path_name(TracePath path);
+std::optional<TracePath> parse_trace_path(std::string_view name);
+
+// What a row measures: one kind of ray set, or the whole Whitted render of the frame.
+enum class Workload { primary, shadow, secondary, whitted };
+const char* workload_name(Workload workload);
+std::optional<Workload> parse_workload(std::string_view name);
+
+struct BenchOptions {
+    std::vector<std::string> scenes{"whitted", "random:16", "random:1024", "sphereflake:4"};
+    std::vector<Workload> workloads{Workload::primary, Workload::shadow, Workload::secondary,
+                                    Workload::whitted};
+    int threads = 0;  // 0: every core TBB sees
+    int reps = 5;     // timed repetitions per row
+    int warmup = 1;   // untimed runs before them (at least 1: its hits are validated)
+    int width = 1920, height = 1080;
+    // Knobs; each list is measured in one run, every value a row of its own. The first
+    // value of each list is the default configuration.
+    std::vector<TileSize> tiles{TileSize{16, 16}};
+    std::vector<PixelOrder> orders{PixelOrder::tiled};
+    std::vector<Isa> isas{Isa::automatic};
+    std::vector<TracePath> paths{TracePath::simd};
+    bool embree = true;  // when compiled in
+    // Rays checked against the scalar oracle per ray set (0: all of them).
+    std::uint32_t validate_rays = 1u << 16;
+    // Whole renders are validated image against image at this size.
+    int validate_width = 320, validate_height = 180;
+    std::string command_line;  // recorded in the report
+};
+
+struct Timing {
+    double seconds_median = 0.0, seconds_min = 0.0, seconds_max = 0.0;
+    double mrays_median = 0.0, mrays_min = 0.0, mrays_max = 0.0;
+};
+// Median / min / max over repetitions of `rays` rays each (the median of an even count is
+// the mean of the middle two). Mrays/s min comes from the slowest repetition.
+Timing summarize(std::vector<double> seconds, std::uint64_t rays);
+
+struct BenchRow {
+    std::string scene;
+    Workload workload = Workload::primary;
+    std::string system;  // "octray" or "embree"
+    std::string mode;    // "packet8" (octray simd, rtcIntersect8) or "single"
+    std::string isa;     // octray: the kernels' ISA or "scalar"; embree: "embree"
+    std::string order;   // pixel order of the rays
+    std::string tile;    // tile size (tiled order, whole renders), "-" where it plays no part
+    int threads = 0;
+    std::uint64_t rays = 0;  // per repetition
+    RayCounts counts;        // the rays of one repetition by kind
+    double hit_fraction = 0.0;
+    std::vector<double> seconds;  // per timed repetition
+    Timing timing;
+    double frames_per_second = 0.0;  // whole renders: 1 / median seconds
+    bool valid = false;
+    std::string validation;  // what was checked, and how it came out
+    // octray rows: this row's median over the best valid Embree row of the same scene,
+    // workload, order and tile; Embree rows: the best valid octray row over this one.
+    std::optional<double> ratio;
+};
+
+struct SceneInfo {
+    std::string spec;
+    std::uint32_t objects = 0, spheres = 0, planes = 0, lights = 0;
+    float epsilon = 0.0f;
+    double compile_ms = 0.0;                                              // compile_scene()
+    std::optional<double> embree_build_ms;                                // rtcCommitScene()
+    std::uint64_t primary_rays = 0, shadow_rays = 0, secondary_rays = 0;  // ray set sizes
+};
+
+struct BenchContext {
+    std::string date;  // UTC, ISO 8601
+    std::string cpu;
+    int logical_cpus = 0;
+    int threads = 0;  // resolved
+    std::string isa;  // octray's default (best supported) ISA
+    std::string compiler;
+    std::string octray_version;
+    std::string embree;  // version and device info, or why it is absent
+    bool embree_available = false;
+    double load_average = 0.0;  // 1-minute load when the run started
+    int width = 0, height = 0, reps = 0, warmup = 0;
+    std::uint32_t validate_rays = 0;
+    std::string command_line;
+};
+
+struct BenchReport {
+    BenchContext context;
+    std::vector<SceneInfo> scenes;
+    std::vector<BenchRow> rows;
+};
+
+// Runs everything the options ask for; progress lines go to `log` when given. Throws
+// SceneError for a scene that cannot be loaded, std::runtime_error for a forced ISA the
+// CPU lacks.
+BenchReport run_bench(const BenchOptions& options, std::ostream* log = nullptr);
+
+// Fills in BenchRow::ratio for every row (run_bench does it; exposed for tests).
+void compute_ratios(std::vector<BenchRow>& rows);
+
+void print_table(const BenchReport& report, std::ostream& out);
+std::string report_json(const BenchReport& report);
+// Written atomically; throws IoError naming the file.
+void write_json_file(const BenchReport& report, const std::string& path);
+
+}  // namespace octray::bench

@@ -1,0 +1,258 @@
+// Embree 3 baseline (compiled only when CMake finds Embree): the octray scene rebuilt as
+// Embree geometry, tracing the bench's ray sets in single-ray and 8-wide packet modes.
+
+#include "bench/embree_baseline.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace octray::bench {
+
+const char* embree_mode_name(EmbreeMode mode) {
+    return mode == EmbreeMode::single ? "single" : "packet8";
+}
+
+namespace {
+
+// An infinite plane becomes one quad reaching at least this many times the scene's size
+// from the point below the eye: a ray that hits the plane further out misses the quad. For
+// the default scenes' camera heights, that is a ray within ~1e-6 rad of the horizon.
+constexpr float kPlaneHalfSizeScale = 1e6f;
+
+void throw_error(RTCDevice device, const char* what) {
+    const RTCError code = rtcGetDeviceError(device);
+    throw std::runtime_error(std::string("Embree: ") + what + " failed (error " +
+                             std::to_string(static_cast<int>(code)) + ")");
+}
+
+}  // namespace
+
+struct EmbreeScene::Impl {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    // Per geometry ID: primitive ID -> object file index.
+    std::vector<std::vector<std::int32_t>> object_of;
+    double build_seconds = 0.0;
+    std::string last_error;
+
+    std::int32_t object(unsigned geom_id, unsigned prim_id) const {
+        if (geom_id == RTC_INVALID_GEOMETRY_ID) return kernels::kNoHit;
+        return object_of[geom_id][prim_id];
+    }
+};
+
+EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads)
+    : impl_(std::make_unique<Impl>()) {
+    Impl& im = *impl_;
+    const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+    im.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+    if (!im.device) throw std::runtime_error("Embree: rtcNewDevice failed");
+    rtcSetDeviceErrorFunction(
+        im.device,
+        [](void* user, RTCError, const char* message) {
+            static_cast<Impl*>(user)->last_error = message ? message : "";
+        },
+        &im);
+    im.scene = rtcNewScene(im.device);
+    rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+
+    // Spheres: one SPHERE_POINT geometry, (x, y, z, r) per sphere, in file order.
+    const CompiledSpheres& s = compiled.spheres;
+    if (s.count > 0) {
+        RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        if (!g) throw_error(im.device, "rtcNewGeometry(SPHERE_POINT)");
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), s.count));
+        std::vector<std::int32_t> objects(s.count);
+        for (std::uint32_t i = 0; i < s.count; ++i) {
+            v[4 * i + 0] = s.cx[i], v[4 * i + 1] = s.cy[i], v[4 * i + 2] = s.cz[i];
+            v[4 * i + 3] = s.radius[i];
+            objects[i] = static_cast<std::int32_t>(s.object[i]);
+        }
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(im.scene, g);
+        rtcReleaseGeometry(g);
+        if (im.object_of.size() <= id) im.object_of.resize(id + 1);
+        im.object_of[id] = std::move(objects);
+    }
+
+    // Planes: one QUAD geometry, a square per plane spanned by the checker basis.
+    const CompiledPlanes& p = compiled.planes;
+    if (p.count > 0) {
+        RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_QUAD);
+        if (!g) throw_error(im.device, "rtcNewGeometry(QUAD)");
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 4 * p.count));
+        auto* index = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, 4 * sizeof(unsigned), p.count));
+        // The scene's size: the diagonal of the spheres' bounding box (at least 1).
+        Vec3 lo{kInfinity, kInfinity, kInfinity}, hi = -lo;
+        for (std::uint32_t i = 0; i < s.count; ++i) {
+            const Vec3 c{s.cx[i], s.cy[i], s.cz[i]}, r{s.radius[i], s.radius[i], s.radius[i]};
+            lo = min(lo, c - r), hi = max(hi, c + r);
+        }
+        const float extent = s.count > 0 ? length(hi - lo) : 0.0f;
+        const float half = kPlaneHalfSizeScale * std::max(1.0f, extent);
+        std::vector<std::int32_t> objects(p.count);
+        for (std::uint32_t i = 0; i < p.count; ++i) {
+            const Object& o = scene.objects[p.object[i]];
+            const TangentBasis tb = checker_basis(o.normal);
+            // Embree splits a quad into two triangles along a diagonal, and the edge tests
+            // of a triangle this large are imprecise near its edges: a diagonal through the
+            // view would let rays slip between the two halves. So the point of the plane
+            // nearest the eye sits at (-R/2, R/4) in the quad's (t1, t2) frame, far from
+            // both diagonals (and from the edges) whichever one Embree splits along.
+            const Vec3 eye = compiled.camera.eye;
+            const Vec3 foot = eye - o.normal * dot(eye - o.point, o.normal);
+            const Vec3 center = foot + tb.t1 * (0.5f * half) - tb.t2 * (0.25f * half);
+            const float su[4] = {-1, 1, 1, -1}, sv[4] = {-1, -1, 1, 1};
+            for (int c = 0; c < 4; ++c) {
+                const Vec3 corner = center + tb.t1 * (su[c] * half) + tb.t2 * (sv[c] * half);
+                v[3 * (4 * i + c) + 0] = corner.x;
+                v[3 * (4 * i + c) + 1] = corner.y;
+                v[3 * (4 * i + c) + 2] = corner.z;
+                index[4 * i + c] = 4 * i + static_cast<unsigned>(c);
+            }
+            objects[i] = static_cast<std::int32_t>(p.object[i]);
+        }
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(im.scene, g);
+        rtcReleaseGeometry(g);
+        if (im.object_of.size() <= id) im.object_of.resize(id + 1);
+        im.object_of[id] = std::move(objects);
+    }
+
+    const auto start = std::chrono::steady_clock::now();
+    rtcCommitScene(im.scene);
+    im.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (rtcGetDeviceError(im.device) != RTC_ERROR_NONE || !im.last_error.empty())
+        throw std::runtime_error("Embree: scene build failed: " + im.last_error);
+}
+
+EmbreeScene::~EmbreeScene() {
+    if (impl_->scene) rtcReleaseScene(impl_->scene);
+    if (impl_->device) rtcReleaseDevice(impl_->device);
+}
+
+double EmbreeScene::build_seconds() const { return impl_->build_seconds; }
+
+std::string EmbreeScene::version() { return RTC_VERSION_STRING; }
+
+std::string EmbreeScene::device_info() const {
+    const auto prop = [&](RTCDeviceProperty p) {
+        return rtcGetDeviceProperty(impl_->device, p);
+    };
+    std::string s = "embree " + version();
+    s += prop(RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? ", native ray8" : ", emulated ray8";
+    s += prop(RTC_DEVICE_PROPERTY_TASKING_SYSTEM) == 1 ? ", TBB tasking" : ", own tasking";
+    return s;
+}
+
+namespace {
+
+RTCIntersectContext make_context(bool coherent) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags =
+        coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    return context;
+}
+
+void set_ray(RTCRay& r, const RaySet& rays, std::uint32_t i) {
+    r.org_x = rays.ox[i], r.org_y = rays.oy[i], r.org_z = rays.oz[i];
+    r.tnear = rays.t_min;
+    r.dir_x = rays.dx[i], r.dir_y = rays.dy[i], r.dir_z = rays.dz[i];
+    r.time = 0.0f;
+    r.tfar = rays.t_max[i];
+    r.mask = 0xFFFFFFFFu;
+    r.id = i;
+    r.flags = 0;
+}
+
+// Lanes [first, first + 8) of the set into an 8-wide packet; lanes past `end` are off.
+void set_ray8(RTCRay8& r, int (&valid)[8], const RaySet& rays, std::uint32_t first,
+              std::uint32_t end) {
+    for (std::uint32_t k = 0; k < 8; ++k) {
+        const std::uint32_t i = first + k;
+        valid[k] = i < end ? -1 : 0;
+        r.org_x[k] = rays.ox[i], r.org_y[k] = rays.oy[i], r.org_z[k] = rays.oz[i];
+        r.tnear[k] = rays.t_min;
+        r.dir_x[k] = rays.dx[i], r.dir_y[k] = rays.dy[i], r.dir_z[k] = rays.dz[i];
+        r.time[k] = 0.0f;
+        r.tfar[k] = rays.t_max[i];
+        r.mask[k] = 0xFFFFFFFFu;
+        r.id[k] = i;
+        r.flags[k] = 0;
+    }
+}
+
+}  // namespace
+
+void EmbreeScene::intersect(EmbreeMode mode, const RaySet& rays, std::uint32_t first,
+                            std::uint32_t n, HitSet& hits, bool coherent) const {
+    const Impl& im = *impl_;
+    RTCIntersectContext context = make_context(coherent);
+    const std::uint32_t end = first + n;
+    if (mode == EmbreeMode::single) {
+        for (std::uint32_t i = first; i < end; ++i) {
+            RTCRayHit rh;
+            set_ray(rh.ray, rays, i);
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(im.scene, &context, &rh);
+            const std::int32_t object = im.object(rh.hit.geomID, rh.hit.primID);
+            hits.object[i] = object;
+            hits.t[i] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar;
+        }
+        return;
+    }
+    alignas(32) RTCRayHit8 rh;
+    alignas(32) int valid[8];
+    for (std::uint32_t base = first; base < end; base += 8) {
+        set_ray8(rh.ray, valid, rays, base, end);
+        for (int k = 0; k < 8; ++k) {
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, im.scene, &context, &rh);
+        for (std::uint32_t k = 0; k < 8 && base + k < end; ++k) {
+            const std::int32_t object = im.object(rh.hit.geomID[k], rh.hit.primID[k]);
+            hits.object[base + k] = object;
+            hits.t[base + k] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar[k];
+        }
+    }
+}
+
+void EmbreeScene::occluded(EmbreeMode mode, const RaySet& rays, std::uint32_t first,
+                           std::uint32_t n, HitSet& hits, bool coherent) const {
+    const Impl& im = *impl_;
+    RTCIntersectContext context = make_context(coherent);
+    const std::uint32_t end = first + n;
+    // An occluded ray comes back with tfar = -inf.
+    if (mode == EmbreeMode::single) {
+        for (std::uint32_t i = first; i < end; ++i) {
+            RTCRay r;
+            set_ray(r, rays, i);
+            rtcOccluded1(im.scene, &context, &r);
+            hits.object[i] = r.tfar < 0.0f ? kOccluded : kernels::kNoHit;
+        }
+        return;
+    }
+    alignas(32) RTCRay8 r;
+    alignas(32) int valid[8];
+    for (std::uint32_t base = first; base < end; base += 8) {
+        set_ray8(r, valid, rays, base, end);
+        rtcOccluded8(valid, im.scene, &context, &r);
+        for (std::uint32_t k = 0; k < 8 && base + k < end; ++k)
+            hits.object[base + k] = r.tfar[k] < 0.0f ? kOccluded : kernels::kNoHit;
+    }
+}
+
+}  // namespace octray::bench

@@ -1,0 +1,72 @@
+#pragma once
+// Embree 3 as the baseline of `octray bench`: the identical scene (spheres as
+// RTC_GEOMETRY_TYPE_SPHERE_POINT, each plane as one large quad) tracing the identical rays,
+// read from the same SoA arrays (bench/ray_sets.h), into the same hit arrays.
+//
+// Compiled only when CMake finds Embree (OCTRAY_HAVE_EMBREE == 1); the declarations are
+// always visible so that callers can be written once and test embree_compiled().
+//
+// Semantics, checked against Embree 3.13's kernels/geometry/sphere_intersector.h: a
+// sphere reports its entry root when it lies in (tnear, tfar), else its exit root (so a
+// ray that starts inside a sphere hits its far side, as in octray); both bounds are
+// strict, as octray's live interval. Directions need not be unit length (shadow rays
+// reach the light at t = 1). The two differences that remain, and that validation
+// tolerates: Embree computes t by projecting the center onto the ray (it rounds
+// differently), and an infinite plane becomes a finite quad (see embree_baseline.cpp).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "bench/ray_sets.h"
+#include "scene/compile.h"
+#include "scene/scene.h"
+
+#ifndef OCTRAY_HAVE_EMBREE
+#define OCTRAY_HAVE_EMBREE 0
+#endif
+
+namespace octray::bench {
+
+enum class EmbreeMode {
+    single,   // rtcIntersect1 / rtcOccluded1, one ray at a time
+    packet8,  // rtcIntersect8 / rtcOccluded8 over 8 consecutive rays of the set
+};
+
+const char* embree_mode_name(EmbreeMode mode);
+
+constexpr bool embree_compiled() { return OCTRAY_HAVE_EMBREE != 0; }
+
+class EmbreeScene {
+  public:
+    // Builds the device and the scene (BVH build quality high: the scene is static).
+    // `threads` (0: all) caps Embree's own TBB use. Throws std::runtime_error with
+    // Embree's message on failure.
+    EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads);
+    ~EmbreeScene();
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+    // Closest hits of rays [first, first + n) on (rays.t_min, t_max): t and the object's
+    // file index, kNoHit for a miss. For packet8, first is a multiple of 8.
+    // Coherent sets the coherent-ray hint (RTC_INTERSECT_CONTEXT_FLAG_COHERENT).
+    void intersect(EmbreeMode mode, const RaySet& rays, std::uint32_t first, std::uint32_t n,
+                   HitSet& hits, bool coherent) const;
+
+    // Any hit on (t_min, t_max): object is kOccluded or kNoHit.
+    void occluded(EmbreeMode mode, const RaySet& rays, std::uint32_t first, std::uint32_t n,
+                  HitSet& hits, bool coherent) const;
+
+    // Seconds rtcCommitScene took (the BVH build), in the calling thread's TBB arena.
+    double build_seconds() const;
+
+    // "3.13.5", and what the device reports (native packet support, ISA-relevant flags).
+    static std::string version();
+    std::string device_info() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace octray::bench

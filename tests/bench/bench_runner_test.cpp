@@ -1,0 +1,135 @@
+// bench/bench_runner.h: statistics, ratios, and the JSON report's schema (timings are
+// never asserted, only their shape).
+
+#include "bench/bench_runner.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "bench/embree_baseline.h"
+
+namespace octray::bench {
+namespace {
+
+TEST(Summarize, MedianMinMaxOverRepetitions) {
+    // 1e6 rays in 1, 2 and 4 seconds: 1, 0.5 and 0.25 Mrays/s.
+    const Timing t = summarize({2.0, 4.0, 1.0}, 1000000);
+    EXPECT_DOUBLE_EQ(t.seconds_median, 2.0);
+    EXPECT_DOUBLE_EQ(t.mrays_median, 0.5);
+    EXPECT_DOUBLE_EQ(t.mrays_min, 0.25);
+    EXPECT_DOUBLE_EQ(t.mrays_max, 1.0);
+    EXPECT_DOUBLE_EQ(summarize({1.0, 3.0}, 1000000).seconds_median, 2.0);
+    EXPECT_DOUBLE_EQ(summarize({}, 10).mrays_median, 0.0);
+}
+
+BenchRow row(std::string system, Workload w, double mrays, bool valid = true) {
+    // Scene, order and tile stay empty: equal on every row, so one comparison group per
+    // workload.
+    BenchRow r;
+    r.workload = w;
+    r.system = std::move(system);
+    r.timing.mrays_median = mrays;
+    r.valid = valid;
+    return r;
+}
+
+TEST(Ratios, OctrayRowsAreMeasuredAgainstTheBestValidEmbreeMode) {
+    std::vector<BenchRow> rows{
+        row("embree", Workload::primary, 10.0), row("embree", Workload::primary, 40.0),
+        row("embree", Workload::primary, 400.0, false),  // invalid
+        row("octray", Workload::primary, 20.0), row("octray", Workload::shadow, 5.0)};
+    compute_ratios(rows);
+    ASSERT_TRUE(rows[3].ratio);
+    EXPECT_DOUBLE_EQ(*rows[3].ratio, 0.5);  // 20 / best valid Embree (40)
+    EXPECT_DOUBLE_EQ(*rows[0].ratio, 2.0);  // best octray (20) / 10
+    EXPECT_DOUBLE_EQ(*rows[1].ratio, 0.5);
+    EXPECT_FALSE(rows[4].ratio);  // no Embree shadow row to compare with
+}
+
+// A small but complete run: every workload, both paths.
+BenchReport small_run() {
+    BenchOptions o;
+    o.scenes = {"random:16"};
+    o.width = 48;
+    o.height = 24;
+    o.reps = 2;
+    o.warmup = 1;
+    o.threads = 1;
+    o.validate_rays = 0;
+    o.validate_width = 48;
+    o.validate_height = 24;
+    o.paths = {TracePath::simd, TracePath::scalar};
+    o.command_line = "test";
+    return run_bench(o);
+}
+
+TEST(Report, JsonHasTheContextAndRowsSchema) {
+    const BenchReport report = small_run();
+    const nlohmann::json j = nlohmann::json::parse(report_json(report));
+
+    const nlohmann::json& c = j.at("context");
+    for (const char* key :
+         {"cpu", "isa", "compiler", "date", "embree", "octray_version", "command"})
+        EXPECT_TRUE(c.at(key).is_string()) << key;
+    EXPECT_EQ(c.at("threads").get<int>(), 1);
+    EXPECT_EQ(c.at("embree_available").get<bool>(), embree_compiled());
+
+    ASSERT_TRUE(j.at("scenes").is_array());
+    ASSERT_EQ(j.at("scenes").size(), 1u);
+    EXPECT_EQ(j["scenes"][0].at("spheres").get<int>(), 16);
+    EXPECT_GT(j["scenes"][0].at("primary_rays").get<int>(), 0);
+
+    const nlohmann::json& rows = j.at("rows");
+    ASSERT_TRUE(rows.is_array());
+    std::set<std::string> kinds, systems, modes;
+    for (const nlohmann::json& r : rows) {
+        for (const char* key : {"scene", "ray_kind", "system", "mode", "isa", "order", "tile"})
+            ASSERT_TRUE(r.at(key).is_string()) << key;
+        EXPECT_EQ(r.at("threads").get<int>(), 1);
+        for (const char* key : {"mrays_median", "mrays_min", "mrays_max"})
+            ASSERT_TRUE(r.at(key).is_number()) << key;
+        EXPECT_LE(r["mrays_min"].get<double>(), r["mrays_median"].get<double>());
+        EXPECT_LE(r["mrays_median"].get<double>(), r["mrays_max"].get<double>());
+        EXPECT_TRUE(r.at("valid").get<bool>()) << r.at("validation");
+        EXPECT_EQ(r.at("seconds").size(), 2u);
+        EXPECT_TRUE(r.at("counts").is_object());
+        kinds.insert(r["ray_kind"].get<std::string>());
+        systems.insert(r["system"].get<std::string>());
+        modes.insert(r["mode"].get<std::string>());
+        if (r["ray_kind"] == "whitted") {
+            EXPECT_GT(r.at("frames_per_second").get<double>(), 0.0);
+            EXPECT_EQ(r["counts"]["primary"].get<int>(), 48 * 24);
+        }
+    }
+    EXPECT_EQ(kinds, (std::set<std::string>{"primary", "shadow", "secondary", "whitted"}));
+    EXPECT_TRUE(modes.count("packet8") && modes.count("single"));
+    EXPECT_EQ(systems.count("embree") == 1, embree_compiled());
+    if (embree_compiled()) {
+        // Every octray ray-set row has its ratio against Embree.
+        for (const nlohmann::json& r : rows) {
+            if (r["system"] == "octray" && r["ray_kind"] != "whitted") {
+                EXPECT_TRUE(r.at("ratio_octray_over_embree").is_number());
+            }
+        }
+    }
+
+    // The file says the same, and the table names every scene and system.
+    const std::filesystem::path dir = OCTRAY_TEST_TMPDIR;
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "bench_report.json").string();
+    write_json_file(report, path);
+    std::ifstream in(path);
+    EXPECT_EQ(nlohmann::json::parse(in), j);
+    std::ostringstream table;
+    print_table(report, table);
+    EXPECT_NE(table.str().find("random:16"), std::string::npos);
+    EXPECT_NE(table.str().find("octray"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace octray::bench

@@ -1,0 +1,166 @@
+// `octray bench`: rays per second of octray and Embree, side by side (bench/README.md).
+// Thin: parse, call bench/bench_runner.h, report.
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench/bench_runner.h"
+#include "bench/embree_baseline.h"
+#include "kernels/dispatch.h"
+#include "tools/commands.h"
+
+namespace octray::tools {
+namespace {
+
+struct BenchArguments {
+    std::vector<std::string> scenes;
+    std::vector<std::string> rays;
+    std::vector<std::string> tiles;
+    std::vector<std::string> orders;
+    std::vector<std::string> isas;
+    std::vector<std::string> paths;
+    int threads = 0, reps = 5, warmup = 1, width = 1920, height = 1080;
+    std::uint32_t validate_rays = 1u << 16;
+    bool no_embree = false;
+    std::string json;
+};
+
+std::string join(const std::vector<std::string>& items) {
+    std::string out;
+    for (const std::string& s : items) out += (out.empty() ? "" : ",") + s;
+    return out;
+}
+
+// The options as a command line that reproduces the run (recorded in the report).
+std::string command_line(const BenchArguments& a) {
+    std::string c = "octray bench";
+    for (const std::string& s : a.scenes) c += " " + s;
+    if (!a.rays.empty()) c += " --rays " + join(a.rays);
+    if (a.threads > 0) c += " --threads " + std::to_string(a.threads);
+    c += " --reps " + std::to_string(a.reps);
+    if (a.warmup != 1) c += " --warmup " + std::to_string(a.warmup);
+    c += " --width " + std::to_string(a.width) + " --height " + std::to_string(a.height);
+    if (!a.tiles.empty()) c += " --tile " + join(a.tiles);
+    if (!a.orders.empty()) c += " --order " + join(a.orders);
+    if (!a.isas.empty()) c += " --isa " + join(a.isas);
+    if (!a.paths.empty()) c += " --path " + join(a.paths);
+    if (a.validate_rays != (1u << 16))
+        c += " --validate-rays " + std::to_string(a.validate_rays);
+    if (a.no_embree) c += " --no-embree";
+    if (!a.json.empty()) c += " --json " + a.json;
+    return c;
+}
+
+// Each list option into its values; an unknown value is a usage error naming it.
+template <class T, class Parse>
+std::vector<T> parse_list(const std::vector<std::string>& items, const char* option,
+                          Parse parse, std::vector<T> fallback) {
+    if (items.empty()) return fallback;
+    std::vector<T> out;
+    for (const std::string& s : items) {
+        const auto v = parse(s);
+        if (!v) throw UsageError(std::string(option) + ": unknown value '" + s + "'");
+        out.push_back(*v);
+    }
+    return out;
+}
+
+void run_bench_command(const BenchArguments& a) {
+    bench::BenchOptions o;
+    if (!a.scenes.empty()) o.scenes = a.scenes;
+    o.workloads =
+        parse_list<bench::Workload>(a.rays, "--rays", bench::parse_workload, o.workloads);
+    o.tiles = parse_list<bench::TileSize>(a.tiles, "--tile", bench::parse_tile_size, o.tiles);
+    o.orders =
+        parse_list<bench::PixelOrder>(a.orders, "--order", bench::parse_pixel_order, o.orders);
+    o.isas = parse_list<Isa>(a.isas, "--isa", parse_isa, o.isas);
+    o.paths = parse_list<bench::TracePath>(a.paths, "--path", bench::parse_trace_path, o.paths);
+    for (Isa isa : o.isas)
+        if (!isa_supported(isa))
+            throw UsageError(std::string("--isa ") + isa_name(isa) +
+                             ": this CPU does not support it");
+    o.threads = a.threads;
+    o.reps = a.reps;
+    o.warmup = a.warmup;
+    o.width = a.width;
+    o.height = a.height;
+    o.validate_rays = a.validate_rays;
+    o.embree = !a.no_embree;
+    o.command_line = command_line(a);
+
+    if (!bench::embree_compiled())
+        std::cerr
+            << "octray bench: Embree 3 was not found when octray was built; measuring octray "
+               "alone\n";
+    const bench::BenchReport report = bench::run_bench(o, &std::cerr);
+    std::cout << '\n';
+    bench::print_table(report, std::cout);
+    if (!a.json.empty()) {
+        bench::write_json_file(report, a.json);
+        std::cerr << "wrote " << a.json << '\n';
+    }
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app, CommandRunner& run) {
+    auto a = std::make_shared<BenchArguments>();
+    CLI::App* cmd =
+        app.add_subcommand("bench",
+                           "Rays per second of octray and Embree 3 on the same scenes and rays "
+                           "(bench/README.md)");
+    cmd->add_option("scenes", a->scenes,
+                    "Scenes [default: whitted random:16 random:1024 sphereflake:4]")
+        ->type_name("SCENE...");
+    cmd->add_option("--rays", a->rays,
+                    "Workloads: primary,shadow,secondary (ray sets), whitted (whole renders) "
+                    "[default: all]")
+        ->delimiter(',')
+        ->type_name("LIST");
+    cmd->add_option("--threads", a->threads, "Threads for both systems [default: all cores]")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--reps", a->reps, "Timed repetitions per row [default: 5]")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--warmup", a->warmup, "Untimed runs before them [default: 1]")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--width", a->width, "Frame width [default: 1920]")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--height", a->height, "Frame height [default: 1080]")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--json", a->json, "Also write the report as JSON")->type_name("FILE");
+    cmd->add_option(
+           "--tile", a->tiles,
+           "Tile sizes WxH (tiled order, whole renders); a list is measured in one run "
+           "[default: 16x16]")
+        ->delimiter(',')
+        ->type_name("LIST");
+    cmd->add_option("--order", a->orders,
+                    "Pixel orders of the rays: rowmajor, tiled, morton [default: tiled]")
+        ->delimiter(',')
+        ->type_name("LIST");
+    cmd->add_option("--isa", a->isas,
+                    "octray kernel ISAs: auto, sse2, sse4.1, avx2 [default: auto]")
+        ->delimiter(',')
+        ->type_name("LIST");
+    cmd->add_option(
+           "--path", a->paths,
+           "octray paths: simd (packet kernels), scalar (the reference) [default: simd]")
+        ->delimiter(',')
+        ->type_name("LIST");
+    cmd->add_option(
+        "--validate-rays", a->validate_rays,
+        "Rays per set checked against the scalar oracle, 0 for all [default: 65536]");
+    cmd->add_flag("--no-embree", a->no_embree, "Measure octray alone");
+    cmd->footer(
+        "Examples:\n"
+        "  octray bench                                   # the default table\n"
+        "  octray bench random:1024 --rays primary,shadow --threads 2 --json out.json\n"
+        "  octray bench whitted --order rowmajor,tiled,morton --rays primary\n\n" +
+        exit_code_help());
+    cmd->callback([a, &run] { run.action = [a] { run_bench_command(*a); }; });
+}
+
+}  // namespace octray::tools
