@@ -1,0 +1,206 @@
+#include "render/error_heatmap.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string_view>
+
+#include "render/image_io.h"
+
+namespace octray {
+namespace {
+
+// matplotlib's magma (van der Walt & Smith, 2015): every 4th entry of its 256-entry
+// table plus the last, in sRGB [0, 1]. Linear interpolation between these knots stays
+// within one 8-bit step of the full table (every 8th entry would not, at the dark end).
+constexpr int magma_knot_count = 65;
+constexpr float magma_knots[magma_knot_count][3] = {
+    {0.001462f, 0.000466f, 0.013866f}, {0.005950f, 0.004843f, 0.037130f},
+    {0.013708f, 0.011771f, 0.068667f}, {0.024792f, 0.020715f, 0.100676f},
+    {0.039608f, 0.031090f, 0.133515f}, {0.056615f, 0.042160f, 0.167446f},
+    {0.074257f, 0.052017f, 0.202660f}, {0.092949f, 0.059904f, 0.239164f},
+    {0.113094f, 0.065492f, 0.276784f}, {0.135053f, 0.068391f, 0.315000f},
+    {0.159018f, 0.068354f, 0.352688f}, {0.184801f, 0.065732f, 0.387973f},
+    {0.211718f, 0.061992f, 0.418647f}, {0.238826f, 0.059517f, 0.443256f},
+    {0.265447f, 0.060237f, 0.461840f}, {0.291366f, 0.064553f, 0.475462f},
+    {0.316654f, 0.071690f, 0.485380f}, {0.341482f, 0.080564f, 0.492631f},
+    {0.366012f, 0.090314f, 0.497960f}, {0.390384f, 0.100379f, 0.501864f},
+    {0.414709f, 0.110431f, 0.504662f}, {0.439062f, 0.120298f, 0.506555f},
+    {0.463508f, 0.129893f, 0.507652f}, {0.488088f, 0.139186f, 0.508011f},
+    {0.512831f, 0.148179f, 0.507648f}, {0.537755f, 0.156894f, 0.506551f},
+    {0.562866f, 0.165368f, 0.504692f}, {0.588158f, 0.173652f, 0.502035f},
+    {0.613617f, 0.181811f, 0.498536f}, {0.639216f, 0.189921f, 0.494150f},
+    {0.664915f, 0.198075f, 0.488836f}, {0.690661f, 0.206384f, 0.482558f},
+    {0.716387f, 0.214982f, 0.475290f}, {0.742004f, 0.224025f, 0.467018f},
+    {0.767398f, 0.233705f, 0.457755f}, {0.792427f, 0.244242f, 0.447543f},
+    {0.816914f, 0.255895f, 0.436461f}, {0.840636f, 0.268953f, 0.424666f},
+    {0.863320f, 0.283729f, 0.412403f}, {0.884651f, 0.300530f, 0.400047f},
+    {0.904281f, 0.319610f, 0.388137f}, {0.921884f, 0.341098f, 0.377376f},
+    {0.937221f, 0.364929f, 0.368567f}, {0.950210f, 0.390820f, 0.362468f},
+    {0.960949f, 0.418323f, 0.359630f}, {0.969680f, 0.446936f, 0.360311f},
+    {0.976690f, 0.476226f, 0.364466f}, {0.982279f, 0.505851f, 0.371874f},
+    {0.986700f, 0.535582f, 0.382210f}, {0.990138f, 0.565296f, 0.395122f},
+    {0.992785f, 0.594891f, 0.410283f}, {0.994738f, 0.624350f, 0.427397f},
+    {0.996096f, 0.653659f, 0.446213f}, {0.996925f, 0.682828f, 0.466526f},
+    {0.997325f, 0.711848f, 0.488154f}, {0.997285f, 0.740772f, 0.510983f},
+    {0.996898f, 0.769591f, 0.534892f}, {0.996162f, 0.798348f, 0.559820f},
+    {0.995131f, 0.827052f, 0.585701f}, {0.993866f, 0.855711f, 0.612482f},
+    {0.992440f, 0.884330f, 0.640099f}, {0.990930f, 0.912915f, 0.668481f},
+    {0.989434f, 0.941470f, 0.697519f}, {0.988033f, 0.970012f, 0.727077f},
+    {0.987053f, 0.991438f, 0.749504f},
+};
+
+// Table index (0..255) of each knot: 0, 4, ..., 252, then 255.
+constexpr double knot_index(int k) { return k == magma_knot_count - 1 ? 255.0 : 4.0 * k; }
+
+// A 3x5 pixel font for the legend's numbers: each glyph is five rows of three bits, the
+// high bit on the left. Only what "%.3g" prints is here.
+struct Glyph {
+    char c;
+    std::uint8_t rows[5];
+};
+constexpr Glyph glyphs[] = {
+    {'0', {7, 5, 5, 5, 7}}, {'1', {2, 6, 2, 2, 7}}, {'2', {7, 1, 7, 4, 7}},
+    {'3', {7, 1, 7, 1, 7}}, {'4', {5, 5, 7, 1, 1}}, {'5', {7, 4, 7, 1, 7}},
+    {'6', {7, 4, 7, 5, 7}}, {'7', {7, 1, 1, 1, 1}}, {'8', {7, 5, 7, 5, 7}},
+    {'9', {7, 5, 7, 1, 7}}, {'.', {0, 0, 0, 0, 2}}, {'e', {2, 5, 7, 4, 3}},
+    {'-', {0, 0, 7, 0, 0}}, {'+', {0, 2, 7, 2, 0}},
+};
+
+constexpr int font_scale = 2;                    // each font pixel is 2x2
+constexpr int glyph_height = 5 * font_scale;
+constexpr int glyph_advance = 4 * font_scale;    // one font pixel between glyphs
+constexpr int min_canvas_width = 256;            // room for three labels under the bar
+constexpr int margin = 8;
+constexpr int bar_height = 14;
+constexpr std::array<std::uint8_t, 3> background{24, 24, 24};
+constexpr std::array<std::uint8_t, 3> text_color{235, 235, 235};
+
+class Canvas {
+public:
+    explicit Canvas(Rgb8Image& image) : image_(image) {}
+
+    void set(int x, int y, std::array<std::uint8_t, 3> color) {
+        if (x < 0 || y < 0 || x >= image_.width || y >= image_.height) return;
+        const std::size_t i = 3 * (static_cast<std::size_t>(y) * image_.width + x);
+        image_.rgb[i] = color[0];
+        image_.rgb[i + 1] = color[1];
+        image_.rgb[i + 2] = color[2];
+    }
+
+    void text(int x, int y, std::string_view s) {
+        for (char c : s) {
+            for (const Glyph& g : glyphs) {
+                if (g.c != c) continue;
+                for (int row = 0; row < 5; ++row)
+                    for (int col = 0; col < 3; ++col)
+                        if (g.rows[row] & (4 >> col))
+                            for (int dy = 0; dy < font_scale; ++dy)
+                                for (int dx = 0; dx < font_scale; ++dx)
+                                    set(x + col * font_scale + dx, y + row * font_scale + dy,
+                                        text_color);
+            }
+            x += glyph_advance;
+        }
+    }
+
+private:
+    Rgb8Image& image_;
+};
+
+int text_width(std::string_view s) {
+    return s.empty() ? 0 : static_cast<int>(s.size()) * glyph_advance - font_scale;
+}
+
+std::string label(double value) {
+    if (value == 0.0) return "0";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", value);
+    return text;
+}
+
+}  // namespace
+
+std::array<std::uint8_t, 3> magma_color(double t) {
+    if (!(t > 0.0)) t = 0.0;
+    if (t > 1.0) t = 1.0;
+    const double index = t * 255.0;
+    int k = std::min(static_cast<int>(index / 4.0), magma_knot_count - 2);
+    const double f = (index - knot_index(k)) / (knot_index(k + 1) - knot_index(k));
+    std::array<std::uint8_t, 3> color{};
+    for (int c = 0; c < 3; ++c) {
+        const double v = magma_knots[k][c] + (magma_knots[k + 1][c] - magma_knots[k][c]) * f;
+        color[static_cast<std::size_t>(c)] =
+            static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+    }
+    return color;
+}
+
+ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
+                                  const CompareResult& result) {
+    ErrorHeatmap map;
+    const int width = result.width, height = result.height;
+    map.scale_max = result.overall.max_abs_error;
+    // Enlarge small images so a few pixels are visible, but keep huge ones as they are.
+    map.zoom = std::clamp(min_canvas_width / std::max(width, 1), 1, 64);
+    map.zoom = std::max(1, std::min(map.zoom, 4096 / std::max(height, 1)));
+    const int map_w = width * map.zoom, map_h = height * map.zoom;
+
+    Rgb8Image& image = map.image;
+    image.width = std::max(map_w, min_canvas_width);
+    const int legend_top = map_h + margin;
+    image.height = legend_top + bar_height + 4 + glyph_height + margin;
+    image.rgb.resize(3 * static_cast<std::size_t>(image.width) * image.height);
+    Canvas canvas(image);
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) canvas.set(x, y, background);
+
+    // The map: the largest error over the compared channels, per pixel.
+    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    for (std::size_t i = 0; i < pixels; ++i) {
+        double error = 0.0;
+        bool finite = true;
+        for (const auto& [index_a, index_b] : result.channel_indices) {
+            const float va = a.plane(index_a)[i], vb = b.plane(index_b)[i];
+            if (!std::isfinite(va) || !std::isfinite(vb)) {
+                finite = false;
+                break;
+            }
+            error = std::max(error, std::fabs(static_cast<double>(va) - vb));
+        }
+        const std::array<std::uint8_t, 3> color =
+            !finite ? heatmap_nonfinite_color
+                    : magma_color(map.scale_max > 0.0 ? error / map.scale_max : 0.0);
+        const int x0 = static_cast<int>(i % static_cast<std::size_t>(width)) * map.zoom;
+        const int y0 = static_cast<int>(i / static_cast<std::size_t>(width)) * map.zoom;
+        for (int dy = 0; dy < map.zoom; ++dy)
+            for (int dx = 0; dx < map.zoom; ++dx) canvas.set(x0 + dx, y0 + dy, color);
+    }
+
+    // The legend: the ramp from 0 to scale_max, with 0, the middle and the top printed.
+    map.bar_x0 = margin;
+    map.bar_x1 = image.width - margin;
+    map.bar_y0 = legend_top;
+    map.bar_y1 = legend_top + bar_height;
+    const int bar_span = std::max(map.bar_x1 - map.bar_x0 - 1, 1);
+    for (int x = map.bar_x0; x < map.bar_x1; ++x) {
+        const auto color = magma_color(static_cast<double>(x - map.bar_x0) / bar_span);
+        for (int y = map.bar_y0; y < map.bar_y1; ++y) canvas.set(x, y, color);
+    }
+    const int text_y = map.bar_y1 + 4;
+    const std::string low = "0", mid = label(map.scale_max / 2), high = label(map.scale_max);
+    canvas.text(map.bar_x0, text_y, low);
+    if (map.scale_max > 0.0) {
+        canvas.text((map.bar_x0 + map.bar_x1 - text_width(mid)) / 2, text_y, mid);
+        canvas.text(map.bar_x1 - text_width(high), text_y, high);
+    }
+    return map;
+}
+
+void write_error_heatmap(const std::string& path, const ChannelImage& a, const ChannelImage& b,
+                         const CompareResult& result) {
+    const ErrorHeatmap map = render_error_heatmap(a, b, result);
+    write_png_rgb8(path, map.image.width, map.image.height, map.image.rgb);
+}
+
+}  // namespace octray

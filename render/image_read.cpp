@@ -1,0 +1,336 @@
+#include "render/image_read.h"
+
+#include <png.h>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <csetjmp>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <new>
+#include <set>
+#include <system_error>
+#include <utility>
+
+#include "render/image_io.h"
+
+namespace octray {
+
+ChannelImage::ChannelImage(int width_, int height_, std::vector<std::string> names)
+    : width(width_), height(height_), channel_names(std::move(names)),
+      planes(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) *
+             channel_names.size()) {}
+
+int ChannelImage::find_channel(std::string_view name) const {
+    for (std::size_t c = 0; c < channel_names.size(); ++c)
+        if (channel_names[c] == name) return static_cast<int>(c);
+    return -1;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A bound on what one comparison may allocate (4 GiB of floats): a corrupt header that
+// claims a gigantic image must fail as a file error, not as an out-of-memory crash.
+constexpr std::size_t max_float_values = std::size_t{1} << 30;
+
+// Callers print the message as one line, and OpenEXR's own messages may hold newlines.
+[[noreturn]] void fail(const std::string& path, std::string reason) {
+    std::replace(reason.begin(), reason.end(), '\n', ' ');
+    throw IoError("cannot read '" + path + "': " + reason);
+}
+
+enum class FileKind { exr, png, unknown };
+
+constexpr std::array<unsigned char, 4> exr_magic{0x76, 0x2f, 0x31, 0x01};
+constexpr std::array<unsigned char, 8> png_magic{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+
+// Opens `path` for reading, after the checks that give each common failure its own
+// message.
+std::ifstream open_checked(const std::string& path) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (ec || !fs::exists(status)) {
+        if (ec && ec != std::errc::no_such_file_or_directory) fail(path, ec.message());
+        fail(path, "no such file");
+    }
+    if (fs::is_directory(status)) fail(path, "is a directory, not an image");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path, std::generic_category().message(errno));
+    return in;
+}
+
+// The first bytes of the file, enough for either signature.
+std::vector<unsigned char> read_signature(const std::string& path) {
+    std::ifstream in = open_checked(path);
+    std::vector<unsigned char> bytes(8);
+    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (in.bad()) fail(path, "read error");
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
+    return bytes;
+}
+
+std::vector<unsigned char> read_whole_file(const std::string& path) {
+    std::ifstream in = open_checked(path);
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                     std::istreambuf_iterator<char>());
+    if (in.bad()) fail(path, "read error");
+    return bytes;
+}
+
+FileKind kind_of(const std::vector<unsigned char>& bytes) {
+    if (bytes.size() >= png_magic.size() &&
+        std::equal(png_magic.begin(), png_magic.end(), bytes.begin()))
+        return FileKind::png;
+    if (bytes.size() >= exr_magic.size() &&
+        std::equal(exr_magic.begin(), exr_magic.end(), bytes.begin()))
+        return FileKind::exr;
+    return FileKind::unknown;
+}
+
+// ---- OpenEXR -------------------------------------------------------------------------
+
+// Sort key that puts each layer's R, G, B, A first, in that order (the order people read
+// them in), and the layer's other channels alphabetically after; OpenEXR itself stores
+// channels alphabetically (A, B, G, R).
+std::pair<std::string, std::pair<int, std::string>> exr_channel_key(const std::string& name) {
+    const std::size_t dot = name.rfind('.');
+    std::string layer = dot == std::string::npos ? std::string() : name.substr(0, dot);
+    std::string suffix = dot == std::string::npos ? name : name.substr(dot + 1);
+    static constexpr std::array<std::string_view, 4> rgba{"R", "G", "B", "A"};
+    int rank = static_cast<int>(rgba.size());
+    for (std::size_t i = 0; i < rgba.size(); ++i)
+        if (suffix == rgba[i]) rank = static_cast<int>(i);
+    return {std::move(layer), {rank, std::move(suffix)}};
+}
+
+ChannelImage read_exr_file(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imf::Header& header = file.header();
+        const Imath::Box2i window = header.dataWindow();
+        const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
+        const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
+        if (w <= 0 || h <= 0) fail(path, "OpenEXR file has an empty data window");
+
+        std::vector<std::string> names;
+        std::set<Imf::PixelType> types;
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+            if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+                fail(path, std::string("OpenEXR channel '") + it.name() +
+                               "' is subsampled, which compare does not support");
+            names.emplace_back(it.name());
+            types.insert(it.channel().type);
+        }
+        if (names.empty()) fail(path, "OpenEXR file has no channels");
+        if (static_cast<unsigned long long>(w) * static_cast<unsigned long long>(h) *
+                names.size() >
+            max_float_values)
+            fail(path, "image too large to compare");
+        std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+            return exr_channel_key(a) < exr_channel_key(b);
+        });
+
+        ChannelImage image(static_cast<int>(w), static_cast<int>(h), names);
+        image.origin_x = window.min.x;
+        image.origin_y = window.min.y;
+        std::string format = "OpenEXR";
+        for (Imf::PixelType type : types)
+            format += type == Imf::HALF ? " half" : type == Imf::FLOAT ? " float" : " uint";
+        image.format = format;
+
+        // Every channel is read as FLOAT; OpenEXR converts HALF and UINT on the way.
+        Imf::FrameBuffer frame_buffer;
+        for (int c = 0; c < image.channel_count(); ++c)
+            frame_buffer.insert(image.channel_names[static_cast<std::size_t>(c)],
+                                Imf::Slice::Make(Imf::FLOAT, image.plane(c), window,
+                                                 sizeof(float),
+                                                 sizeof(float) * static_cast<std::size_t>(w)));
+        file.setFrameBuffer(frame_buffer);
+        file.readPixels(window.min.y, window.max.y);
+        return image;
+    } catch (const IoError&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        fail(path, "out of memory reading OpenEXR file");
+    } catch (const std::exception& e) {
+        // OpenEXR says the same things for a cut-off file and a damaged one.
+        fail(path, std::string("truncated or corrupt OpenEXR file (") + e.what() + ")");
+    }
+}
+
+// ---- PNG -----------------------------------------------------------------------------
+// libpng reports errors by longjmp. The functions that call setjmp create no object with
+// a destructor after it, so the jump never skips one; everything that owns memory lives
+// in read_png_file, outside them.
+
+struct PngSource {
+    const unsigned char* data = nullptr;
+    std::size_t size = 0;
+    std::size_t offset = 0;
+    bool ran_out = false;
+    char error[256] = {};
+};
+
+struct PngLayout {
+    png_uint_32 width = 0;
+    png_uint_32 height = 0;
+    int channels = 0;
+    int bit_depth = 0;  // 8 or 16 after the transforms below
+    std::size_t row_bytes = 0;
+};
+
+void on_png_error(png_structp png, png_const_charp message) {
+    auto* source = static_cast<PngSource*>(png_get_error_ptr(png));
+    std::snprintf(source->error, sizeof source->error, "%s", message);
+    png_longjmp(png, 1);
+}
+
+// libpng warns about harmless quirks (an sRGB profile it does not recognise, ...); they
+// are not the comparison's business.
+void on_png_warning(png_structp, png_const_charp) {}
+
+void on_png_read(png_structp png, png_bytep out, std::size_t length) {
+    auto* source = static_cast<PngSource*>(png_get_io_ptr(png));
+    if (length > source->size - source->offset) {
+        source->ran_out = true;
+        png_error(png, "unexpected end of file");
+    }
+    std::memcpy(out, source->data + source->offset, length);
+    source->offset += length;
+}
+
+bool read_png_header(png_structp png, png_infop info, PngLayout& layout) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_read_info(png, info);
+    const int color_type = png_get_color_type(png, info);
+    // Palette and low-bit gray become 8-bit samples; a palette's transparency becomes an
+    // alpha channel. 16-bit samples stay 16-bit, so no precision is lost.
+    if (color_type == PNG_COLOR_TYPE_PALETTE) {
+        png_set_palette_to_rgb(png);
+        if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+    }
+    if (color_type == PNG_COLOR_TYPE_GRAY && png_get_bit_depth(png, info) < 8)
+        png_set_expand_gray_1_2_4_to_8(png);
+    png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    layout.width = png_get_image_width(png, info);
+    layout.height = png_get_image_height(png, info);
+    layout.channels = png_get_channels(png, info);
+    layout.bit_depth = png_get_bit_depth(png, info);
+    layout.row_bytes = png_get_rowbytes(png, info);
+    return true;
+}
+
+bool read_png_rows(png_structp png, png_infop info, png_bytepp rows) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_read_image(png, rows);
+    // Reading up to IEND is what tells a file cut off after its pixel data.
+    png_read_end(png, info);
+    return true;
+}
+
+// Owns libpng's two structures for the length of one read.
+class PngReadHandle {
+public:
+    explicit PngReadHandle(PngSource& source) {
+        png_ = png_create_read_struct(PNG_LIBPNG_VER_STRING, &source, on_png_error,
+                                      on_png_warning);
+        if (png_) info_ = png_create_info_struct(png_);
+    }
+    ~PngReadHandle() { png_destroy_read_struct(&png_, info_ ? &info_ : nullptr, nullptr); }
+    PngReadHandle(const PngReadHandle&) = delete;
+    PngReadHandle& operator=(const PngReadHandle&) = delete;
+
+    png_structp png() const { return png_; }
+    png_infop info() const { return info_; }
+
+private:
+    png_structp png_ = nullptr;
+    png_infop info_ = nullptr;
+};
+
+ChannelImage read_png_file(const std::string& path, const std::vector<unsigned char>& bytes) {
+    PngSource source;
+    source.data = bytes.data();
+    source.size = bytes.size();
+    PngReadHandle handle(source);
+    if (!handle.png() || !handle.info()) fail(path, "out of memory starting libpng");
+    png_set_read_fn(handle.png(), &source, on_png_read);
+
+    const auto png_failure = [&]() -> std::string {
+        if (source.ran_out) return "truncated PNG file (unexpected end of file)";
+        return std::string("corrupt PNG file (") + source.error + ")";
+    };
+
+    PngLayout layout;
+    if (!read_png_header(handle.png(), handle.info(), layout)) fail(path, png_failure());
+    if (layout.channels < 1 || layout.channels > 4 ||
+        (layout.bit_depth != 8 && layout.bit_depth != 16))
+        fail(path, "unsupported PNG sample layout");
+    const std::size_t pixels = static_cast<std::size_t>(layout.width) * layout.height;
+    if (pixels == 0) fail(path, "PNG file has no pixels");
+    if (pixels * static_cast<std::size_t>(layout.channels) > max_float_values)
+        fail(path, "image too large to compare");
+
+    std::vector<png_byte> raw(layout.row_bytes * layout.height);
+    std::vector<png_bytep> rows(layout.height);
+    for (png_uint_32 y = 0; y < layout.height; ++y) rows[y] = raw.data() + y * layout.row_bytes;
+    if (!read_png_rows(handle.png(), handle.info(), rows.data())) fail(path, png_failure());
+
+    static const std::vector<std::string> names_by_count[4] = {
+        {"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
+    ChannelImage image(static_cast<int>(layout.width), static_cast<int>(layout.height),
+                       names_by_count[layout.channels - 1]);
+    image.format = layout.bit_depth == 16 ? "PNG 16-bit" : "PNG 8-bit";
+
+    // Raw samples scaled to [0, 1]; 16-bit samples are big-endian in the file.
+    const int channels = layout.channels;
+    for (int y = 0; y < image.height; ++y) {
+        const png_byte* row = rows[static_cast<std::size_t>(y)];
+        for (int x = 0; x < image.width; ++x) {
+            for (int c = 0; c < channels; ++c) {
+                const std::size_t sample = static_cast<std::size_t>(x) * channels + c;
+                float value;
+                if (layout.bit_depth == 16) {
+                    const unsigned v = (unsigned{row[2 * sample]} << 8) | row[2 * sample + 1];
+                    value = static_cast<float>(v) / 65535.0f;
+                } else {
+                    value = static_cast<float>(row[sample]) / 255.0f;
+                }
+                image.at(c, x, y) = value;
+            }
+        }
+    }
+    return image;
+}
+
+}  // namespace
+
+ChannelImage read_image(const std::string& path) {
+    const std::vector<unsigned char> signature = read_signature(path);
+    if (signature.empty()) fail(path, "empty file, not an image");
+    switch (kind_of(signature)) {
+        case FileKind::png:
+            return read_png_file(path, read_whole_file(path));
+        case FileKind::exr:
+            return read_exr_file(path);
+        case FileKind::unknown:
+            break;
+    }
+    fail(path, "not an image (neither an OpenEXR nor a PNG signature)");
+}
+
+}  // namespace octray

@@ -1,0 +1,208 @@
+#include "render/image_read.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "render/image_io.h"
+#include "tests/render/compare_fixtures.h"
+
+namespace octray {
+namespace {
+
+using testing::make_image;
+using testing::write_test_exr;
+using testing::write_test_png;
+
+class ImageReadTest : public testing::ScratchDirTest {};
+
+// A different value in every channel of every pixel, exact in half precision.
+ChannelImage numbered_image(int w, int h, std::vector<std::string> names) {
+    ChannelImage image = make_image(w, h, std::move(names));
+    for (int c = 0; c < image.channel_count(); ++c)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) image.at(c, x, y) = c * 100.0f + y * 10.0f + x + 0.5f;
+    return image;
+}
+
+// The message of the IoError read_image throws, or a test failure.
+std::string read_error(const std::string& path) {
+    try {
+        read_image(path);
+    } catch (const IoError& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << "read_image(" << path << ") did not throw";
+    return "";
+}
+
+TEST_F(ImageReadTest, ExrFloatRoundTripsEveryValueAndOrdersRgbaFirst) {
+    const ChannelImage written = numbered_image(5, 3, {"A", "B", "G", "R", "Z"});
+    write_test_exr(path("f.exr"), written, Imf::FLOAT);
+    const ChannelImage read = read_image(path("f.exr"));
+    ASSERT_EQ(read.width, 5);
+    ASSERT_EQ(read.height, 3);
+    EXPECT_EQ(read.channel_names, (std::vector<std::string>{"R", "G", "B", "A", "Z"}));
+    EXPECT_EQ(read.format, "OpenEXR float");
+    for (const std::string& name : read.channel_names)
+        for (int y = 0; y < 3; ++y)
+            for (int x = 0; x < 5; ++x)
+                EXPECT_EQ(read.at(read.find_channel(name), x, y),
+                          written.at(written.find_channel(name), x, y))
+                    << name << " at " << x << "," << y;
+}
+
+TEST_F(ImageReadTest, ExrHalfAndUintChannelsReadAsFloat) {
+    const ChannelImage written = numbered_image(4, 2, {"R", "G", "B"});
+    write_test_exr(path("h.exr"), written, Imf::HALF);
+    const ChannelImage half_image = read_image(path("h.exr"));
+    EXPECT_EQ(half_image.format, "OpenEXR half");
+    EXPECT_EQ(half_image.at(2, 3, 1), 213.5f);  // exact in half
+
+    ChannelImage ids = make_image(3, 1, {"id"});
+    ids.at(0, 0, 0) = 7.0f;
+    ids.at(0, 2, 0) = 65536.0f;
+    write_test_exr(path("u.exr"), ids, Imf::UINT);
+    const ChannelImage uint_image = read_image(path("u.exr"));
+    EXPECT_EQ(uint_image.format, "OpenEXR uint");
+    EXPECT_EQ(uint_image.at(0, 0, 0), 7.0f);
+    EXPECT_EQ(uint_image.at(0, 2, 0), 65536.0f);
+}
+
+TEST_F(ImageReadTest, ExrLayersSortRgbaFirstWithinEachLayer) {
+    write_test_exr(path("l.exr"),
+                   make_image(2, 2, {"diffuse.B", "diffuse.R", "depth.Z", "G", "R", "B"}));
+    EXPECT_EQ(read_image(path("l.exr")).channel_names,
+              (std::vector<std::string>{"R", "G", "B", "depth.Z", "diffuse.R", "diffuse.B"}));
+}
+
+TEST_F(ImageReadTest, ExrDataWindowOffsetIsHonored) {
+    ChannelImage written = numbered_image(3, 2, {"Y"});
+    written.origin_x = 10;
+    written.origin_y = -4;
+    write_test_exr(path("dw.exr"), written);
+    const ChannelImage read = read_image(path("dw.exr"));
+    EXPECT_EQ(read.origin_x, 10);
+    EXPECT_EQ(read.origin_y, -4);
+    ASSERT_EQ(read.width, 3);
+    ASSERT_EQ(read.height, 2);
+    EXPECT_EQ(read.at(0, 0, 0), 0.5f);
+    EXPECT_EQ(read.at(0, 2, 1), 12.5f);
+}
+
+TEST_F(ImageReadTest, ExrNanAndInfSurviveReading) {
+    ChannelImage written = make_image(2, 1, {"R"});
+    written.at(0, 0, 0) = std::numeric_limits<float>::quiet_NaN();
+    written.at(0, 1, 0) = -std::numeric_limits<float>::infinity();
+    write_test_exr(path("nan.exr"), written);
+    const ChannelImage read = read_image(path("nan.exr"));
+    EXPECT_TRUE(std::isnan(read.at(0, 0, 0)));
+    EXPECT_EQ(read.at(0, 1, 0), -std::numeric_limits<float>::infinity());
+}
+
+TEST_F(ImageReadTest, Png8BitRgbIsRawValuesOver255) {
+    // Not linearized: 128 reads as 128/255, not as sRGB-decoded 0.2158.
+    write_test_png(path("rgb.png"), 2, 1, 3, 8, {0, 128, 255, 1, 2, 3});
+    const ChannelImage read = read_image(path("rgb.png"));
+    EXPECT_EQ(read.channel_names, (std::vector<std::string>{"R", "G", "B"}));
+    EXPECT_EQ(read.format, "PNG 8-bit");
+    EXPECT_EQ(read.at(0, 0, 0), 0.0f);
+    EXPECT_EQ(read.at(1, 0, 0), 128.0f / 255.0f);
+    EXPECT_EQ(read.at(2, 0, 0), 1.0f);
+    EXPECT_EQ(read.at(2, 1, 0), 3.0f / 255.0f);
+}
+
+TEST_F(ImageReadTest, Png16BitRgbaKeepsFullPrecisionAndUnpremultipliedAlpha) {
+    write_test_png(path("rgba16.png"), 1, 2, 4, 16,
+                   {65535, 257, 1, 0, /* row 1 */ 40000, 30000, 20000, 32768});
+    const ChannelImage read = read_image(path("rgba16.png"));
+    EXPECT_EQ(read.channel_names, (std::vector<std::string>{"R", "G", "B", "A"}));
+    EXPECT_EQ(read.format, "PNG 16-bit");
+    EXPECT_EQ(read.at(0, 0, 0), 1.0f);
+    EXPECT_EQ(read.at(1, 0, 0), 257.0f / 65535.0f);
+    EXPECT_EQ(read.at(2, 0, 0), 1.0f / 65535.0f);
+    EXPECT_EQ(read.at(3, 0, 0), 0.0f);  // colour of a transparent pixel kept as stored
+    EXPECT_EQ(read.at(0, 0, 1), 40000.0f / 65535.0f);
+    EXPECT_EQ(read.at(3, 0, 1), 32768.0f / 65535.0f);
+}
+
+TEST_F(ImageReadTest, PngGrayAndGrayAlphaAreYAndYA) {
+    write_test_png(path("y.png"), 2, 2, 1, 8, {0, 51, 102, 255});
+    const ChannelImage y = read_image(path("y.png"));
+    EXPECT_EQ(y.channel_names, (std::vector<std::string>{"Y"}));
+    EXPECT_EQ(y.at(0, 1, 0), 51.0f / 255.0f);
+    EXPECT_EQ(y.at(0, 0, 1), 102.0f / 255.0f);
+
+    write_test_png(path("ya.png"), 1, 1, 2, 16, {1000, 2000});
+    const ChannelImage ya = read_image(path("ya.png"));
+    EXPECT_EQ(ya.channel_names, (std::vector<std::string>{"Y", "A"}));
+    EXPECT_EQ(ya.at(1, 0, 0), 2000.0f / 65535.0f);
+}
+
+TEST_F(ImageReadTest, FormatComesFromMagicBytesNotExtension) {
+    write_test_png(path("actually_png.exr"), 1, 1, 1, 8, {255});
+    EXPECT_EQ(read_image(path("actually_png.exr")).format, "PNG 8-bit");
+    write_test_exr(path("actually_exr.png"), make_image(1, 1, {"R"}, 2.0f));
+    EXPECT_EQ(read_image(path("actually_exr.png")).at(0, 0, 0), 2.0f);
+}
+
+TEST_F(ImageReadTest, MissingFileSaysSo) {
+    const std::string message = read_error(path("nope.exr"));
+    EXPECT_NE(message.find("nope.exr"), std::string::npos) << message;
+    EXPECT_NE(message.find("no such file"), std::string::npos) << message;
+}
+
+TEST_F(ImageReadTest, DirectoryEmptyAndTextFilesAreNotImages) {
+    EXPECT_NE(read_error(dir_.string()).find("is a directory"), std::string::npos);
+    testing::write_text_file(path("empty.exr"), "");
+    EXPECT_NE(read_error(path("empty.exr")).find("empty file"), std::string::npos);
+    testing::write_text_file(path("notes.png"), "this is not a picture\n");
+    const std::string message = read_error(path("notes.png"));
+    EXPECT_NE(message.find("not an image"), std::string::npos) << message;
+    EXPECT_NE(message.find("notes.png"), std::string::npos) << message;
+}
+
+TEST_F(ImageReadTest, TruncatedExrIsAClearIoError) {
+    // Uncompressed, so that cutting the file in half cuts off pixel data for certain.
+    write_test_exr(path("t.exr"), numbered_image(64, 64, {"R", "G", "B"}), Imf::FLOAT,
+                   Imf::NO_COMPRESSION);
+    testing::truncate_file(path("t.exr"), testing::fs::file_size(path("t.exr")) / 2);
+    const std::string message = read_error(path("t.exr"));
+    EXPECT_NE(message.find("t.exr"), std::string::npos) << message;
+    EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+}
+
+TEST_F(ImageReadTest, ExrCutInsideItsHeaderIsAClearIoError) {
+    write_test_exr(path("h.exr"), numbered_image(8, 8, {"R"}));
+    testing::truncate_file(path("h.exr"), 20);
+    const std::string message = read_error(path("h.exr"));
+    EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+}
+
+TEST_F(ImageReadTest, TruncatedPngIsAClearIoError) {
+    std::vector<std::uint16_t> samples(32 * 32 * 3);
+    for (std::size_t i = 0; i < samples.size(); ++i) samples[i] = static_cast<std::uint16_t>(i * 7919 % 256);
+    write_test_png(path("t.png"), 32, 32, 3, 8, samples);
+    testing::truncate_file(path("t.png"), testing::fs::file_size(path("t.png")) / 2);
+    const std::string message = read_error(path("t.png"));
+    EXPECT_NE(message.find("t.png"), std::string::npos) << message;
+    EXPECT_NE(message.find("truncated PNG"), std::string::npos) << message;
+}
+
+TEST_F(ImageReadTest, PngWithBrokenDataIsAnIoErrorNotACrash) {
+    write_test_png(path("c.png"), 16, 16, 3, 8, std::vector<std::uint16_t>(16 * 16 * 3, 77));
+    {
+        // Flip bytes in the middle of the file (inside IDAT): a CRC or zlib error.
+        std::fstream f(path("c.png"), std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(60);
+        f.write("\xde\xad\xbe\xef\xde\xad\xbe\xef", 8);
+    }
+    const std::string message = read_error(path("c.png"));
+    EXPECT_NE(message.find("corrupt PNG"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace octray
