@@ -2,6 +2,7 @@
 // Writing images: OpenEXR (the product) and 8-bit PNG previews. Every writer goes through
 // write_file_atomically(), so an interrupted run never leaves a partial image behind.
 
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -50,5 +51,11 @@ void write_exr(const std::string& path, const Image& image, const ExrWriteOption
 
 // An 8-bit sRGB preview: linear values clamped to [0, 1], sRGB-encoded. Throws IoError.
 void write_png_preview(const std::string& path, const Image& image);
+
+// An 8-bit RGB PNG of ready-made sRGB bytes (row 0 on top, rgb.size() == 3 * width *
+// height), for pictures that are not renders: the compare heatmap. Throws IoError.
+// (Implemented in png_write.cpp.)
+void write_png_rgb8(const std::string& path, int width, int height,
+                    const std::vector<std::uint8_t>& rgb);
 
 }  // namespace octray

@@ -3,6 +3,7 @@
 #include <png.h>
 
 #include <ImfChannelList.h>
+#include <ImfCompression.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
@@ -116,6 +117,57 @@ std::pair<std::string, std::pair<int, std::string>> exr_channel_key(const std::s
     return {std::move(layer), {rank, std::move(suffix)}};
 }
 
+// The most pixel bytes one byte of the file can hold under each codec: upper bounds on the
+// compression ratio, with margin. None: 1. RLE: a run of at most 128 bytes in 2. ZIP(S):
+// deflate's limit is 1032:1; PXR24 first packs float to 24 bits (4/3), then deflates. PIZ:
+// the Huffman coder spends at least 10 bits on a run of 256 16-bit values (about 410:1).
+// B44(A): 32 bytes in at least 3. DWAA/DWAB: a 2-byte DC value per 8x8 block, deflated
+// (64 x 1032). 0 means unknown, for codecs newer than this table: no bound but the cap.
+unsigned long long max_expansion(Imf::Compression compression) {
+    switch (compression) {
+        case Imf::NO_COMPRESSION: return 1;
+        case Imf::RLE_COMPRESSION: return 128;
+        case Imf::ZIPS_COMPRESSION:
+        case Imf::ZIP_COMPRESSION:
+        case Imf::PXR24_COMPRESSION: return 2048;
+        case Imf::PIZ_COMPRESSION: return 4096;
+        case Imf::B44_COMPRESSION:
+        case Imf::B44A_COMPRESSION: return 16;
+        case Imf::DWAA_COMPRESSION:
+        case Imf::DWAB_COMPRESSION: return 1ull << 17;
+        default: return 0;
+    }
+}
+
+// A header is a few hundred bytes, and it may claim any data window. The pixel data it
+// claims must fit in the file under the best compression its codec can reach; otherwise
+// the file is cut off or corrupt, and it is refused before the planes are allocated
+// (a 449-byte fuzzer input claiming a huge window made compare allocate 260 MB, and the
+// float cap alone would have allowed 4 GiB).
+void check_pixel_data_fits(const std::string& path, const Imf::Header& header, long long w,
+                           long long h) {
+    const unsigned long long ratio = max_expansion(header.compression());
+    if (ratio == 0) return;
+    unsigned long long bytes_per_pixel = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+        bytes_per_pixel += it.channel().type == Imf::HALF ? 2 : 4;
+    // w, h < 2^31 and at most 2^30 values in all (checked above): no overflow.
+    const unsigned long long pixel_bytes = static_cast<unsigned long long>(w) *
+                                           static_cast<unsigned long long>(h) *
+                                           bytes_per_pixel;
+    std::error_code ec;
+    const std::uintmax_t file_bytes = fs::file_size(path, ec);
+    if (ec) return;  // OpenEXR reports an unreadable file itself
+    if (pixel_bytes / ratio <= file_bytes) return;
+    fail(path, "truncated or corrupt OpenEXR file (its header claims a " + std::to_string(w) +
+                   " x " + std::to_string(h) + " data window, " +
+                   std::to_string(pixel_bytes) + " bytes of pixel data, which cannot fit in " +
+                   "the file's " + std::to_string(file_bytes) + " bytes" +
+                   (ratio == 1 ? std::string(" uncompressed")
+                               : " even at " + std::to_string(ratio) + ":1 compression") +
+                   ")");
+}
+
 ChannelImage read_exr_file(const std::string& path) {
     try {
         Imf::InputFile file(path.c_str());
@@ -139,6 +191,7 @@ ChannelImage read_exr_file(const std::string& path) {
                 names.size() >
             max_float_values)
             fail(path, "image too large to compare");
+        check_pixel_data_fits(path, header, w, h);
         std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
             return exr_channel_key(a) < exr_channel_key(b);
         });

@@ -33,9 +33,6 @@ constexpr int kMaxSphereflakeLevel = 7;
 // Same cap as validate_scene applies to render.max_depth (scene/README.md).
 constexpr int kMaxDepthLimit = 64;
 
-constexpr std::array<std::string_view, 5> kOptionNames = {"width", "height", "spp", "seed",
-                                                          "max_depth"};
-
 std::string quote_text(std::string_view s) { return "\"" + std::string(s) + "\""; }
 
 struct Overrides {

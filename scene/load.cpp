@@ -72,9 +72,18 @@ std::string format_rgb(Rgb c) {
     return "[" + format_float(c.r) + ", " + format_float(c.g) + ", " + format_float(c.b) + "]";
 }
 
+// Keys, names and words longer than this are cut short in messages: a 100 MB key must
+// not make a 100 MB message.
+constexpr std::size_t kMaxQuotedLength = 64;
+
+std::string abbreviated(std::string_view s) {
+    if (s.size() <= kMaxQuotedLength) return std::string(s);
+    return std::string(s.substr(0, kMaxQuotedLength - 3)) + "...";
+}
+
 std::string quote_text(std::string_view s) {
     // replace: a key or string with broken UTF-8 must still make a readable message.
-    return Json(std::string(s)).dump(-1, ' ', false, Json::error_handler_t::replace);
+    return Json(abbreviated(s)).dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 // A short description of a JSON value for "found ..." in messages.
@@ -113,7 +122,7 @@ std::string child_path(const std::string& path, std::string_view key) {
                    c == '_' || c == '-';
         });
     if (!plain) return path + "[" + quote_text(key) + "]";
-    return path.empty() ? std::string(key) : path + "." + std::string(key);
+    return path.empty() ? abbreviated(key) : path + "." + abbreviated(key);
 }
 
 std::string index_path(const std::string& path, std::size_t i) {
@@ -143,9 +152,15 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 
 // " (did you mean "x"?)" when one candidate is close, else "".
 std::string suggestion(std::string_view word, std::span<const std::string_view> candidates) {
+    // The edit distance costs |word| x |candidate| time and memory; beyond a few dozen
+    // characters a typo is unlikely and two long names would make it quadratic.
+    if (word.size() > kMaxQuotedLength) return "";
+    const std::size_t limit = std::clamp<std::size_t>(word.size() / 3, 1, 2);
     std::string_view best;
     std::size_t best_distance = std::numeric_limits<std::size_t>::max();
     for (std::string_view c : candidates) {
+        // The distance is at least the difference in length.
+        if (c.size() > word.size() + limit || word.size() > c.size() + limit) continue;
         const std::size_t d = edit_distance(word, c);
         if (d < best_distance) {
             best = c;
@@ -153,7 +168,6 @@ std::string suggestion(std::string_view word, std::span<const std::string_view> 
         }
     }
     // Up to a third of the word may be wrong (at least one edit, at most two).
-    const std::size_t limit = std::clamp<std::size_t>(word.size() / 3, 1, 2);
     if (best_distance == 0 || best_distance > limit) return "";
     return " (did you mean " + quote_text(best) + "?)";
 }

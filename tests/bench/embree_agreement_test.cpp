@@ -20,9 +20,9 @@
 namespace octray::bench {
 namespace {
 
+#if OCTRAY_HAVE_EMBREE
 constexpr int kWidth = 320, kHeight = 180;
 
-#if OCTRAY_HAVE_EMBREE
 // The nearest root of `object` on (t_min, t_max) in double precision (NaN for a miss).
 double exact_t(const Object& o, const Ray& r) {
     const double dx = r.direction.x, dy = r.direction.y, dz = r.direction.z;

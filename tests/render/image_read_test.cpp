@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -180,6 +184,60 @@ TEST_F(ImageReadTest, ExrCutInsideItsHeaderIsAClearIoError) {
     testing::truncate_file(path("h.exr"), 20);
     const std::string message = read_error(path("h.exr"));
     EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+}
+
+// Rewrites the dataWindow attribute of an EXR written by write_test_exr in place, so that
+// a file of a few hundred bytes claims a width x height image.
+void claim_data_window(const std::string& path, int width, int height) {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    const std::string name("dataWindow\0box2i\0", 17);
+    const std::size_t at = bytes.find(name);
+    ASSERT_NE(at, std::string::npos);
+    const std::int32_t window[4] = {0, 0, width - 1, height - 1};  // little-endian host
+    f.seekp(static_cast<std::streamoff>(at + name.size() + 4));   // after the size field
+    f.write(reinterpret_cast<const char*>(window), sizeof window);
+}
+
+// Fuzzer finding (tests/fuzz/README.md, Findings): a header that claims a huge data window
+// must be refused before the planes are allocated, not after OpenEXR finds the pixel data
+// missing. The rows stay 4, so the line offset table is whole and OpenEXR opens the file;
+// without the check each of these allocates 48 million floats (192 MB) first.
+TEST_F(ImageReadTest, ExrClaimingMorePixelDataThanTheFileHoldsIsRefusedUpFront) {
+    for (const Imf::Compression compression : {Imf::NO_COMPRESSION, Imf::ZIP_COMPRESSION}) {
+        SCOPED_TRACE(static_cast<int>(compression));
+        write_test_exr(path("big.exr"), numbered_image(4, 4, {"R", "G", "B"}), Imf::HALF,
+                       compression);
+        claim_data_window(path("big.exr"), 4'000'000, 4);
+        const std::string message = read_error(path("big.exr"));
+        if (std::getenv("OCTRAY_KEEP_BIG_EXR"))
+            testing::fs::copy_file(path("big.exr"), std::getenv("OCTRAY_KEEP_BIG_EXR"),
+                                   testing::fs::copy_options::overwrite_existing);
+        EXPECT_NE(message.find("big.exr"), std::string::npos) << message;
+        EXPECT_NE(message.find("truncated or corrupt OpenEXR file"), std::string::npos)
+            << message;
+        EXPECT_NE(message.find("claims a 4000000 x 4 data window"), std::string::npos)
+            << message;
+    }
+}
+
+// The file the fuzzer kept (tests/fuzz/findings/): an IoError, not a long allocation.
+TEST_F(ImageReadTest, FuzzFindingSlowExrLargeDataWindowIsAClearIoError) {
+    const std::string finding =
+        std::string(OCTRAY_SOURCE_DIR) + "/tests/fuzz/findings/slow-exr-large-data-window.exr";
+    const std::string message = read_error(finding);
+    EXPECT_NE(message.find("slow-exr-large-data-window.exr"), std::string::npos) << message;
+    EXPECT_NE(message.find("truncated or corrupt OpenEXR file"), std::string::npos) << message;
+}
+
+// The bound is a lower bound on the file size: a large image that is really there loads.
+TEST_F(ImageReadTest, LargeUncompressedExrStillLoads) {
+    ChannelImage image = make_image(1024, 512, {"R", "G", "B", "A"});
+    image.at(3, 1023, 511) = 0.25f;
+    write_test_exr(path("large.exr"), image, Imf::FLOAT, Imf::NO_COMPRESSION);
+    const ChannelImage read = read_image(path("large.exr"));
+    EXPECT_EQ(read.width, 1024);
+    EXPECT_EQ(read.at(read.find_channel("A"), 1023, 511), 0.25f);
 }
 
 TEST_F(ImageReadTest, TruncatedPngIsAClearIoError) {

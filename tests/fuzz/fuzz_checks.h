@@ -1,0 +1,184 @@
+#pragma once
+// The invariants the fuzzers check, one function per reader of outside input. The
+// libFuzzer targets (fuzz_*.cpp) call them on every input; tests/hardening replays the
+// checked-in corpus (seeds and regression inputs) through the same functions, so a crash
+// input kept in tests/fuzz/corpus/ stays a test in every ordinary build.
+//
+// Refusing bad input with the reader's own error type is success. A broken invariant
+// throws InvariantBroken: in a fuzzer that escapes LLVMFuzzerTestOneInput, std::terminate
+// aborts and libFuzzer keeps the input; in a GoogleTest it fails the test.
+
+#include <unistd.h>
+
+#include <charconv>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+#include "render/image_io.h"
+#include "render/image_read.h"
+#include "scene/builtin.h"
+#include "scene/compile.h"
+#include "scene/limits.h"
+#include "scene/load.h"
+#include "scene_diff.h"
+
+namespace octray::fuzz {
+
+class InvariantBroken : public std::logic_error {
+  public:
+    InvariantBroken(const std::string& invariant, const std::string& detail)
+        : std::logic_error("invariant broken: " + invariant + ": " + detail) {}
+};
+
+// A scene that loaded must validate, survive scene_to_json -> parse_scene_json bit for
+// bit, write the same text again, and be digestible by the memory estimate and
+// compile_scene (the packet path's layout).
+inline void check_loaded_scene(const Scene& scene) {
+    try {
+        validate_scene(scene);
+    } catch (const SceneError& e) {
+        throw InvariantBroken("a loaded scene passes validate_scene", e.what());
+    }
+    const std::string written = scene_to_json(scene);
+    Scene back;
+    try {
+        back = parse_scene_json(written, "written.json");
+    } catch (const SceneError& e) {
+        throw InvariantBroken("scene_to_json output loads",
+                              std::string(e.what()) + "\n" + written);
+    }
+    const std::string difference = first_scene_difference(scene, back);
+    if (!difference.empty()) {
+        throw InvariantBroken("the round trip is bit-identical", difference + "\n" + written);
+    }
+    if (scene_to_json(back) != written) {
+        throw InvariantBroken("writing a read-back scene gives the same text", written);
+    }
+    // Saturating arithmetic: a signed overflow here would be a UBSan report.
+    const RenderMemoryEstimate estimate = estimate_render_memory(scene);
+    if (estimate.total < estimate.framebuffer) {
+        throw InvariantBroken("the memory estimate covers the framebuffer",
+                              estimate.describe());
+    }
+    if (scene.objects.size() <= (std::size_t{1} << 24)) {
+        const CompiledScene compiled = compile_scene(scene);
+        if (compiled.objects.count != scene.objects.size()) {
+            throw InvariantBroken("compile_scene keeps every object",
+                                  std::to_string(compiled.objects.count));
+        }
+    }
+}
+
+// parse_scene_json on arbitrary bytes: SceneError, or a scene passing check_loaded_scene.
+inline void check_scene_json(std::string_view text) {
+    Scene scene;
+    try {
+        scene = parse_scene_json(text, "fuzz.json");
+    } catch (const SceneError&) {
+        return;  // refused with a located message: the expected outcome for most inputs
+    }
+    check_loaded_scene(scene);
+}
+
+// The built-in generators accept up to 2^24 spheres (random:N) and level 7 (sphereflake,
+// 5.4 million spheres): their documented limit, but up to 1.5 GB per input. Specs that are
+// valid but would build more than kMaxFuzzSpheres spheres are skipped before generation;
+// counts beyond the generators' limits are not, since refusing them quickly is what must
+// be tested. 256 keeps an input under ~10 ms with ASan (at 4096 the fuzzer spent a whole
+// 30-second CI run replaying its corpus).
+inline constexpr std::uint64_t kMaxFuzzSpheres = 256;
+inline constexpr std::uint64_t kMaxFuzzSphereflakeLevel = 2;  // 91 spheres
+
+inline bool builtin_spec_too_big_to_fuzz(std::string_view spec) {
+    const std::size_t colon = spec.find(':');
+    if (colon == std::string_view::npos) return false;
+    const std::string_view name = spec.substr(0, colon);
+    if (name.find(',') != std::string_view::npos) return false;  // options before ':'
+    std::string_view argument = spec.substr(colon + 1);
+    argument = argument.substr(0, argument.find(','));
+    std::uint64_t n = 0;
+    const auto [end, ec] =
+        std::from_chars(argument.data(), argument.data() + argument.size(), n);
+    if (ec != std::errc{} || end != argument.data() + argument.size()) return false;
+    if (name == "random") return n > kMaxFuzzSpheres && n <= (std::uint64_t{1} << 24);
+    if (name == "sphereflake") return n > kMaxFuzzSphereflakeLevel && n <= 7;
+    return false;
+}
+
+// make_builtin_scene on an arbitrary string: a SceneError naming the spec, or a scene
+// passing check_loaded_scene. Returns false for a spec skipped as too big to fuzz.
+inline bool check_builtin_spec(const std::string& spec) {
+    if (builtin_spec_too_big_to_fuzz(spec)) return false;
+    Scene scene;
+    try {
+        scene = make_builtin_scene(spec);
+    } catch (const SceneError& e) {
+        if (e.file() != spec) throw InvariantBroken("a spec error names the spec", e.what());
+        return true;
+    }
+    if (!is_builtin_scene(spec)) throw InvariantBroken("only built-in names build", spec);
+    if (scene.objects.size() > kMaxFuzzSpheres + 1) {  // + 1: sphereflake's floor
+        throw InvariantBroken("the fuzz size cap holds",
+                              std::to_string(scene.objects.size()) + " objects");
+    }
+    check_loaded_scene(scene);
+    return true;
+}
+
+// read_image on a file holding `bytes`: an IoError, or a consistent image.
+inline void check_image_file(const std::string& path) {
+    ChannelImage image;
+    try {
+        image = read_image(path);
+    } catch (const IoError&) {
+        return;
+    }
+    if (image.width <= 0 || image.height <= 0) {
+        throw InvariantBroken("a read image has pixels", image.format);
+    }
+    if (image.channel_count() < 1)
+        throw InvariantBroken("a read image has channels", image.format);
+    if (image.planes.size() != image.pixel_count() * image.channel_names.size()) {
+        throw InvariantBroken("the planes hold every channel of every pixel", image.format);
+    }
+    // Touch every value (ASan sees a short plane); PNG samples lie in [0, 1].
+    const bool png = image.format.rfind("PNG", 0) == 0;
+    for (float v : image.planes) {
+        if (png && !(v >= 0.0f && v <= 1.0f)) {
+            throw InvariantBroken("PNG samples lie in [0, 1]", image.format);
+        }
+    }
+}
+
+// A private temporary file for the image fuzzer, made once per process, removed at exit.
+inline const std::string& scratch_image_path() {
+    static const std::string path = [] {
+        const char* dir = std::getenv("TMPDIR");
+        std::string templ = std::string(dir && *dir ? dir : "/tmp") + "/octray_fuzz_XXXXXX";
+        const int fd = mkstemp(templ.data());
+        if (fd < 0) throw std::runtime_error("mkstemp failed for " + templ);
+        close(fd);
+        std::atexit([] { std::remove(scratch_image_path().c_str()); });
+        return templ;
+    }();
+    return path;
+}
+
+// read_image has no in-memory entry point, so the bytes go through a file.
+inline void check_image_bytes(const std::uint8_t* data, std::size_t size) {
+    const std::string& path = scratch_image_path();
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) throw std::runtime_error("cannot open " + path);
+    const bool written = size == 0 || std::fwrite(data, 1, size, f) == size;
+    std::fclose(f);
+    if (!written) throw std::runtime_error("cannot write " + path);
+    check_image_file(path);
+}
+
+}  // namespace octray::fuzz

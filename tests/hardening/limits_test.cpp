@@ -1,0 +1,143 @@
+// scene/limits.h: the render memory estimate, the limit check behind --max-memory, and
+// the size parser.
+
+#include "scene/limits.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "scene/builtin.h"
+#include "scene/scene_error.h"
+
+namespace octray {
+namespace {
+
+constexpr std::uint64_t kGiB = std::uint64_t{1} << 30;
+constexpr std::uint64_t kMiB = std::uint64_t{1} << 20;
+
+Scene image_scene(int width, int height, int spp = 1) {
+    Scene s = make_builtin_scene("whitted");
+    s.image = {width, height, spp};
+    return s;
+}
+
+TEST(RenderMemory, FramebufferAndHalfOutputScaleWithPixels) {
+    RenderMemoryParams reference_path;
+    reference_path.packet_path = false;
+    reference_path.threads = 1;
+    const RenderMemoryEstimate e =
+        estimate_render_memory(image_scene(1000, 500), reference_path);
+    EXPECT_EQ(e.framebuffer, 1000u * 500u * 12u);
+    EXPECT_EQ(e.output, 1000u * 500u * 6u);
+    EXPECT_EQ(e.per_thread, 0u);
+    EXPECT_EQ(e.total, e.framebuffer + e.output + e.scene);
+
+    reference_path.float32_output = true;  // OpenEXR reads the framebuffer itself
+    EXPECT_EQ(estimate_render_memory(image_scene(1000, 500), reference_path).output, 0u);
+}
+
+TEST(RenderMemory, PacketScratchGrowsWithSppLightsDepthAndThreads) {
+    RenderMemoryParams p;
+    p.threads = 2;
+    const Scene base = image_scene(640, 480, 1);
+    const RenderMemoryEstimate e1 = estimate_render_memory(base, p);
+    EXPECT_GT(e1.per_thread, 0u);
+    EXPECT_EQ(e1.threads, 2u);
+    EXPECT_EQ(e1.total, e1.framebuffer + e1.output + e1.scene + 2 * e1.per_thread);
+
+    const RenderMemoryEstimate e16 = estimate_render_memory(image_scene(640, 480, 16), p);
+    EXPECT_GT(e16.per_thread, 15 * e1.per_thread);
+
+    Scene lights = base;
+    lights.lights.resize(100, lights.lights.front());
+    EXPECT_GT(estimate_render_memory(lights, p).per_thread, e1.per_thread + 256u * 90u * 48u);
+
+    Scene deep = base;
+    deep.render.max_depth = 64;
+    EXPECT_GT(estimate_render_memory(deep, p).per_thread, e1.per_thread);
+
+    p.threads = 8;
+    EXPECT_EQ(estimate_render_memory(base, p).total, e1.total + 6 * e1.per_thread);
+}
+
+TEST(RenderMemory, TilesNeverExceedTheImage) {
+    RenderMemoryParams p;
+    p.threads = 1;
+    p.tile_width = 1 << 20;
+    p.tile_height = 1 << 20;
+    const RenderMemoryEstimate small = estimate_render_memory(image_scene(4, 4), p);
+    EXPECT_LT(small.per_thread, kMiB);
+}
+
+TEST(RenderMemory, SaturatesInsteadOfOverflowing) {
+    // 2^31 - 1 spp on a 46340 x 46340 image: pixels * spp * bytes is far beyond 2^64.
+    RenderMemoryParams p;
+    p.threads = 1 << 20;
+    p.tile_width = 46340;
+    p.tile_height = 46340;
+    Scene s = image_scene(46340, 46340, std::numeric_limits<int>::max());
+    s.render.max_depth = 64;
+    const RenderMemoryEstimate e = estimate_render_memory(s, p);
+    EXPECT_EQ(e.total, std::numeric_limits<std::uint64_t>::max());
+    EXPECT_NE(e.describe().find("more than 16 EiB"), std::string::npos) << e.describe();
+}
+
+TEST(MemoryLimit, RefusesUpFrontWithTheEstimateInTheMessage) {
+    Scene s = image_scene(20000, 20000);
+    s.source = "big.json";
+    RenderMemoryParams p;
+    p.threads = 2;
+    const RenderMemoryEstimate e = estimate_render_memory(s, p);
+    ASSERT_GT(e.total, 4 * kGiB);  // 400 M pixels: 4.5 GiB of framebuffer alone
+    try {
+        check_memory_limit(s, kGiB, p);
+        FAIL() << "a 20000 x 20000 render fits in 1 GiB?";
+    } catch (const SceneError& err) {
+        const std::string what = err.what();
+        EXPECT_EQ(err.file(), "big.json");
+        EXPECT_EQ(err.json_path(), "image");
+        EXPECT_NE(what.find("20000 x 20000"), std::string::npos) << what;
+        EXPECT_NE(what.find(e.describe()), std::string::npos) << what;
+        EXPECT_NE(what.find("framebuffer 4.5 GiB"), std::string::npos) << what;
+        EXPECT_NE(what.find("1073741824 bytes"), std::string::npos) << what;
+    }
+    EXPECT_NO_THROW(check_memory_limit(s, e.total, p));  // the limit is inclusive
+    EXPECT_THROW(check_memory_limit(s, e.total - 1, p), SceneError);
+}
+
+TEST(MemoryLimit, HugeSppIsRefusedThroughThePacketScratch) {
+    // A small image, but 16 x 16 tiles of 10^6 samples each: the packet path's per-tile
+    // streams, not the framebuffer, are what would exhaust memory.
+    Scene s = image_scene(64, 64, 1000000);
+    RenderMemoryParams p;
+    p.threads = 1;
+    EXPECT_THROW(check_memory_limit(s, 16 * kGiB, p), SceneError);
+    p.packet_path = false;  // the reference renderer keeps one sample at a time
+    EXPECT_NO_THROW(check_memory_limit(s, 16 * kGiB, p));
+}
+
+TEST(MemorySize, ParsesBinaryUnits) {
+    EXPECT_EQ(parse_memory_size("1048576"), std::uint64_t{1048576});
+    EXPECT_EQ(parse_memory_size("512K"), 512u * 1024u);
+    EXPECT_EQ(parse_memory_size("512KiB"), 512u * 1024u);
+    EXPECT_EQ(parse_memory_size("512kb"), 512u * 1024u);
+    EXPECT_EQ(parse_memory_size("300M"), 300 * kMiB);
+    EXPECT_EQ(parse_memory_size("4G"), 4 * kGiB);
+    EXPECT_EQ(parse_memory_size("4GiB"), 4 * kGiB);
+    EXPECT_EQ(parse_memory_size("2T"), 2 * 1024 * kGiB);
+    EXPECT_EQ(parse_memory_size("7B"), std::uint64_t{7});
+    EXPECT_EQ(parse_memory_size("16777215T"), std::uint64_t{16777215} << 40);
+}
+
+TEST(MemorySize, RefusesEverythingElse) {
+    for (const char* bad : {"", "G", "0", "0G", "-1G", "1.5G", "4 G", "4X", "4GG", "4Bi", "4iB",
+                            "16777216T", "18446744073709551616", " 4G"}) {
+        EXPECT_FALSE(parse_memory_size(bad).has_value()) << bad;
+    }
+}
+
+}  // namespace
+}  // namespace octray

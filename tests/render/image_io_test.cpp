@@ -1,0 +1,425 @@
+#include "render/image_io.h"
+
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfStringAttribute.h>
+#include <half.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace octray {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Each test gets its own empty directory, so "nothing else was left behind" is a plain
+// directory listing.
+class ImageIoTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        std::string name = std::string(info->test_suite_name()) + "." + info->name();
+        for (char& c : name)
+            if (c == '/') c = '_';
+        dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "image_io" /
+               (name + "." + std::to_string(::getpid()));
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override {
+        if (!HasFailure()) fs::remove_all(dir_);
+    }
+
+    std::vector<std::string> entries() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(dir_))
+            names.push_back(e.path().filename().string());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+
+    fs::path dir_;
+};
+
+// A smooth HDR image (lossy codecs are built for such content) whose rows and columns are
+// all distinguishable: red grows to the right, green downwards, blue goes above 1.
+Image gradient_image(int width, int height) {
+    Image image(width, height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            image.at(x, y) = Rgb(0.05f + 0.9f * static_cast<float>(x) / width,
+                                 0.05f + 0.9f * static_cast<float>(y) / height,
+                                 1.0f + 3.0f * static_cast<float>(x + y) / (width + height));
+    return image;
+}
+
+struct ReadExr {
+    Image image;
+    Imf::Header header;
+    std::vector<Imf::PixelType> channel_types;
+};
+
+ReadExr read_exr(const std::string& path) {
+    Imf::InputFile file(path.c_str());
+    ReadExr out{Image(), file.header(), {}};
+    const Imath::Box2i window = file.header().dataWindow();
+    const int width = window.max.x - window.min.x + 1;
+    const int height = window.max.y - window.min.y + 1;
+    out.image = Image(width, height);
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end();
+         ++it)
+        out.channel_types.push_back(it.channel().type);
+
+    // Address the buffer so that data-window row min.y lands in image row 0.
+    char* base = reinterpret_cast<char*>(out.image.data()) -
+                 (static_cast<std::ptrdiff_t>(window.min.x) +
+                  static_cast<std::ptrdiff_t>(window.min.y) * width) *
+                     static_cast<std::ptrdiff_t>(sizeof(Rgb));
+    Imf::FrameBuffer fb;
+    const std::size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * static_cast<std::size_t>(width);
+    fb.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xs, ys));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xs, ys));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
+    file.readPixels(window.min.y, window.max.y);
+    return out;
+}
+
+float as_half(float v) { return static_cast<float>(half(v)); }
+
+const std::vector<ExrCompression> kAllCompressions = {
+    ExrCompression::none,  ExrCompression::rle,  ExrCompression::zips, ExrCompression::zip,
+    ExrCompression::piz,   ExrCompression::pxr24, ExrCompression::b44, ExrCompression::b44a,
+    ExrCompression::dwaa,  ExrCompression::dwab};
+
+// Which codecs lose information for which channel type: B44 is lossy for HALF and stores
+// FLOAT uncompressed; PXR24 rounds FLOAT to 24 bits and keeps HALF exact; DWA quantises
+// R, G and B in the DCT domain whatever their type.
+bool is_lossy(ExrCompression c, bool float32) {
+    switch (c) {
+        case ExrCompression::pxr24: return float32;
+        case ExrCompression::b44:
+        case ExrCompression::b44a: return !float32;
+        case ExrCompression::dwaa:
+        case ExrCompression::dwab: return true;
+        default: return false;
+    }
+}
+
+TEST(ExrCompressionNames, RoundTripEveryName) {
+    const std::vector<std::string> names = {"none", "rle",  "zips", "zip",  "piz",
+                                            "pxr24", "b44", "b44a", "dwaa", "dwab"};
+    ASSERT_EQ(names.size(), kAllCompressions.size());
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        const auto parsed = parse_exr_compression(names[i]);
+        ASSERT_TRUE(parsed.has_value()) << names[i];
+        EXPECT_EQ(*parsed, kAllCompressions[i]) << names[i];
+        EXPECT_EQ(to_string(*parsed), names[i]);
+    }
+    EXPECT_FALSE(parse_exr_compression("").has_value());
+    EXPECT_FALSE(parse_exr_compression("ZIP").has_value());
+    EXPECT_FALSE(parse_exr_compression("zip ").has_value());
+    EXPECT_FALSE(parse_exr_compression("jpeg").has_value());
+}
+
+TEST_F(ImageIoTest, ExrRoundTripsEveryCompressionHalfAndFloat) {
+    const Image image = gradient_image(37, 21);  // odd sizes: partial codec blocks
+    for (const bool float32 : {false, true}) {
+        for (const ExrCompression c : kAllCompressions) {
+            SCOPED_TRACE(std::string(to_string(c)) + (float32 ? " float" : " half"));
+            const std::string path = (dir_ / "round_trip.exr").string();
+            write_exr(path, image, {float32, c});
+            const ReadExr read = read_exr(path);
+
+            // ExrCompression lists the codecs in Imf::Compression's order.
+            EXPECT_EQ(static_cast<int>(read.header.compression()), static_cast<int>(c));
+            ASSERT_EQ(read.image.width(), image.width());
+            ASSERT_EQ(read.image.height(), image.height());
+            ASSERT_EQ(read.channel_types.size(), 3u);
+            for (Imf::PixelType t : read.channel_types)
+                EXPECT_EQ(t, float32 ? Imf::FLOAT : Imf::HALF);
+
+            const bool lossy = is_lossy(c, float32);
+            double max_relative_error = 0.0;
+            for (int y = 0; y < image.height(); ++y) {
+                for (int x = 0; x < image.width(); ++x) {
+                    const Rgb in = image.at(x, y), out = read.image.at(x, y);
+                    const float expected[3] = {in.r, in.g, in.b};
+                    const float got[3] = {out.r, out.g, out.b};
+                    for (int k = 0; k < 3; ++k) {
+                        const float e = float32 ? expected[k] : as_half(expected[k]);
+                        if (!lossy) {
+                            ASSERT_EQ(got[k], e) << "pixel " << x << "," << y;
+                        } else {
+                            max_relative_error = std::max(
+                                max_relative_error,
+                                static_cast<double>(std::fabs(got[k] - e) / std::fabs(e)));
+                        }
+                    }
+                }
+            }
+            // Lossy codecs still have to give back the picture, not noise.
+            EXPECT_LT(max_relative_error, 0.05);
+        }
+    }
+}
+
+TEST_F(ImageIoTest, ExrCompressionIsTheOneAskedFor) {
+    const Image image = gradient_image(8, 8);
+    const std::string path = (dir_ / "c.exr").string();
+    write_exr(path, image, {false, ExrCompression::piz});
+    EXPECT_EQ(read_exr(path).header.compression(), Imf::PIZ_COMPRESSION);
+    write_exr(path, image, {false, ExrCompression::none});
+    EXPECT_EQ(read_exr(path).header.compression(), Imf::NO_COMPRESSION);
+    write_exr(path, image, {});  // the default
+    EXPECT_EQ(read_exr(path).header.compression(), Imf::ZIP_COMPRESSION);
+}
+
+TEST_F(ImageIoTest, ExrCarriesEveryAttribute) {
+    ExrAttributes attributes;
+    attributes.strings = {{"software", "octray test"}, {"octray.scene", "random:8"}};
+    attributes.floats = {{"renderTimeSeconds", 1.25f}};
+    attributes.ints = {{"samplesPerPixel", 16}};
+    attributes.doubles = {{"octray.rays.primary", 12345678901234.0}};
+    const std::string path = (dir_ / "attr.exr").string();
+    write_exr(path, gradient_image(4, 3), {}, attributes);
+
+    const Imf::Header header = read_exr(path).header;
+    const auto* software = header.findTypedAttribute<Imf::StringAttribute>("software");
+    ASSERT_NE(software, nullptr);
+    EXPECT_EQ(software->value(), "octray test");
+    const auto* scene = header.findTypedAttribute<Imf::StringAttribute>("octray.scene");
+    ASSERT_NE(scene, nullptr);
+    EXPECT_EQ(scene->value(), "random:8");
+    const auto* time = header.findTypedAttribute<Imf::FloatAttribute>("renderTimeSeconds");
+    ASSERT_NE(time, nullptr);
+    EXPECT_EQ(time->value(), 1.25f);
+    const auto* spp = header.findTypedAttribute<Imf::IntAttribute>("samplesPerPixel");
+    ASSERT_NE(spp, nullptr);
+    EXPECT_EQ(spp->value(), 16);
+    const auto* rays = header.findTypedAttribute<Imf::DoubleAttribute>("octray.rays.primary");
+    ASSERT_NE(rays, nullptr);
+    EXPECT_EQ(rays->value(), 12345678901234.0);
+}
+
+TEST_F(ImageIoTest, ExrRowZeroIsTheTopRow) {
+    // Only row 0 is bright; a flipped writer would put it at the bottom of the file.
+    Image image(5, 4);
+    for (int x = 0; x < 5; ++x) image.at(x, 0) = Rgb(1.0f, 0.5f, 0.25f);
+    image.at(4, 3) = Rgb(0.0f, 0.0f, 2.0f);  // bottom-right marker
+    const std::string path = (dir_ / "rows.exr").string();
+    write_exr(path, image, {true, ExrCompression::none});
+
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    EXPECT_EQ(window.min.x, 0);
+    EXPECT_EQ(window.min.y, 0);
+    EXPECT_EQ(window.max.x, 4);
+    EXPECT_EQ(window.max.y, 3);
+    EXPECT_EQ(file.header().lineOrder(), Imf::INCREASING_Y);
+
+    // Read scan line min.y alone: it must be image row 0.
+    std::vector<float> line(5);
+    Imf::FrameBuffer fb;
+    fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(line.data()),
+                              sizeof(float), 0));
+    file.setFrameBuffer(fb);
+    file.readPixels(window.min.y);
+    for (float v : line) EXPECT_EQ(v, 1.0f);
+    file.readPixels(window.max.y);
+    for (float v : line) EXPECT_EQ(v, 0.0f);
+
+    const ReadExr read = read_exr(path);
+    EXPECT_EQ(read.image, image);
+}
+
+TEST_F(ImageIoTest, NonFinitePixelsSurviveInExr) {
+    // The EXR is the HDR product: infinities and NaNs are stored, not clamped.
+    Image image(3, 1);
+    image.at(0, 0) = Rgb(std::numeric_limits<float>::infinity(), 0.0f, 0.0f);
+    image.at(1, 0) = Rgb(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
+    image.at(2, 0) = Rgb(1.0e6f, 0.0f, 0.0f);  // above half's range
+    const std::string path = (dir_ / "nonfinite.exr").string();
+    write_exr(path, image, {true, ExrCompression::zip});
+    const ReadExr read = read_exr(path);
+    EXPECT_TRUE(std::isinf(read.image.at(0, 0).r));
+    EXPECT_TRUE(std::isnan(read.image.at(1, 0).r));
+    EXPECT_EQ(read.image.at(2, 0).r, 1.0e6f);
+}
+
+TEST_F(ImageIoTest, WriteIntoMissingDirectoryThrowsAndLeavesNothing) {
+    const fs::path missing = dir_ / "no" / "such" / "dir";
+    const std::string exr = (missing / "out.exr").string();
+    try {
+        write_exr(exr, gradient_image(4, 4), {});
+        FAIL() << "expected IoError";
+    } catch (const IoError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(exr), std::string::npos) << message;
+        EXPECT_NE(message.find("No such file or directory"), std::string::npos) << message;
+    }
+    EXPECT_THROW(write_png_preview((missing / "out.png").string(), gradient_image(4, 4)),
+                 IoError);
+    EXPECT_FALSE(fs::exists(dir_ / "no"));
+    EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(ImageIoTest, NoTemporaryLeftAfterSuccess) {
+    write_exr((dir_ / "a.exr").string(), gradient_image(6, 5), {});
+    write_png_preview((dir_ / "a.png").string(), gradient_image(6, 5));
+    // Overwriting an existing file also goes through a temporary.
+    write_exr((dir_ / "a.exr").string(), gradient_image(6, 5), {true, ExrCompression::piz});
+    EXPECT_EQ(entries(), (std::vector<std::string>{"a.exr", "a.png"}));
+}
+
+TEST_F(ImageIoTest, FailedWriteRemovesTemporaryAndKeepsOldFile) {
+    const fs::path target = dir_ / "keep.txt";
+    { std::ofstream(target) << "old"; }
+    std::string seen_tmp;
+    try {
+        write_file_atomically(target.string(), [&](const std::string& tmp) {
+            seen_tmp = tmp;
+            std::ofstream(tmp) << "half-written";
+            throw std::runtime_error("disk on fire");
+        });
+        FAIL() << "expected IoError";
+    } catch (const IoError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(target.string()), std::string::npos) << message;
+        EXPECT_NE(message.find("disk on fire"), std::string::npos) << message;
+    }
+    // The temporary sat next to the target, hidden, and is gone now.
+    EXPECT_EQ(fs::path(seen_tmp).parent_path(), dir_);
+    EXPECT_EQ(fs::path(seen_tmp).filename().string().rfind(".keep.txt.tmp.", 0), 0u)
+        << seen_tmp;
+    EXPECT_EQ(entries(), std::vector<std::string>{"keep.txt"});
+    std::ifstream in(target);
+    std::stringstream content;
+    content << in.rdbuf();
+    EXPECT_EQ(content.str(), "old");
+}
+
+TEST_F(ImageIoTest, AtomicWriteReplacesExistingFile) {
+    const fs::path target = dir_ / "f.txt";
+    { std::ofstream(target) << "old content that is longer"; }
+    write_file_atomically(target.string(),
+                          [](const std::string& tmp) { std::ofstream(tmp) << "new"; });
+    std::ifstream in(target);
+    std::stringstream content;
+    content << in.rdbuf();
+    EXPECT_EQ(content.str(), "new");
+    EXPECT_EQ(entries(), std::vector<std::string>{"f.txt"});
+}
+
+TEST_F(ImageIoTest, TargetThatIsADirectoryFailsCleanly) {
+    fs::create_directory(dir_ / "taken.exr");
+    EXPECT_THROW(write_exr((dir_ / "taken.exr").string(), gradient_image(2, 2), {}), IoError);
+    EXPECT_EQ(entries(), std::vector<std::string>{"taken.exr"});
+    EXPECT_TRUE(fs::is_directory(dir_ / "taken.exr"));
+}
+
+TEST_F(ImageIoTest, EmptyImageIsRefused) {
+    EXPECT_THROW(write_exr((dir_ / "e.exr").string(), Image(), {}), IoError);
+    EXPECT_THROW(write_png_preview((dir_ / "e.png").string(), Image(0, 3)), IoError);
+    EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(ImageIoTest, BadAttributeNameIsAnIoErrorAndLeavesNothing) {
+    ExrAttributes attributes;
+    attributes.strings = {{"", "an attribute needs a name"}};
+    EXPECT_THROW(write_exr((dir_ / "bad.exr").string(), gradient_image(2, 2), {}, attributes),
+                 IoError);
+    EXPECT_TRUE(entries().empty());
+}
+
+struct PngPixels {
+    int width = 0, height = 0;
+    std::vector<unsigned char> rgb;
+};
+
+// Decoded by libpng itself (the simplified API), as any viewer would.
+PngPixels read_png(const std::string& path) {
+    png_image image{};
+    image.version = PNG_IMAGE_VERSION;
+    EXPECT_NE(png_image_begin_read_from_file(&image, path.c_str()), 0) << image.message;
+    PngPixels out;
+    out.width = static_cast<int>(image.width);
+    out.height = static_cast<int>(image.height);
+    EXPECT_EQ(image.format & PNG_FORMAT_FLAG_COLOR, PNG_FORMAT_FLAG_COLOR);
+    EXPECT_EQ(image.format & PNG_FORMAT_FLAG_ALPHA, 0u);
+    image.format = PNG_FORMAT_RGB;
+    out.rgb.resize(PNG_IMAGE_SIZE(image));
+    EXPECT_NE(png_image_finish_read(&image, nullptr, out.rgb.data(), 0, nullptr), 0)
+        << image.message;
+    png_image_free(&image);
+    return out;
+}
+
+TEST_F(ImageIoTest, PngEncodesKnownValues) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    Image image(4, 2);
+    image.at(0, 0) = Rgb(0.0f, 1.0f, 0.5f);
+    image.at(1, 0) = Rgb(2.0f, -1.0f, nan);
+    image.at(2, 0) = Rgb(0.002f, 0.0031308f, 0.2f);
+    image.at(3, 0) = Rgb(inf, -inf, 1.0001f);
+    image.at(0, 1) = Rgb(0.25f, 0.75f, 0.1f);
+    const std::string path = (dir_ / "known.png").string();
+    write_png_preview(path, image);
+
+    const PngPixels png = read_png(path);
+    ASSERT_EQ(png.width, 4);
+    ASSERT_EQ(png.height, 2);
+    auto px = [&](int x, int y, int k) { return static_cast<int>(png.rgb[(y * 4 + x) * 3 + k]); };
+    EXPECT_EQ(px(0, 0, 0), 0);    // 0 -> 0
+    EXPECT_EQ(px(0, 0, 1), 255);  // 1 -> 255
+    EXPECT_EQ(px(0, 0, 2), 188);  // 0.5 linear -> 0.7354 sRGB -> 187.5 -> 188
+    EXPECT_EQ(px(1, 0, 0), 255);  // > 1 clamps
+    EXPECT_EQ(px(1, 0, 1), 0);    // < 0 clamps
+    EXPECT_EQ(px(1, 0, 2), 0);    // NaN -> 0
+    EXPECT_EQ(px(2, 0, 0), 7);    // linear segment: 12.92 * 0.002 * 255 = 6.59
+    EXPECT_EQ(px(2, 0, 1), 10);   // the knee: 12.92 * 0.0031308 * 255 = 10.31
+    EXPECT_EQ(px(2, 0, 2), 124);  // 1.055 * 0.2^(1/2.4) - 0.055 = 0.4845 -> 123.5 -> 124
+    EXPECT_EQ(px(3, 0, 0), 255);  // +inf clamps
+    EXPECT_EQ(px(3, 0, 1), 0);    // -inf clamps
+    EXPECT_EQ(px(3, 0, 2), 255);
+    // Row 1 (the second row from the top) is where row 1 of the image went.
+    EXPECT_EQ(px(0, 1, 0), 137);  // 0.25 -> 0.5371 -> 136.96
+    EXPECT_EQ(px(0, 1, 1), 225);  // 0.75 -> 0.8808 -> 224.6
+    EXPECT_EQ(px(0, 1, 2), 89);   // 0.1 -> 0.3492 -> 89.05
+    EXPECT_EQ(px(1, 1, 0), 0);
+}
+
+TEST_F(ImageIoTest, PngOfLargerImageIsReadable) {
+    const Image image = gradient_image(320, 200);
+    const std::string path = (dir_ / "big.png").string();
+    write_png_preview(path, image);
+    const PngPixels png = read_png(path);
+    ASSERT_EQ(png.width, 320);
+    ASSERT_EQ(png.height, 200);
+    // Red grows to the right and green downwards, as in the image; blue is clamped.
+    auto px = [&](int x, int y, int k) {
+        return static_cast<int>(png.rgb[(static_cast<std::size_t>(y) * 320 + x) * 3 + k]);
+    };
+    EXPECT_LT(px(0, 0, 0), px(319, 0, 0));
+    EXPECT_LT(px(0, 0, 1), px(0, 199, 1));
+    EXPECT_EQ(px(100, 100, 2), 255);
+}
+
+}  // namespace
+}  // namespace octray

@@ -1,0 +1,378 @@
+// End-to-end tests of the `octray` executable: run it as a user would (through the shell),
+// then check its exit status, its messages and the files it leaves behind.
+
+#include <gtest/gtest.h>
+#include <png.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfStringAttribute.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+    int status = -1;     // the exit code, or -1 if the process did not exit normally
+    std::string output;  // stdout and stderr together
+};
+
+std::string quote(const std::string& arg) {
+    std::string quoted = "'";
+    for (char c : arg) {
+        if (c == '\'')
+            quoted.append("'\\''");
+        else
+            quoted.push_back(c);
+    }
+    quoted.push_back('\'');
+    return quoted;
+}
+
+// Runs `octray <args...>` in `cwd` with stdin closed, as CI does.
+RunResult run_octray(const std::vector<std::string>& args, const fs::path& cwd,
+                     bool capture_stderr = true) {
+    // Built with append(): GCC 12's -O3 warns falsely (-Wrestrict) on chains of operator+.
+    std::string command = "cd ";
+    command.append(quote(cwd.string())).append(" && ").append(quote(OCTRAY_EXE));
+    for (const std::string& a : args) command.append(" ").append(quote(a));
+    command.append(" </dev/null");
+    command.append(capture_stderr ? " 2>&1" : " 2>/dev/null");
+    RunResult result;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr) return result;
+    std::array<char, 4096> buffer;
+    std::size_t n = 0;
+    while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+        result.output.append(buffer.data(), n);
+    const int status = ::pclose(pipe);
+    if (status != -1 && WIFEXITED(status)) result.status = WEXITSTATUS(status);
+    return result;
+}
+
+class CliTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "cli" /
+               (std::string(info->test_suite_name()) + "." + info->name() + "." +
+                std::to_string(::getpid()));
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override {
+        if (!HasFailure()) fs::remove_all(dir_);
+    }
+
+    RunResult octray(const std::vector<std::string>& args, bool capture_stderr = true) {
+        return run_octray(args, dir_, capture_stderr);
+    }
+
+    std::vector<std::string> entries() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(dir_))
+            names.push_back(e.path().filename().string());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+    fs::path dir_;
+};
+
+bool contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+struct ExrPixels {
+    int width = 0, height = 0;
+    std::vector<float> rgb;  // as stored; FLOAT channels are read back bit for bit
+};
+
+ExrPixels read_exr_pixels(const std::string& file_path) {
+    Imf::InputFile file(file_path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    ExrPixels out;
+    out.width = window.max.x - window.min.x + 1;
+    out.height = window.max.y - window.min.y + 1;
+    out.rgb.resize(static_cast<std::size_t>(out.width) * out.height * 3);
+    char* base = reinterpret_cast<char*>(out.rgb.data()) -
+                 (static_cast<std::ptrdiff_t>(window.min.x) +
+                  static_cast<std::ptrdiff_t>(window.min.y) * out.width) *
+                     static_cast<std::ptrdiff_t>(3 * sizeof(float));
+    const std::size_t xs = 3 * sizeof(float), ys = xs * static_cast<std::size_t>(out.width);
+    Imf::FrameBuffer fb;
+    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
+    file.readPixels(window.min.y, window.max.y);
+    return out;
+}
+
+bool same_bits(const ExrPixels& a, const ExrPixels& b) {
+    return a.width == b.width && a.height == b.height && a.rgb.size() == b.rgb.size() &&
+           std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0;
+}
+
+bool any_nonzero(const ExrPixels& p) {
+    return std::any_of(p.rgb.begin(), p.rgb.end(), [](float v) { return v != 0.0f; });
+}
+
+TEST_F(CliTest, VersionPrintsTheVersion) {
+    const RunResult r = octray({"--version"});
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.output, "octray 0.1.0\n");
+}
+
+TEST_F(CliTest, HelpExplainsCommandsOptionsAndExitCodes) {
+    const RunResult top = octray({"--help"});
+    EXPECT_EQ(top.status, 0);
+    EXPECT_TRUE(contains(top.output, "render")) << top.output;
+    EXPECT_TRUE(contains(top.output, "scene")) << top.output;
+    EXPECT_TRUE(contains(top.output, "Exit codes")) << top.output;
+
+    const RunResult render = octray({"render", "--help"});
+    EXPECT_EQ(render.status, 0);
+    for (const char* option : {"--output", "--width", "--height", "--spp", "--threads", "--seed",
+                               "--max-depth", "--path", "--png", "--float", "--compression",
+                               "--tile", "Examples", "Exit codes"})
+        EXPECT_TRUE(contains(render.output, option)) << option << "\n" << render.output;
+}
+
+TEST_F(CliTest, RendersSmallBuiltinWithAttributesAndPreview) {
+    const std::string spec = "random:8,width=32,height=24";
+    const RunResult r =
+        octray({"render", spec, "--path", "scalar", "-o", "r.exr", "--png", "r.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "Mrays/s")) << r.output;
+    EXPECT_TRUE(contains(r.output, "r.exr")) << r.output;
+    EXPECT_TRUE(contains(r.output, "r.png")) << r.output;
+    // Nothing else: no temporaries left next to the outputs.
+    EXPECT_EQ(entries(), (std::vector<std::string>{"r.exr", "r.png"}));
+
+    Imf::InputFile file(path("r.exr").c_str());
+    const Imf::Header& h = file.header();
+    const Imath::Box2i window = h.dataWindow();
+    EXPECT_EQ(window.max.x - window.min.x + 1, 32);
+    EXPECT_EQ(window.max.y - window.min.y + 1, 24);
+    EXPECT_EQ(h.channels().findChannel("R")->type, Imf::HALF);  // the default
+    EXPECT_EQ(h.compression(), Imf::ZIP_COMPRESSION);
+
+    const auto* software = h.findTypedAttribute<Imf::StringAttribute>("software");
+    ASSERT_NE(software, nullptr);
+    EXPECT_EQ(software->value(), "octray 0.1.0");
+    const auto* date = h.findTypedAttribute<Imf::StringAttribute>("capDate");
+    ASSERT_NE(date, nullptr);
+    EXPECT_TRUE(std::regex_match(date->value(),
+                                 std::regex(R"(\d{4}:\d{2}:\d{2} \d{2}:\d{2}:\d{2})")))
+        << date->value();
+    EXPECT_NE(h.findTypedAttribute<Imf::FloatAttribute>("utcOffset"), nullptr);
+    const auto* scene = h.findTypedAttribute<Imf::StringAttribute>("octray.scene");
+    ASSERT_NE(scene, nullptr);
+    EXPECT_EQ(scene->value(), spec);
+    const auto* spp = h.findTypedAttribute<Imf::IntAttribute>("samplesPerPixel");
+    ASSERT_NE(spp, nullptr);
+    EXPECT_EQ(spp->value(), 1);
+    const auto* seconds = h.findTypedAttribute<Imf::DoubleAttribute>("renderTimeSeconds");
+    ASSERT_NE(seconds, nullptr);
+    EXPECT_GE(seconds->value(), 0.0);
+
+    // One primary ray per pixel sample of the pinhole camera; the kinds add up to the total.
+    double sum = 0.0;
+    for (const char* kind : {"primary", "shadow", "reflected", "refracted"}) {
+        const auto* count = h.findTypedAttribute<Imf::DoubleAttribute>(
+            std::string("octray.rays.") + kind);
+        ASSERT_NE(count, nullptr) << kind;
+        EXPECT_GE(count->value(), 0.0);
+        sum += count->value();
+    }
+    EXPECT_EQ(h.findTypedAttribute<Imf::DoubleAttribute>("octray.rays.primary")->value(),
+              32.0 * 24.0);
+    const auto* total = h.findTypedAttribute<Imf::DoubleAttribute>("octray.rays.total");
+    ASSERT_NE(total, nullptr);
+    EXPECT_EQ(total->value(), sum);
+
+    png_image png{};
+    png.version = PNG_IMAGE_VERSION;
+    ASSERT_NE(png_image_begin_read_from_file(&png, path("r.png").c_str()), 0) << png.message;
+    EXPECT_EQ(png.width, 32u);
+    EXPECT_EQ(png.height, 24u);
+    png_image_free(&png);
+
+    EXPECT_TRUE(any_nonzero(read_exr_pixels(path("r.exr"))));
+}
+
+TEST_F(CliTest, SceneWrittenAsJsonRendersBitIdentically) {
+    // spp=4 puts the seeded jitter into play as well.
+    const std::string spec = "random:8,width=40,height=30,spp=4";
+    const RunResult written = octray({"scene", spec, "-o", "x.json"});
+    ASSERT_EQ(written.status, 0) << written.output;
+    ASSERT_TRUE(fs::exists(dir_ / "x.json"));
+
+    const RunResult from_json = octray({"render", "x.json", "--float", "-o", "json.exr"});
+    ASSERT_EQ(from_json.status, 0) << from_json.output;
+    const RunResult from_spec = octray({"render", spec, "--float", "-o", "spec.exr"});
+    ASSERT_EQ(from_spec.status, 0) << from_spec.output;
+
+    const ExrPixels a = read_exr_pixels(path("json.exr"));
+    const ExrPixels b = read_exr_pixels(path("spec.exr"));
+    EXPECT_EQ(a.width, 40);
+    EXPECT_EQ(a.height, 30);
+    EXPECT_TRUE(any_nonzero(a));
+    EXPECT_TRUE(same_bits(a, b));
+}
+
+TEST_F(CliTest, SceneWithoutOutputPrintsJsonToStdout) {
+    const RunResult r = octray({"scene", "random:2"}, /*capture_stderr=*/false);
+    ASSERT_EQ(r.status, 0);
+    ASSERT_FALSE(r.output.empty());
+    EXPECT_EQ(r.output.front(), '{') << r.output;
+    EXPECT_TRUE(contains(r.output, "\"objects\"")) << r.output;
+    EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(CliTest, ImageDoesNotDependOnThreadsOrTiles) {
+    const std::string spec = "random:16,width=37,height=23,spp=2";
+    ASSERT_EQ(octray({"render", spec, "--float", "--threads", "1", "-o", "a.exr"}).status, 0);
+    ASSERT_EQ(
+        octray({"render", spec, "--float", "--threads", "2", "--tile", "7x5", "-o", "b.exr"})
+            .status,
+        0);
+    EXPECT_TRUE(same_bits(read_exr_pixels(path("a.exr")), read_exr_pixels(path("b.exr"))));
+}
+
+TEST_F(CliTest, OverridesReachTheScene) {
+    const RunResult r = octray({"render", "random:4,width=8,height=8", "--width", "20",
+                                "--height", "10", "--spp", "4", "--max-depth", "0", "-o",
+                                "o.exr", "--compression", "piz", "--float"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    Imf::InputFile file(path("o.exr").c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    EXPECT_EQ(window.max.x - window.min.x + 1, 20);
+    EXPECT_EQ(window.max.y - window.min.y + 1, 10);
+    EXPECT_EQ(file.header().compression(), Imf::PIZ_COMPRESSION);
+    EXPECT_EQ(file.header().channels().findChannel("G")->type, Imf::FLOAT);
+    EXPECT_EQ(file.header().findTypedAttribute<Imf::IntAttribute>("samplesPerPixel")->value(),
+              4);
+    EXPECT_EQ(file.header().findTypedAttribute<Imf::IntAttribute>("octray.maxDepth")->value(),
+              0);
+    EXPECT_EQ(
+        file.header().findTypedAttribute<Imf::DoubleAttribute>("octray.rays.primary")->value(),
+        20.0 * 10.0 * 4.0);
+}
+
+TEST_F(CliTest, DefaultOutputIsNamedAfterTheScene) {
+    const RunResult r = octray({"render", "random:3,width=8,height=6"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(entries(), std::vector<std::string>{"random-3.exr"});
+}
+
+TEST_F(CliTest, BrokenSceneFileIsASceneError) {
+    { std::ofstream(dir_ / "broken.json") << "{ \"image\": { \"width\": 32, "; }
+    const RunResult r = octray({"render", "broken.json", "-o", "out.exr"});
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "broken.json")) << r.output;
+    EXPECT_EQ(entries(), std::vector<std::string>{"broken.json"});
+}
+
+TEST_F(CliTest, MissingSceneFileIsASceneError) {
+    const RunResult r = octray({"render", "no-such-scene.json", "-o", "out.exr"});
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "no-such-scene.json")) << r.output;
+    const RunResult s = octray({"scene", "no-such-scene.json"});
+    EXPECT_EQ(s.status, 3) << s.output;
+    EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(CliTest, MissingOutputDirectoryIsAnIoErrorAndLeavesNothing) {
+    const RunResult r =
+        octray({"render", "random:2,width=8,height=8", "-o", "nope/sub/out.exr"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "nope/sub/out.exr")) << r.output;
+
+    // An unwritable preview is found before rendering, so the EXR is not written either.
+    const RunResult png = octray(
+        {"render", "random:2,width=8,height=8", "-o", "out.exr", "--png", "nope/out.png"});
+    EXPECT_EQ(png.status, 4) << png.output;
+
+    const RunResult scene = octray({"scene", "random:2", "-o", "nope/x.json"});
+    EXPECT_EQ(scene.status, 4) << scene.output;
+    EXPECT_TRUE(contains(scene.output, "nope/x.json")) << scene.output;
+
+    EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(CliTest, UsageErrorsExitWithTwo) {
+    const std::vector<std::vector<std::string>> bad = {
+        {"render", "--no-such-option"},
+        {"render", "random:2", "--threads", "-1"},
+        {"render", "random:2", "--width", "0"},
+        {"render", "random:2", "--spp", "many"},
+        {"render", "random:2", "--tile", "0x16"},
+        {"render", "random:2", "--tile", "16by16"},
+        {"render", "random:2", "--compression", "jpeg"},
+        {"render", "random:2", "--path", "gpu"},
+        {"render", "random:2", "-o", "same.exr", "--png", "same.exr"},
+        {"render", "a.json", "b.json"},
+        {"scene"},
+        {"frobnicate"},
+        {},
+    };
+    for (const auto& args : bad) {
+        std::string joined;
+        for (const auto& a : args) joined += a + " ";
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << joined << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "--help")) << joined << "\n" << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
+// The SIMD packet path (the default) writes the same pixels as the scalar reference, under
+// every --isa; `verify` agrees and `info` names the ISA it uses.
+TEST_F(CliTest, SimdPathMatchesScalarAndVerifyPasses) {
+    const std::string spec = "whitted,width=40,height=30";
+    ASSERT_EQ(octray({"render", spec, "--path", "scalar", "-o", "scalar.exr", "--float"}).status, 0);
+    const RunResult simd = octray({"render", spec, "-o", "simd.exr", "--float"});
+    ASSERT_EQ(simd.status, 0) << simd.output;
+    EXPECT_TRUE(contains(simd.output, "simd (")) << simd.output;  // "simd (avx2) path"
+    EXPECT_TRUE(same_bits(read_exr_pixels(path("scalar.exr")), read_exr_pixels(path("simd.exr"))));
+    const RunResult sse2 = octray({"render", spec, "--isa", "sse2", "-o", "sse2.exr", "--float"});
+    ASSERT_EQ(sse2.status, 0) << sse2.output;
+    EXPECT_TRUE(same_bits(read_exr_pixels(path("scalar.exr")), read_exr_pixels(path("sse2.exr"))));
+    EXPECT_EQ(octray({"render", spec, "--isa", "avx512", "-o", "x.exr"}).status, 2);
+
+    const RunResult verify = octray({"verify", spec, "--tile", "x"});
+    EXPECT_EQ(verify.status, 2) << verify.output;  // no such option
+    const RunResult ok = octray({"verify", "random:16,width=24,height=16", "--threads", "2"});
+    EXPECT_EQ(ok.status, 0) << ok.output;
+    EXPECT_TRUE(contains(ok.output, "PASS")) << ok.output;
+    EXPECT_TRUE(contains(ok.output, "max abs")) << ok.output;
+    EXPECT_TRUE(contains(ok.output, "psnr")) << ok.output;
+
+    const RunResult info = octray({"info", "random:5"});
+    EXPECT_EQ(info.status, 0) << info.output;
+    EXPECT_TRUE(contains(info.output, "uses")) << info.output;
+    EXPECT_TRUE(contains(info.output, "5 spheres")) << info.output;
+}
+
+}  // namespace

@@ -1,0 +1,245 @@
+// End-to-end tests of `octray compare`: every exit code, its one-line reason, and the files
+// --diff and --heatmap leave behind. Inputs are written with OpenEXR and libpng directly.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "tests/render/compare_fixtures.h"
+
+namespace octray {
+namespace {
+
+using testing::make_image;
+using testing::write_test_exr;
+
+struct RunResult {
+    int status = -1;     // the exit code, or -1 if the process did not exit normally
+    std::string output;  // stdout, and stderr too when asked
+};
+
+std::string quote(const std::string& arg) {
+    std::string quoted = "'";
+    for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
+class CompareCliTest : public testing::ScratchDirTest {
+protected:
+    // Runs `octray compare <args...>` in the scratch directory.
+    RunResult compare(const std::vector<std::string>& args, bool capture_stderr = true) {
+        std::string command = "cd " + quote(dir_.string()) + " && " + quote(OCTRAY_EXE) +
+                              " compare";
+        for (const std::string& a : args) command += " " + quote(a);
+        command += " </dev/null";
+        command += capture_stderr ? " 2>&1" : " 2>/dev/null";
+        RunResult result;
+        FILE* pipe = ::popen(command.c_str(), "r");
+        if (pipe == nullptr) return result;
+        std::array<char, 4096> buffer;
+        std::size_t n = 0;
+        while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+            result.output.append(buffer.data(), n);
+        const int status = ::pclose(pipe);
+        if (status != -1 && WIFEXITED(status)) result.status = WEXITSTATUS(status);
+        return result;
+    }
+
+    // The reference: 8x8 RGB, a ramp; and a copy whose pixel (5, 3) is off in G by `delta`.
+    void write_pair(float delta) {
+        ChannelImage a = make_image(8, 8, {"R", "G", "B"});
+        for (std::size_t i = 0; i < a.planes.size(); ++i)
+            a.planes[i] = static_cast<float>(i % 64) / 64.0f;
+        ChannelImage b = a;
+        b.at(1, 5, 3) += delta;
+        write_test_exr(path("a.exr"), a);
+        write_test_exr(path("b.exr"), b);
+    }
+};
+
+std::string last_line(const std::string& text) {
+    std::string trimmed = text;
+    while (!trimmed.empty() && trimmed.back() == '\n') trimmed.pop_back();
+    return trimmed.substr(trimmed.rfind('\n') + 1);
+}
+
+TEST_F(CompareCliTest, IdenticalImagesExit0) {
+    write_pair(0.0f);
+    const RunResult r = compare({"a.exr", "b.exr"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(last_line(r.output), "PASS: images are identical");
+}
+
+TEST_F(CompareCliTest, OverTheWarnLimitExits1) {
+    write_pair(0.125f);
+    const RunResult r = compare({"a.exr", "b.exr", "--fail", "0.5", "--warn", "0.01"});
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_EQ(last_line(r.output),
+              "WARN: 1 of 64 pixels (1.562%) differ by more than 0.01; allowed 0%");
+    EXPECT_NE(r.output.find("max error 0.125 at (5, 3) G"), std::string::npos) << r.output;
+}
+
+TEST_F(CompareCliTest, OverTheFailLimitExits2) {
+    write_pair(0.125f);
+    const RunResult r = compare({"a.exr", "b.exr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_EQ(last_line(r.output).rfind("FAIL: 1 of 64 pixels", 0), 0u) << r.output;
+}
+
+TEST_F(CompareCliTest, PercentAllowancesAndHardFail) {
+    write_pair(0.125f);
+    EXPECT_EQ(compare({"a.exr", "b.exr", "--failpercent", "2", "--warnpercent", "2"}).status, 0);
+    const RunResult r = compare(
+        {"a.exr", "b.exr", "--failpercent", "2", "--warnpercent", "2", "--hardfail", "0.1"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_EQ(last_line(r.output), "FAIL: error 0.125 at (5, 3) G is over the hard limit 0.1");
+}
+
+TEST_F(CompareCliTest, SizeMismatchExits3) {
+    write_test_exr(path("a.exr"), make_image(8, 8, {"R", "G", "B"}));
+    write_test_exr(path("b.exr"), make_image(8, 7, {"R", "G", "B"}));
+    const RunResult r = compare({"a.exr", "b.exr"});
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_EQ(r.output,
+              "octray: compare: size mismatch: A is 8x8, B is 8x7 (A = a.exr, B = b.exr)\n");
+}
+
+TEST_F(CompareCliTest, ChannelMismatchExits3UnlessChannelsAreChosen) {
+    write_test_exr(path("rgba.exr"), make_image(4, 4, {"R", "G", "B", "A"}, 0.5f));
+    testing::write_test_png(path("rgb.png"), 4, 4, 3, 8,
+                            std::vector<std::uint16_t>(4 * 4 * 3, 255));
+    const RunResult r = compare({"rgba.exr", "rgb.png"});
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_NE(r.output.find("channel mismatch: A has R,G,B,A, B has R,G,B"), std::string::npos)
+        << r.output;
+    // With the common channels chosen they compare: 0.5 against 1.0 everywhere.
+    const RunResult chosen = compare({"rgba.exr", "rgb.png", "--channels", "R,G,B"});
+    EXPECT_EQ(chosen.status, 2) << chosen.output;
+    EXPECT_NE(chosen.output.find("max error 0.5"), std::string::npos) << chosen.output;
+}
+
+TEST_F(CompareCliTest, FileErrorsExit4WithOneLineReasons) {
+    write_pair(0.0f);
+    RunResult r = compare({"a.exr", "missing.exr"});
+    EXPECT_EQ(r.status, 4);
+    EXPECT_EQ(r.output, "octray: I/O error: cannot read 'missing.exr': no such file\n");
+
+    testing::write_text_file(path("notes.exr"), "plain text\n");
+    r = compare({"notes.exr", "a.exr"});
+    EXPECT_EQ(r.status, 4);
+    EXPECT_EQ(r.output,
+              "octray: I/O error: cannot read 'notes.exr': not an image (neither an OpenEXR "
+              "nor a PNG signature)\n");
+}
+
+TEST_F(CompareCliTest, TruncatedExrExits4WithAClearMessage) {
+    ChannelImage big = make_image(64, 64, {"R", "G", "B"}, 0.25f);
+    write_test_exr(path("ref.exr"), big);
+    write_test_exr(path("cut.exr"), big, Imf::FLOAT, Imf::NO_COMPRESSION);
+    testing::truncate_file(path("cut.exr"), testing::fs::file_size(path("cut.exr")) / 2);
+    const RunResult r = compare({"ref.exr", "cut.exr"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_EQ(r.output.rfind("octray: I/O error: cannot read 'cut.exr': truncated or corrupt "
+                             "OpenEXR file",
+                             0),
+              0u)
+        << r.output;
+    EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << "not one line: " << r.output;
+}
+
+TEST_F(CompareCliTest, NanAndInfAreReportedNotCrashedOn) {
+    ChannelImage a = make_image(4, 4, {"R", "G", "B"}, 0.5f);
+    ChannelImage b = a;
+    a.at(0, 1, 2) = std::numeric_limits<float>::quiet_NaN();
+    b.at(2, 3, 3) = std::numeric_limits<float>::infinity();
+    write_test_exr(path("a.exr"), a);
+    write_test_exr(path("b.exr"), b);
+    const RunResult r = compare({"a.exr", "b.exr", "--heatmap", "h.png", "--diff", "d.exr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("2 pixels hold NaN or Inf (A: 1 NaN, 0 Inf; B: 0 NaN, 1 Inf "
+                            "values); first at (1, 2) R: A = nan, B = 0.5"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(last_line(r.output).find("(2 with NaN or Inf)"), std::string::npos) << r.output;
+    EXPECT_TRUE(testing::fs::exists(dir_ / "h.png"));
+    EXPECT_TRUE(testing::fs::exists(dir_ / "d.exr"));
+}
+
+TEST_F(CompareCliTest, DiffAndHeatmapFilesAreWritten) {
+    write_pair(0.125f);
+    const RunResult r = compare({"a.exr", "b.exr", "--diff", "d.exr", "--heatmap", "h.png"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    const ChannelImage diff = read_image(path("d.exr"));
+    EXPECT_EQ(diff.channel_names, (std::vector<std::string>{"R", "G", "B"}));
+    EXPECT_EQ(diff.at(1, 5, 3), 0.125f);
+    EXPECT_EQ(diff.at(1, 4, 3), 0.0f);
+    const ChannelImage heatmap = read_image(path("h.png"));
+    EXPECT_EQ(heatmap.format, "PNG 8-bit");
+    EXPECT_GE(heatmap.width, 256);
+}
+
+TEST_F(CompareCliTest, UnwritableOutputExits4) {
+    write_pair(0.125f);
+    const RunResult r = compare({"a.exr", "b.exr", "--diff", "no/such/dir/d.exr"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_NE(r.output.find("no/such/dir/d.exr"), std::string::npos) << r.output;
+}
+
+TEST_F(CompareCliTest, JsonCarriesTheVerdictForEveryOutcome) {
+    write_pair(0.125f);
+    RunResult r = compare({"a.exr", "b.exr", "--json"}, /*capture_stderr=*/false);
+    EXPECT_EQ(r.status, 2);
+    nlohmann::json j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["verdict"], "FAIL");
+    EXPECT_EQ(j["overall"]["fail_pixels"], 1);
+    EXPECT_EQ(j["overall"]["max_abs_error"], 0.125);
+    EXPECT_EQ(j["overall"]["max_at"]["channel"], "G");
+    EXPECT_EQ(j["channels"].size(), 3u);
+
+    r = compare({"a.exr", "a.exr", "--json"}, false);
+    EXPECT_EQ(r.status, 0);
+    j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["verdict"], "PASS");
+    EXPECT_TRUE(j["overall"]["psnr_db"].is_null());
+
+    write_test_exr(path("small.exr"), make_image(2, 2, {"R", "G", "B"}));
+    r = compare({"a.exr", "small.exr", "--json"}, false);
+    EXPECT_EQ(r.status, 3);
+    j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["verdict"], "MISMATCH");
+    EXPECT_EQ(j["exit_code"], 3);
+
+    r = compare({"a.exr", "gone.exr", "--json"}, false);
+    EXPECT_EQ(r.status, 4);
+    j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["verdict"], "ERROR");
+    EXPECT_EQ(j["reason"], "cannot read 'gone.exr': no such file");
+}
+
+TEST_F(CompareCliTest, BadCommandLinesAreRejected) {
+    write_pair(0.0f);
+    RunResult r = compare({"a.exr", "b.exr", "--failpercent", "200"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("--failpercent"), std::string::npos) << r.output;
+    r = compare({"a.exr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    r = compare({"a.exr", "b.exr", "--diff", "x.exr", "--heatmap", "x.exr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+}
+
+TEST_F(CompareCliTest, HelpListsTheExitCodes) {
+    const RunResult r = compare({"--help"});
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.output.find("3  the images cannot be compared"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--hardfail"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace octray

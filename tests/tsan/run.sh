@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# ThreadSanitizer over the parallel rendering tests (the reference's and the packet
+# renderer's bit-identity across thread counts and tile sizes):
+#   1. builds oneTBB with -fsanitize=thread once (tests/tsan/build_tbb.sh says why),
+#   2. checks that TSan reports a planted race (tests/tsan/race_canary.cpp),
+#   3. configures the `tsan` preset against that TBB, builds the two test binaries and
+#      runs their thread tests with halt_on_error=1 and tests/tsan/tsan.supp.
+# Usage: tests/tsan/run.sh   (root on a fresh machine: step 1 adds a deb-src entry)
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+
+start=$SECONDS
+tests/tsan/build_tbb.sh
+tbb=$PWD/build/tsan-tbb/install
+
+# 2. The canary must be caught.
+mkdir -p build/tsan
+c++ -std=c++20 -g -O1 -fsanitize=thread -I"$tbb/include" tests/tsan/race_canary.cpp \
+  -o build/tsan/race_canary -L"$tbb/lib" -Wl,-rpath,"$tbb/lib" -ltbb
+if TSAN_OPTIONS=halt_on_error=1 build/tsan/race_canary > build/tsan/race_canary.log 2>&1 ||
+   ! grep -q "ThreadSanitizer: data race" build/tsan/race_canary.log; then
+  cat build/tsan/race_canary.log
+  echo "tests/tsan/run.sh: ThreadSanitizer missed the planted race; the setup is broken" >&2
+  exit 1
+fi
+
+# 3. The thread tests. The test preset sets TSAN_OPTIONS (suppressions, halt_on_error=1).
+cmake --preset tsan  # TBB_DIR: build/tsan-tbb/install (the preset)
+cmake --build --preset tsan -j2
+ctest --preset tsan --no-tests=error \
+  -R 'ReferenceRender\.ThreadCountAndTileSizeDoNotChangeASingleBit|PacketRenderer\.BitIdenticalForAnyThreadCountAndTileSize'
+echo "tests/tsan/run.sh: passed in $((SECONDS - start)) s"

@@ -1,0 +1,161 @@
+// `octray compare`: idiff-style numeric comparison of two images (OpenEXR or PNG), with an
+// optional difference EXR, an error heatmap and JSON output. The figures, the thresholds
+// and the exit codes are idiff's; render/COMPARE.md defines them.
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "render/error_heatmap.h"
+#include "render/image_compare.h"
+#include "render/image_io.h"
+#include "render/image_read.h"
+#include "tools/commands.h"
+
+namespace octray::tools {
+namespace {
+
+// compare's own exit codes, idiff's: 0 pass, 1 warn, 2 fail (Verdict), 3 and 4 below.
+constexpr int kCompareMismatch = 3;
+
+struct CompareArguments {
+    std::string a;
+    std::string b;
+    CompareOptions options;
+    std::string diff;
+    std::string heatmap;
+    bool json = false;
+};
+
+// With --json, standard output carries JSON whatever happens, so a script can parse it
+// before looking at the exit status.
+void print_json_outcome(const CompareArguments& args, std::string_view verdict, int code,
+                        const std::string& reason) {
+    const nlohmann::ordered_json j = {{"a", args.a},         {"b", args.b},
+                              {"verdict", verdict},  {"exit_code", code},
+                              {"reason", reason}};
+    std::cout << j.dump(2) << '\n' << std::flush;
+}
+
+void run_compare(const CompareArguments& args) {
+    if (!args.diff.empty() && args.diff == args.heatmap)
+        throw UsageError("--diff and --heatmap name the same file: " + args.diff);
+
+    ChannelImage a, b;
+    CompareResult result;
+    try {
+        a = read_image(args.a);
+        b = read_image(args.b);
+        result = compare_images(a, b, args.options);
+    } catch (const ImageMismatch& e) {
+        const std::string reason =
+            std::string(e.what()) + " (A = " + args.a + ", B = " + args.b + ")";
+        if (args.json) print_json_outcome(args, "MISMATCH", kCompareMismatch, reason);
+        std::cerr << "octray: compare: " << reason << '\n';
+        throw CommandExit{kCompareMismatch};
+    } catch (const IoError& e) {
+        if (args.json) print_json_outcome(args, "ERROR", kExitIo, e.what());
+        throw;  // run_command reports it on stderr and exits 4
+    }
+
+    // The outputs first: a file that cannot be written is exit 4, whatever the verdict.
+    if (!args.diff.empty()) write_channel_exr(args.diff, difference_image(a, b, result));
+    if (!args.heatmap.empty()) write_error_heatmap(args.heatmap, a, b, result);
+
+    if (args.json) {
+        std::cout << format_compare_json(result, args.options, args.a, args.b) << std::flush;
+    } else {
+        // The reason stays the last line, where scripts and people look for it.
+        if (!args.diff.empty()) std::cout << "wrote " << args.diff << " (|A - B|, float)\n";
+        if (!args.heatmap.empty())
+            std::cout << "wrote " << args.heatmap << " (error heatmap, 0 to "
+                      << result.overall.max_abs_error << ")\n";
+        std::cout << format_compare_report(result, args.options, args.a, args.b) << std::flush;
+    }
+    if (!std::cout) throw IoError("cannot write the report to standard output");
+    if (result.verdict != Verdict::pass) throw CommandExit{static_cast<int>(result.verdict)};
+}
+
+std::string compare_exit_code_help() {
+    return "Exit codes (compare's own, as idiff's):\n"
+           "  0  PASS\n"
+           "  1  WARN: over the warn limits, within the fail limits\n"
+           "  2  FAIL: over the fail limits (also a bad command line, reported on stderr)\n"
+           "  3  the images cannot be compared: size, data window or channel mismatch\n"
+           "  4  file error: an input is missing, unreadable, not an image, truncated or\n"
+           "     corrupt, or --diff / --heatmap cannot be written\n"
+           "The last line of the report (or \"reason\" in --json) says why.\n";
+}
+
+CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
+
+}  // namespace
+
+void add_compare_command(CLI::App& app, CommandRunner& run) {
+    auto args = std::make_shared<CompareArguments>();
+    CLI::App* cmd = app.add_subcommand(
+        "compare", "Compare two images (OpenEXR or PNG) as idiff does: error figures per "
+                   "channel, a pass/warn/fail verdict and exit code");
+    cmd->add_option("a", args->a, "First image (the reference)")->type_name("A")->required();
+    cmd->add_option("b", args->b, "Second image")->type_name("B")->required();
+
+    CompareOptions& o = args->options;
+    cmd->add_option("--fail", o.fail_threshold,
+                    "A pixel fails when any channel differs by more than X")
+        ->type_name("X")
+        ->check(quiet(CLI::NonNegativeNumber))
+        ->capture_default_str();
+    cmd->add_option("--failpercent", o.fail_percent,
+                    "FAIL when more than P% of the pixels fail, 0..100")
+        ->type_name("P")
+        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->capture_default_str();
+    cmd->add_option("--hardfail", o.hard_fail, "FAIL when any one error exceeds H")
+        ->type_name("H")
+        ->check(quiet(CLI::NonNegativeNumber))
+        ->capture_default_str();
+    cmd->add_option("--warn", o.warn_threshold,
+                    "A pixel warns when any channel differs by more than X")
+        ->type_name("X")
+        ->check(quiet(CLI::NonNegativeNumber))
+        ->capture_default_str();
+    cmd->add_option("--warnpercent", o.warn_percent,
+                    "WARN when more than P% of the pixels warn, 0..100")
+        ->type_name("P")
+        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->capture_default_str();
+    cmd->add_option("--hardwarn", o.hard_warn, "WARN when any one error exceeds H")
+        ->type_name("H")
+        ->check(quiet(CLI::NonNegativeNumber))
+        ->capture_default_str();
+    cmd->add_option("--channels", o.channels,
+                    "Compare only these channels, by name (e.g. R,G,B or diffuse.R);\n"
+                    "default: all, and both images must have the same channel names")
+        ->type_name("LIST")
+        ->delimiter(',');
+    cmd->add_option("--diff", args->diff, "Write |A - B| of the compared channels as float EXR")
+        ->type_name("FILE");
+    cmd->add_option("--heatmap", args->heatmap,
+                    "Write a PNG heatmap of the largest channel error per pixel (magma,\n"
+                    "0 to the max error, legend below; NaN/Inf in green)")
+        ->type_name("FILE");
+    cmd->add_flag("--json", args->json, "Print the figures as JSON instead of the report");
+    cmd->footer(
+        "NaN or Inf in either image is an infinite error: the pixel fails and is counted;\n"
+        "the error figures are over the finite values. PSNR = 20 log10(peak / RMSE), peak =\n"
+        "max(1, largest value). See render/COMPARE.md.\n\n"
+        "Examples:\n"
+        "  octray compare ref.exr out.exr\n"
+        "  octray compare ref.exr out.exr --fail 0.004 --failpercent 0.1 --warn 0.001\n"
+        "  octray compare ref.exr out.exr --channels R,G,B --heatmap err.png --diff err.exr\n"
+        "  octray compare ref.png out.png --json\n\n" +
+        compare_exit_code_help());
+    cmd->callback([args, &run] { run.action = [args] { run_compare(*args); }; });
+}
+
+}  // namespace octray::tools

@@ -1,0 +1,63 @@
+// `octray info [SCENE]`: what the CPU supports, which kernel ISAs this binary holds and
+// which one the SIMD path will use; with a scene, its object counts and compile time.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "core/version.h"
+#include "kernels/dispatch.h"
+#include "scene/compile.h"
+#include "scene/load.h"
+#include "tools/commands.h"
+
+namespace octray::tools {
+namespace {
+
+void run_info(const std::string& scene_spec) {
+    const CpuSupport cpu = cpu_support();
+    std::printf("octray   %s\n", kVersion);
+    std::printf("cpu      sse2 %s, sse4.1 %s, avx2 %s, fma %s\n", cpu.sse2 ? "yes" : "no",
+                cpu.sse4_1 ? "yes" : "no", cpu.avx2 ? "yes" : "no", cpu.fma ? "yes" : "no");
+    std::string compiled, usable;
+    for (Isa isa : compiled_isas()) {
+        const kernels::KernelTable& k = kernel_table(isa);
+        compiled +=
+            std::string(compiled.empty() ? "" : ", ") + k.name + " (" +
+            std::to_string(kernels::kPacketWidth / k.lanes_per_register) +
+            (k.lanes_per_register == kernels::kPacketWidth ? " register" : " registers") +
+            " per 8-ray packet)";
+    }
+    for (Isa isa : supported_isas())
+        usable += std::string(usable.empty() ? "" : ", ") + isa_name(isa);
+    std::printf("kernels  %s\n", compiled.c_str());
+    std::printf("usable   %s\n", usable.c_str());
+    std::printf("uses     %s (--isa auto)\n", isa_name(resolve_isa(Isa::automatic)));
+    if (scene_spec.empty()) return;
+
+    const Scene scene = load_scene(scene_spec);
+    const CompiledScene c = compile_scene(scene);
+    std::printf("scene    %s: %dx%d, %d spp, max depth %d\n", scene_spec.c_str(),
+                scene.image.width, scene.image.height, scene.image.spp, scene.render.max_depth);
+    std::printf("objects  %u spheres (padded to %u), %u planes (padded to %u)\n",
+                c.spheres.count, c.spheres.padded_count, c.planes.count, c.planes.padded_count);
+    std::printf("         %u materials, %u lights, epsilon %g\n", c.materials.count,
+                c.lights.count, static_cast<double>(c.epsilon));
+    std::printf("compile  %.3f ms\n", c.compile_seconds * 1e3);
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, CommandRunner& run) {
+    auto scene = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "info",
+        "Show the CPU's instruction sets and the kernels octray will use; with a "
+        "scene, its object counts and compile time");
+    cmd->add_option("scene", *scene, "Optional scene: a JSON file or a built-in")
+        ->type_name("SCENE");
+    cmd->callback([scene, &run] { run.action = [scene] { run_info(*scene); }; });
+}
+
+}  // namespace octray::tools

@@ -1,0 +1,152 @@
+// `octray verify SCENE`: renders the scene with the scalar reference and with the SIMD
+// packet path and compares them with the compare library (render/image_compare.h):
+// max abs error, RMSE, PSNR, the share of pixels over the fail threshold and the worst
+// pixel with both values. Exit 0 within the thresholds, 1 otherwise.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "kernels/dispatch.h"
+#include "render/image_compare.h"
+#include "render/image_read.h"
+#include "render/packet_renderer.h"
+#include "render/reference.h"
+#include "scene/load.h"
+#include "tools/commands.h"
+
+namespace octray::tools {
+namespace {
+
+struct VerifyArguments {
+    std::string scene = "whitted";
+    int width = 0, height = 0, spp = 0;
+    int threads = 0;
+    std::string isa = "auto";
+    double fail = 1e-4;         // a pixel fails when a channel is off by more
+    double fail_percent = 0.1;  // ... and at most this % of the pixels may
+    double hard_fail = 1e-3;    // no value may be off by more
+};
+
+ChannelImage to_channels(const Image& image) {
+    ChannelImage out(image.width(), image.height(), {"R", "G", "B"});
+    const std::size_t n = image.pixel_count();
+    for (std::size_t k = 0; k < n; ++k) {
+        out.plane(0)[k] = image.data()[k].r;
+        out.plane(1)[k] = image.data()[k].g;
+        out.plane(2)[k] = image.data()[k].b;
+    }
+    return out;
+}
+
+void run_verify(const VerifyArguments& args) {
+    Isa isa = Isa::automatic;
+    try {
+        isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
+    } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--isa: ") + e.what());
+    }
+    Scene scene = load_scene(args.scene);
+    if (args.width > 0) scene.image.width = args.width;
+    if (args.height > 0) scene.image.height = args.height;
+    if (args.spp > 0) scene.image.spp = args.spp;
+    validate_scene(scene);
+
+    RenderOptions options;
+    options.threads = args.threads;
+    std::printf("scene    %s (%zu objects, %zu lights), %dx%d, %d spp\n", args.scene.c_str(),
+                scene.objects.size(), scene.lights.size(), scene.image.width,
+                scene.image.height, scene.image.spp);
+    std::fflush(stdout);
+    const RenderResult ref = render_reference(scene, options);
+    const RenderResult simd = render_packet(scene, options, isa);
+    std::printf("scalar   %.3f s, %llu rays\n", ref.seconds,
+                static_cast<unsigned long long>(ref.rays.total()));
+    std::printf("simd     %.3f s, %llu rays (%s), %.2fx\n", simd.seconds,
+                static_cast<unsigned long long>(simd.rays.total()), isa_name(isa),
+                simd.seconds > 0.0 ? ref.seconds / simd.seconds : 0.0);
+
+    CompareOptions compare;
+    compare.fail_threshold = compare.warn_threshold = args.fail;
+    compare.fail_percent = compare.warn_percent = args.fail_percent;
+    compare.hard_fail = compare.hard_warn = args.hard_fail;
+    const CompareResult r =
+        compare_images(to_channels(ref.image), to_channels(simd.image), compare);
+    const ErrorStats& all = r.overall;
+
+    std::size_t identical = 0;
+    for (std::size_t k = 0; k < ref.image.pixel_count(); ++k)
+        identical += ref.image.data()[k] == simd.image.data()[k] ? 1 : 0;
+    std::printf("max abs  %.6g\n", all.max_abs_error);
+    std::printf("rmse     %.6g\n", all.rmse);
+    std::printf("psnr     %.2f dB\n", all.psnr);
+    std::printf("over     %.4f%% of pixels differ by more than %g (%llu pixels)\n",
+                all.fail_percent, args.fail, static_cast<unsigned long long>(all.fail_pixels));
+    std::printf("worst    pixel (%d, %d) %s: scalar %.9g, simd %.9g\n", all.worst.x,
+                all.worst.y, all.worst.channel.c_str(), all.worst.a, all.worst.b);
+    std::printf("exact    %zu of %zu pixels bit-identical\n", identical,
+                ref.image.pixel_count());
+    const bool same_rays =
+        ref.rays.primary == simd.rays.primary && ref.rays.shadow == simd.rays.shadow &&
+        ref.rays.reflected == simd.rays.reflected && ref.rays.refracted == simd.rays.refracted;
+    if (!same_rays) std::printf("rays     the two paths traced different numbers of rays\n");
+    const bool pass = r.verdict == Verdict::pass && same_rays;
+    std::printf("%s\n", pass ? "PASS" : ("FAIL: " + r.reason).c_str());
+    std::fflush(stdout);
+    if (!pass) throw CommandExit{1};
+}
+
+CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
+
+}  // namespace
+
+void add_verify_command(CLI::App& app, CommandRunner& run) {
+    auto args = std::make_shared<VerifyArguments>();
+    CLI::App* cmd = app.add_subcommand(
+        "verify", "Render a scene with the scalar and the SIMD path and compare the images");
+    cmd->add_option("scene", args->scene, "Scene: a JSON file or a built-in (as for render)")
+        ->type_name("SCENE")
+        ->capture_default_str();
+    cmd->add_option("--width", args->width, "Image width (overrides the scene)")
+        ->type_name("W")
+        ->check(quiet(CLI::Range(1, 65536)));
+    cmd->add_option("--height", args->height, "Image height (overrides the scene)")
+        ->type_name("H")
+        ->check(quiet(CLI::Range(1, 65536)));
+    cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")
+        ->type_name("N")
+        ->check(quiet(CLI::Range(1, 1 << 20)));
+    cmd->add_option("--threads", args->threads, "Worker threads; 0 = every core")
+        ->type_name("N")
+        ->check(quiet(CLI::Range(0, 4096)))
+        ->capture_default_str();
+    cmd->add_option("--isa", args->isa, "ISA of the simd path: auto, avx2, sse4.1, sse2")
+        ->type_name("ISA")
+        ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
+        ->capture_default_str();
+    cmd->add_option("--fail", args->fail,
+                    "A pixel fails when any channel differs by more than X")
+        ->type_name("X")
+        ->check(quiet(CLI::NonNegativeNumber))
+        ->capture_default_str();
+    cmd->add_option("--failpercent", args->fail_percent,
+                    "FAIL when more than P% of the pixels fail, 0..100")
+        ->type_name("P")
+        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->capture_default_str();
+    cmd->add_option("--hardfail", args->hard_fail, "FAIL when any one error exceeds H")
+        ->type_name("H")
+        ->check(quiet(CLI::NonNegativeNumber))
+        ->capture_default_str();
+    cmd->footer(
+        "Examples:\n"
+        "  octray verify whitted\n"
+        "  octray verify random:64,width=320,height=180 --isa sse2\n"
+        "  octray verify scene.json --spp 4 --fail 1e-5 --failpercent 0\n\n"
+        "Exit codes: 0 within the thresholds (and equal ray counts), 1 otherwise;\n"
+        "2 usage error, 3 scene error, as every command.\n");
+    cmd->callback([args, &run] { run.action = [args] { run_verify(*args); }; });
+}
+
+}  // namespace octray::tools

@@ -1,0 +1,58 @@
+#pragma once
+// The `octray` subcommands. Each lives in its own cmd_<name>.cpp and registers itself with
+// one add_<name>_command() call in main.cpp, so a new command is a new file and one line.
+//
+// A command's parse callback only records what to do (CommandRunner::action); main() runs
+// it after the whole command line has parsed, so every command shares one mapping from
+// exceptions to exit codes (run_command below).
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace octray::tools {
+
+// The exit status of every command; --help and README.md list the same table.
+enum ExitCode : int {
+    kExitSuccess = 0,
+    kExitInternal = 1,  // an unexpected failure (a bug, or out of memory)
+    kExitUsage = 2,     // a bad command line: unknown option, bad value, bad combination
+    kExitScene = 3,     // the scene cannot be loaded or is invalid (octray::SceneError)
+    kExitIo = 4,        // a file cannot be written (octray::IoError)
+};
+
+// The exit-code table as help text, for the --help footers.
+std::string exit_code_help();
+
+// A command-line mistake only found once the command runs (an option combination, a path
+// that is not available yet): exits with kExitUsage like a parse error.
+class UsageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// A command's own outcome with its own exit status, already reported (`octray compare`:
+// 1 warn, 2 fail, 3 mismatch): run_command prints nothing and returns `status`.
+struct CommandExit {
+    int status;
+};
+
+struct CommandRunner {
+    std::function<void()> action;  // set by the subcommand the user chose
+};
+
+// Runs `action`, reports any exception on stderr and returns the exit code for it.
+int run_command(const std::function<void()>& action);
+
+void add_render_command(CLI::App& app, CommandRunner& run);
+void add_scene_command(CLI::App& app, CommandRunner& run);
+void add_compare_command(CLI::App& app, CommandRunner& run);
+void add_bench_command(CLI::App& app, CommandRunner& run);
+void add_verify_command(CLI::App& app, CommandRunner& run);
+void add_info_command(CLI::App& app, CommandRunner& run);
+
+}  // namespace octray::tools
