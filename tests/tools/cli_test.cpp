@@ -21,7 +21,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -97,6 +96,18 @@ protected:
 
     fs::path dir_;
 };
+
+// EXR's capDate format, "YYYY:MM:DD HH:MM:SS". (Checked by hand: std::regex trips a false
+// -Wmaybe-uninitialized in GCC 12 under the sanitizer build.)
+bool is_exr_date(const std::string& text) {
+    const std::string pattern = "dddd:dd:dd dd:dd:dd";
+    if (text.size() != pattern.size()) return false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const bool digit = text[i] >= '0' && text[i] <= '9';
+        if (pattern[i] == 'd' ? !digit : text[i] != pattern[i]) return false;
+    }
+    return true;
+}
 
 bool contains(const std::string& text, const std::string& part) {
     return text.find(part) != std::string::npos;
@@ -182,9 +193,7 @@ TEST_F(CliTest, RendersSmallBuiltinWithAttributesAndPreview) {
     EXPECT_EQ(software->value(), "octray 0.1.0");
     const auto* date = h.findTypedAttribute<Imf::StringAttribute>("capDate");
     ASSERT_NE(date, nullptr);
-    EXPECT_TRUE(std::regex_match(date->value(),
-                                 std::regex(R"(\d{4}:\d{2}:\d{2} \d{2}:\d{2}:\d{2})")))
-        << date->value();
+    EXPECT_TRUE(is_exr_date(date->value())) << date->value();
     EXPECT_NE(h.findTypedAttribute<Imf::FloatAttribute>("utcOffset"), nullptr);
     const auto* scene = h.findTypedAttribute<Imf::StringAttribute>("octray.scene");
     ASSERT_NE(scene, nullptr);

@@ -37,7 +37,10 @@ protected:
     RunResult compare(const std::vector<std::string>& args, bool capture_stderr = true) {
         std::string command = "cd " + quote(dir_.string()) + " && " + quote(OCTRAY_EXE) +
                               " compare";
-        for (const std::string& a : args) command += " " + quote(a);
+        for (const std::string& a : args) {
+            command += ' ';  // appended separately: `" " + string` trips GCC 12's -Wrestrict
+            command += quote(a);
+        }
         command += " </dev/null";
         command += capture_stderr ? " 2>&1" : " 2>/dev/null";
         RunResult result;
