@@ -24,47 +24,14 @@
 #include <string>
 #include <vector>
 
+#include "run_octray.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-    int status = -1;     // the exit code, or -1 if the process did not exit normally
-    std::string output;  // stdout and stderr together
-};
-
-std::string quote(const std::string& arg) {
-    std::string quoted = "'";
-    for (char c : arg) {
-        if (c == '\'')
-            quoted.append("'\\''");
-        else
-            quoted.push_back(c);
-    }
-    quoted.push_back('\'');
-    return quoted;
-}
-
-// Runs `octray <args...>` in `cwd` with stdin closed, as CI does.
-RunResult run_octray(const std::vector<std::string>& args, const fs::path& cwd,
-                     bool capture_stderr = true) {
-    // Built with append(): GCC 12's -O3 warns falsely (-Wrestrict) on chains of operator+.
-    std::string command = "cd ";
-    command.append(quote(cwd.string())).append(" && ").append(quote(OCTRAY_EXE));
-    for (const std::string& a : args) command.append(" ").append(quote(a));
-    command.append(" </dev/null");
-    command.append(capture_stderr ? " 2>&1" : " 2>/dev/null");
-    RunResult result;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr) return result;
-    std::array<char, 4096> buffer;
-    std::size_t n = 0;
-    while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-        result.output.append(buffer.data(), n);
-    const int status = ::pclose(pipe);
-    if (status != -1 && WIFEXITED(status)) result.status = WEXITSTATUS(status);
-    return result;
-}
+using octray::testing::RunResult;
+using octray::testing::run_octray;
 
 class CliTest : public ::testing::Test {
 protected:

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tests/render/compare_fixtures.h"
+#include "run_octray.h"
 
 namespace octray {
 namespace {
@@ -20,39 +21,14 @@ namespace {
 using testing::make_image;
 using testing::write_test_exr;
 
-struct RunResult {
-    int status = -1;     // the exit code, or -1 if the process did not exit normally
-    std::string output;  // stdout, and stderr too when asked
-};
-
-std::string quote(const std::string& arg) {
-    std::string quoted = "'";
-    for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return quoted + "'";
-}
+using testing::RunResult;
 
 class CompareCliTest : public testing::ScratchDirTest {
 protected:
     // Runs `octray compare <args...>` in the scratch directory.
-    RunResult compare(const std::vector<std::string>& args, bool capture_stderr = true) {
-        std::string command = "cd " + quote(dir_.string()) + " && " + quote(OCTRAY_EXE) +
-                              " compare";
-        for (const std::string& a : args) {
-            command += ' ';  // appended separately: `" " + string` trips GCC 12's -Wrestrict
-            command += quote(a);
-        }
-        command += " </dev/null";
-        command += capture_stderr ? " 2>&1" : " 2>/dev/null";
-        RunResult result;
-        FILE* pipe = ::popen(command.c_str(), "r");
-        if (pipe == nullptr) return result;
-        std::array<char, 4096> buffer;
-        std::size_t n = 0;
-        while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-            result.output.append(buffer.data(), n);
-        const int status = ::pclose(pipe);
-        if (status != -1 && WIFEXITED(status)) result.status = WEXITSTATUS(status);
-        return result;
+    RunResult compare(std::vector<std::string> args, bool capture_stderr = true) {
+        args.insert(args.begin(), "compare");
+        return testing::run_octray(args, dir_, capture_stderr);
     }
 
     // The reference: 8x8 RGB, a ramp; and a copy whose pixel (5, 3) is off in G by `delta`.
