@@ -742,6 +742,147 @@ void read_lights(const Reader& r, const Json& j, Scene& scene) {
     }
 }
 
+// The animation block: JSON types, key names and object names here; the rules on values
+// (frame order, ranges, keys that do not fit the object or camera) in Validator::animation,
+// so that a hand-built Animation is checked the same way.
+
+// Keys a camera or object has that key frames cannot change: a clearer message than
+// "unknown key".
+void refuse_unanimated_keys(const Reader& r, const Json& key, const std::string& path,
+                            std::span<const std::string_view> unanimated,
+                            std::span<const std::string_view> animated, std::string_view what) {
+    for (const auto& [name, value] : key.items()) {
+        if (std::find(unanimated.begin(), unanimated.end(), name) == unanimated.end()) continue;
+        r.fail(child_path(path, name), "key " + quote_text(name) + " cannot be animated; " +
+                                           std::string(what) + " keys may set " +
+                                           join_quoted(animated.subspan(1)) +
+                                           " (besides \"frame\")");
+    }
+}
+
+int read_key_frame(const Reader& r, const Json& key, const std::string& path) {
+    return static_cast<int>(r.integer(
+        r.require_key(key, path, "frame", "the key's frame number (an integer >= 0)"),
+        child_path(path, "frame"), 0, kMaxIntValue));
+}
+
+std::vector<CameraKey> read_camera_keys(const Reader& r, const Json& j) {
+    const std::string path = "animation.camera";
+    if (!j.is_array()) {
+        r.fail(path, "expected an array of camera keys such as {\"frame\": 0, \"eye\": [0, 1, 5]}, "
+                     "found " + describe(j));
+    }
+    static constexpr std::array<std::string_view, 5> keys = {"frame", "eye", "lookat", "up",
+                                                             "fov"};
+    static constexpr std::array<std::string_view, 4> unanimated = {"type", "width", "aperture",
+                                                                   "focus_distance"};
+    std::vector<CameraKey> out;
+    out.reserve(j.size());
+    for (std::size_t i = 0; i < j.size(); ++i) {
+        const std::string kpath = index_path(path, i);
+        const Json& k = j[i];
+        r.require_object(k, kpath, "a camera key: frame, and any of eye, lookat, up, fov");
+        refuse_unanimated_keys(r, k, kpath, unanimated, keys, "camera");
+        r.check_keys(k, kpath, keys);
+        CameraKey key;
+        key.frame = read_key_frame(r, k, kpath);
+        if (k.contains("eye")) key.eye = r.vec3(k["eye"], child_path(kpath, "eye"));
+        if (k.contains("lookat")) key.lookat = r.vec3(k["lookat"], child_path(kpath, "lookat"));
+        if (k.contains("up")) key.up = r.vec3(k["up"], child_path(kpath, "up"));
+        if (k.contains("fov")) key.fov = r.number(k["fov"], child_path(kpath, "fov"));
+        out.push_back(key);
+    }
+    return out;
+}
+
+// Object names in file order for messages: at most a dozen, then "and N more".
+std::string known_object_names(const Scene& scene) {
+    std::vector<std::string_view> names;
+    std::size_t total = 0;
+    for (const Object& o : scene.objects) {
+        if (o.name.empty()) continue;
+        if (names.size() < 12) names.push_back(o.name);
+        ++total;
+    }
+    if (total == 0) return "the scene names no objects; give one a \"name\" to animate it";
+    std::string out = "the scene names " + join_quoted(names);
+    if (total > names.size()) out += " and " + std::to_string(total - names.size()) + " more";
+    return out;
+}
+
+std::vector<ObjectTrack> read_object_tracks(const Reader& r, const Json& j, const Scene& scene) {
+    const std::string path = "animation.objects";
+    if (!j.is_object()) {
+        r.fail(path, "expected an object mapping object names to key arrays, such as "
+                     "{\"ball\": [{\"frame\": 0, \"center\": [0, 1, 0]}]}, found " + describe(j));
+    }
+    std::unordered_map<std::string_view, std::uint32_t> by_name;
+    std::vector<std::string_view> names;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+        const std::string& name = scene.objects[i].name;
+        if (name.empty()) continue;
+        by_name.emplace(name, static_cast<std::uint32_t>(i));
+        names.push_back(name);
+    }
+    static constexpr std::array<std::string_view, 3> keys = {"frame", "center", "radius"};
+    static constexpr std::array<std::string_view, 5> unanimated = {"type", "name", "material",
+                                                                   "point", "normal"};
+    std::vector<ObjectTrack> out;
+    for (const auto& [name, value] : j.items()) {
+        const std::string tpath = child_path(path, name);
+        const auto found = by_name.find(name);
+        if (found == by_name.end()) {
+            r.fail(tpath, "unknown object " + quote_text(name) + suggestion(name, names) +
+                              "; expected the \"name\" of an object in \"objects\" (" +
+                              known_object_names(scene) + ")");
+        }
+        if (!value.is_array()) {
+            r.fail(tpath, "expected an array of object keys such as {\"frame\": 0, \"center\": "
+                          "[0, 1, 0]}, found " + describe(value));
+        }
+        ObjectTrack track;
+        track.name = name;
+        track.object = found->second;
+        track.keys.reserve(value.size());
+        for (std::size_t i = 0; i < value.size(); ++i) {
+            const std::string kpath = index_path(tpath, i);
+            const Json& k = value[i];
+            r.require_object(k, kpath, "an object key: frame, and center and/or radius");
+            refuse_unanimated_keys(r, k, kpath, unanimated, keys, "object");
+            r.check_keys(k, kpath, keys);
+            ObjectKey key;
+            key.frame = read_key_frame(r, k, kpath);
+            if (k.contains("center")) key.center = r.vec3(k["center"], child_path(kpath, "center"));
+            if (k.contains("radius")) key.radius = r.number(k["radius"], child_path(kpath, "radius"));
+            track.keys.push_back(key);
+        }
+        out.push_back(std::move(track));
+    }
+    return out;
+}
+
+Animation read_animation(const Reader& r, const Json& j, const Scene& scene) {
+    const std::string path = "animation";
+    r.require_object(j, path, "frames, fps, camera, objects");
+    static constexpr std::array<std::string_view, 4> keys = {"frames", "fps", "camera", "objects"};
+    r.check_keys(j, path, keys);
+    Animation a;
+    a.frames = static_cast<int>(
+        r.integer(r.require_key(j, path, "frames", "the number of frames (an integer >= 1)"),
+                  "animation.frames", 1, kMaxAnimationFrames));
+    if (j.contains("fps")) {
+        const Json& fps = j["fps"];
+        if (!fps.is_number()) {
+            r.fail("animation.fps", "expected frames per second (a number > 0), found " +
+                                        describe(fps));
+        }
+        a.fps = fps.get<double>();
+    }
+    if (j.contains("camera")) a.camera = read_camera_keys(r, j["camera"]);
+    if (j.contains("objects")) a.objects = read_object_tracks(r, j["objects"], scene);
+    return a;
+}
+
 // ---------------------------------------------------------------------------------------
 // Semantic checks on an in-memory scene.
 
@@ -948,6 +1089,167 @@ public:
         }
     }
 
+    // Key frames strictly increasing, within [0, 2^31 - 1].
+    template <typename Key>
+    void key_frames(const std::vector<Key>& keys, const std::string& path) const {
+        for (std::size_t i = 0; i < keys.size(); ++i) {
+            const std::string fpath = child_path(index_path(path, i), "frame");
+            if (keys[i].frame < 0) {
+                fail(fpath, "expected a frame number >= 0, found " + std::to_string(keys[i].frame));
+            }
+            if (i > 0 && keys[i].frame <= keys[i - 1].frame) {
+                fail(fpath, "expected key frames in strictly increasing order, found frame " +
+                                std::to_string(keys[i].frame) + " after frame " +
+                                std::to_string(keys[i - 1].frame) + " (" +
+                                index_path(path, i - 1) + ")");
+            }
+        }
+    }
+
+    // The animation's own rules, then the camera of every frame that can differ (the pose
+    // is constant after the last camera key) through the same checks as the still camera.
+    void animation() const {
+        if (!scene_.animation) return;
+        const Animation& a = *scene_.animation;
+        int_range(a.frames, "animation.frames", 1, kMaxAnimationFrames);
+        if (!(std::isfinite(a.fps) && a.fps > 0.0)) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%g", a.fps);
+            fail("animation.fps", std::string("expected frames per second > 0, found ") + buf);
+        }
+
+        const Camera& c = scene_.camera;
+        key_frames(a.camera, "animation.camera");
+        for (std::size_t i = 0; i < a.camera.size(); ++i) {
+            const CameraKey& k = a.camera[i];
+            const std::string path = index_path("animation.camera", i);
+            if (!k.eye && !k.lookat && !k.up && !k.fov) {
+                fail(path, "a camera key sets nothing; expected at least one of \"eye\", "
+                           "\"lookat\", \"up\", \"fov\" besides \"frame\"");
+            }
+            if (k.eye) finite(*k.eye, child_path(path, "eye"));
+            if (k.lookat) finite(*k.lookat, child_path(path, "lookat"));
+            if (k.up) {
+                finite(*k.up, child_path(path, "up"));
+                if (*k.up == Vec3{}) {
+                    fail(child_path(path, "up"), "expected a non-zero up vector, found [0, 0, 0]");
+                }
+            }
+            if (k.fov) {
+                const std::string fpath = child_path(path, "fov");
+                if (c.type == CameraType::orthographic) {
+                    fail(fpath, "key \"fov\" applies only to pinhole, thinlens and fisheye "
+                                "cameras, not to an orthographic camera");
+                }
+                const float fov = *k.fov;
+                const bool fisheye = c.type == CameraType::fisheye;
+                const bool ok = fisheye ? (fov > 0.0f && fov <= 360.0f)
+                                        : (fov > 0.0f && fov < 180.0f);
+                if (!ok) {
+                    fail(fpath, std::string("expected a field of view in ") +
+                                    (fisheye ? "(0, 360]" : "(0, 180)") + " degrees, found " +
+                                    format_float(fov));
+                }
+            }
+        }
+
+        std::unordered_set<std::uint32_t> animated;
+        for (const ObjectTrack& track : a.objects) {
+            const std::string path = child_path("animation.objects", track.name);
+            if (track.object >= scene_.objects.size()) {
+                fail(path, "expected an object index below " +
+                               std::to_string(scene_.objects.size()) +
+                               " (the scene's object count), found " + std::to_string(track.object));
+            }
+            const Object& o = scene_.objects[track.object];
+            const std::string opath = index_path("objects", track.object);
+            if (o.name != track.name) {
+                fail(path, "the track is for " + quote_text(track.name) + " but " + opath +
+                               " is named " + quote_text(o.name));
+            }
+            if (!animated.insert(track.object).second) {
+                fail(path, "expected one track per object, found a second one for " +
+                               quote_text(track.name));
+            }
+            key_frames(track.keys, path);
+            for (std::size_t i = 0; i < track.keys.size(); ++i) {
+                const ObjectKey& k = track.keys[i];
+                const std::string kpath = index_path(path, i);
+                if (!k.center && !k.radius) {
+                    fail(kpath, "an object key sets nothing; expected \"center\" and/or "
+                                "\"radius\" besides \"frame\"");
+                }
+                const auto sphere_only = [&](std::string_view key) {
+                    fail(child_path(kpath, key),
+                         "key " + quote_text(key) + " applies only to spheres, not to a plane (" +
+                             opath + ", " + quote_text(o.name) + ")");
+                };
+                if (k.center) {
+                    if (o.type != ObjectType::sphere) sphere_only("center");
+                    finite(*k.center, child_path(kpath, "center"));
+                }
+                if (k.radius) {
+                    if (o.type != ObjectType::sphere) sphere_only("radius");
+                    positive(*k.radius, child_path(kpath, "radius"), "a radius");
+                }
+            }
+        }
+
+        animated_bounds(a);
+        animated_cameras(a);
+    }
+
+    // Interpolated centers and radii stay within the range of the keys' and the authored
+    // values, so the box of all of them bounds every frame's spheres: if its diagonal is
+    // finite, so is every frame's ε_s.
+    void animated_bounds(const Animation& a) const {
+        if (scene_.render.epsilon || a.objects.empty()) return;
+        Scene hull;
+        hull.objects = scene_.objects;
+        for (const ObjectTrack& track : a.objects) {
+            const Object& o = scene_.objects[track.object];
+            float radius = o.radius;
+            for (const ObjectKey& k : track.keys) {
+                if (k.radius) radius = std::max(radius, *k.radius);
+            }
+            for (const ObjectKey& k : track.keys) {
+                if (!k.center) continue;
+                Object extra = o;
+                extra.center = *k.center;
+                extra.radius = radius;
+                hull.objects.push_back(extra);
+            }
+            hull.objects[track.object].radius = radius;
+        }
+        if (!std::isfinite(self_intersection_epsilon(hull))) {
+            fail("animation.objects",
+                 "the spheres' bounding box over all frames overflows float range; expected "
+                 "coordinates and radii small enough that its diagonal is finite");
+        }
+    }
+
+    void animated_cameras(const Animation& a) const {
+        if (a.camera.empty()) return;
+        // After the last camera key every frame has the pose of that key's frame.
+        const int last = std::min(a.frames - 1, a.camera.back().frame);
+        Scene still;
+        still.source = scene_.source;
+        still.image = scene_.image;
+        visit_camera_frames(scene_, 0, last, [&](int f, const Camera& camera) {
+            still.camera = camera;
+            try {
+                Validator(still).camera();
+            } catch (const SceneError& e) {
+                std::string what = e.what();
+                const std::string prefix = e.json_path() + ": ";
+                const std::size_t at = what.find(prefix);
+                if (at != std::string::npos) what.erase(0, at + prefix.size());
+                fail("animation.camera", "at frame " + std::to_string(f) +
+                                             " the interpolated camera is unusable: " + what);
+            }
+        });
+    }
+
     void lights() const {
         for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
             const std::string path = index_path("lights", i);
@@ -985,12 +1287,6 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
     if (!root.is_object()) {
         r.fail("", "expected a JSON object at the top level, found " + describe(root));
     }
-    // Refused before anything else, so an animated scene is never rendered as a still.
-    if (root.contains("animation")) {
-        r.fail("animation",
-               "animation is not supported yet: octray renders still scenes only; expected no "
-               "\"animation\" block (remove it to render the scene at its authored pose)");
-    }
     r.check_keys(root, "", kTopKeys);
 
     Scene scene;
@@ -1019,6 +1315,7 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
     }
     if (root.contains("objects")) read_objects(r, root["objects"], scene, table);
     if (root.contains("lights")) read_lights(r, root["lights"], scene);
+    if (root.contains("animation")) scene.animation = read_animation(r, root["animation"], scene);
 
     validate_scene(scene);
     return scene;
@@ -1060,6 +1357,7 @@ void validate_scene(const Scene& scene) {
     v.materials();
     v.objects();
     v.lights();
+    v.animation();
 }
 
 }  // namespace octray

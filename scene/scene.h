@@ -10,6 +10,7 @@
 
 #include "core/color.h"
 #include "core/vec3.h"
+#include "scene/animation.h"
 
 namespace octray {
 
@@ -102,6 +103,9 @@ struct Scene {
     std::vector<NamedMaterial> materials;  // named ones in file order, then inline ones
     std::vector<Object> objects;           // file order: ties go to the first listed
     std::vector<Light> lights;
+    // Key frames (scene/animation.h); empty for a still scene. The fields above are the
+    // authored pose; scene_at_frame() gives the still scene of one frame.
+    std::optional<Animation> animation;
 };
 
 // ε_s of the self-intersection rule: render.epsilon if set, else

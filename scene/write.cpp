@@ -125,6 +125,57 @@ Json light(const Light& l) {
 
 std::string dump(const Json& j) { return j.dump(-1, ' ', false, Json::error_handler_t::replace); }
 
+// Only the properties a key sets, so that the scene's values still show through the others.
+Json camera_key(const CameraKey& k) {
+    Json j = Json::object();
+    j["frame"] = k.frame;
+    if (k.eye) j["eye"] = vector(*k.eye);
+    if (k.lookat) j["lookat"] = vector(*k.lookat);
+    if (k.up) j["up"] = vector(*k.up);
+    if (k.fov) j["fov"] = number(*k.fov);
+    return j;
+}
+
+Json object_key(const ObjectKey& k) {
+    Json j = Json::object();
+    j["frame"] = k.frame;
+    if (k.center) j["center"] = vector(*k.center);
+    if (k.radius) j["radius"] = number(*k.radius);
+    return j;
+}
+
+// One key per line. fps is a double: nlohmann prints the shortest text that reads back
+// as the same double.
+std::string animation(const Animation& a) {
+    std::string out = "  \"animation\": {\n";
+    out += "    \"frames\": " + std::to_string(a.frames) + ",\n";
+    out += "    \"fps\": " + dump(Json(a.fps));
+    if (!a.camera.empty()) {
+        out += ",\n    \"camera\": [";
+        for (std::size_t i = 0; i < a.camera.size(); ++i) {
+            out += i ? ",\n      " : "\n      ";
+            out += dump(camera_key(a.camera[i]));
+        }
+        out += "\n    ]";
+    }
+    if (!a.objects.empty()) {
+        out += ",\n    \"objects\": {";
+        for (std::size_t t = 0; t < a.objects.size(); ++t) {
+            const ObjectTrack& track = a.objects[t];
+            out += t ? ",\n      " : "\n      ";
+            out += dump(Json(track.name)) + ": [";
+            for (std::size_t i = 0; i < track.keys.size(); ++i) {
+                out += i ? ",\n        " : "\n        ";
+                out += dump(object_key(track.keys[i]));
+            }
+            out += track.keys.empty() ? "]" : "\n      ]";
+        }
+        out += "\n    }";
+    }
+    out += "\n  }\n";
+    return out;
+}
+
 }  // namespace
 
 std::string scene_to_json(const Scene& scene) {
@@ -189,7 +240,13 @@ std::string scene_to_json(const Scene& scene) {
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         out += (i ? ",\n    " : "\n    ") + dump(light(scene.lights[i]));
     }
-    out += scene.lights.empty() ? "]\n" : "\n  ]\n";
+    out += scene.lights.empty() ? "]" : "\n  ]";
+    if (scene.animation) {
+        out += ",\n";
+        out += animation(*scene.animation);
+    } else {
+        out += "\n";
+    }
     out += "}\n";
     return out;
 }

@@ -648,11 +648,11 @@ TEST(SceneLoadError, DirectionalLightNeedsADirection) {
     expect_json_error(j, "lights[1].direction", {"expected a non-zero direction"});
 }
 
-TEST(SceneLoadError, AnimationIsRefused) {
+// The animation block is tested in tests/scene/animation_test.cpp.
+TEST(SceneLoadError, AnimationNeedsAFrameCount) {
     Json j = full_scene();
-    j["objects"][0]["name"] = "ball";
-    j["animation"] = {{"frames", 48}, {"fps", 24}};
-    expect_json_error(j, "animation", {"animation is not supported yet"});
+    j["animation"] = {{"fps", 24}};
+    expect_json_error(j, "animation.frames", {"missing required key \"frames\""});
 }
 
 TEST(SceneLoadError, ObjectNamesAreUnique) {
