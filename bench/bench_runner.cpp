@@ -29,6 +29,7 @@
 #include "render/image_io.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
+#include "scene/bvh.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 
@@ -236,6 +237,18 @@ std::string format(const char* fmt, double a) {
     return buffer;
 }
 
+// The scalar oracle is brute force: checking 65 536 rays against 10^6 spheres would take
+// minutes per ray set. The rays checked per set are capped at kOracleBudget / objects (at
+// least kOracleMinRays); 0 (every ray) is taken as asked.
+constexpr std::uint64_t kOracleBudget = 1ull << 30;  // ray-object tests per ray set
+constexpr std::uint32_t kOracleMinRays = 1024;
+std::uint32_t capped_validation(std::uint32_t asked, std::uint32_t objects) {
+    if (asked == 0 || objects == 0) return asked;
+    const std::uint64_t cap =
+        std::max<std::uint64_t>(kOracleMinRays, kOracleBudget / objects);
+    return static_cast<std::uint32_t>(std::min<std::uint64_t>(asked, cap));
+}
+
 // Loads the spec at the bench's resolution.
 Scene load_bench_scene(const std::string& spec, int width, int height) {
     Scene scene = load_scene(spec);
@@ -248,11 +261,19 @@ Scene load_bench_scene(const std::string& spec, int width, int height) {
 // The packet render of the scene at the validation size equals the reference render,
 // image and ray counts.
 std::string validate_render(const std::string& spec, const BenchOptions& o, Isa isa,
-                            bool& valid) {
-    const Scene small = load_bench_scene(spec, std::min(o.width, o.validate_width),
-                                         std::min(o.height, o.validate_height));
+                            Accel accel, bool& valid) {
+    int width = std::min(o.width, o.validate_width), height = std::min(o.height, o.validate_height);
+    // The reference render is brute force: shrink the image on large scenes (same budget
+    // as the ray sets' oracle, counting pixels).
+    const Scene probe = load_scene(spec);
+    const auto objects = static_cast<std::uint64_t>(std::max<std::size_t>(1, probe.objects.size()));
+    while (static_cast<std::uint64_t>(width) * height * objects > kOracleBudget &&
+           width * height > 256)
+        width = std::max(1, width / 2), height = std::max(1, height / 2);
+    const Scene small = load_bench_scene(spec, width, height);
     RenderOptions ro;
     ro.threads = o.threads;
+    ro.accel = accel;
     const RenderResult ref = render_reference(small, ro);
     const RenderResult simd = render_packet(small, ro, isa);
     valid = ref.image == simd.image && ref.rays.total() == simd.rays.total();
@@ -266,6 +287,15 @@ struct Variant {
     PixelOrder order;
     TileSize tile;
 };
+
+// One configuration of the SIMD rows: brute force or the BVH with a packet/single switch.
+struct SimdConfig {
+    bool bvh;
+    std::uint32_t lanes;
+    kernels::SceneView view;
+    Accel accel;  // as asked (a whole render resolves it itself)
+};
+
 
 }  // namespace
 
@@ -359,6 +389,55 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
             if (report.scenes.empty()) ctx.embree = embree->device_info();
         }
 #endif
+        // octray's BVH, on the bench's threads (after Embree's build, as a render would).
+        SphereBvh bvh;
+        if (compiled.spheres.count > 0) {
+            arena.execute([&] { bvh = build_sphere_bvh(compiled.spheres); });
+            info.bvh_build_ms = bvh.build_seconds * 1e3;
+            info.bvh_bytes_per_sphere = bvh.bytes_per_sphere();
+            info.bvh_nodes = static_cast<std::uint32_t>(bvh.nodes.size());
+            info.bvh_leaves = bvh.leaf_count;
+            info.bvh_depth = bvh.depth;
+        }
+#if OCTRAY_HAVE_EMBREE
+        if (embree && compiled.spheres.count > 0)
+            info.embree_bytes_per_sphere =
+                static_cast<double>(embree->memory_bytes()) / compiled.spheres.count;
+#endif
+        // Primary hits (the origins of shadow and mirror rays) come from the fastest view.
+        const kernels::SceneView fast_view =
+            bvh.nodes.empty() ? view : make_scene_view(compiled, bvh);
+        const std::uint32_t validate_rays = capped_validation(o.validate_rays, info.objects);
+        // The SIMD rows: each --accel value resolved for this scene (and each
+        // --packet-lanes value with the BVH), without duplicates.
+        std::vector<SimdConfig> simd_configs;
+        for (Accel accel : o.accels) {
+            const bool use_bvh = accel_uses_bvh(accel, compiled.spheres.count);
+            if (!use_bvh && compiled.spheres.count > o.brute_force_max_spheres) {
+                log_line(log, spec + ": skipping brute force (--accel " +
+                                  std::string(accel_name(accel)) + ") on " +
+                                  std::to_string(compiled.spheres.count) + " spheres");
+                continue;
+            }
+            const std::vector<std::uint32_t> lanes =
+                use_bvh ? o.packet_lanes : std::vector<std::uint32_t>{0};
+            for (std::uint32_t l : lanes) {
+                const bool seen = std::any_of(simd_configs.begin(), simd_configs.end(),
+                                              [&](const SimdConfig& c) {
+                                                  return c.bvh == use_bvh && c.lanes == l;
+                                              });
+                if (seen) continue;
+                simd_configs.push_back(
+                    {use_bvh, l, use_bvh ? make_scene_view(compiled, bvh, l) : view, accel});
+            }
+        }
+        if (bvh.sphere_count > 0)
+            log_line(log, spec + ": octray BVH built in " + format("%.3f ms", *info.bvh_build_ms) +
+                              ", " + format("%.1f bytes/sphere", *info.bvh_bytes_per_sphere) +
+                              (info.embree_bytes_per_sphere
+                                   ? ", Embree " + format("%.1f bytes/sphere",
+                                                          *info.embree_bytes_per_sphere)
+                                   : std::string()));
         log_line(log, spec + ": " + std::to_string(info.objects) + " objects, compiled in " +
                           format("%.3f ms", info.compile_ms) +
                           (info.embree_build_ms ? ", Embree BVH built in " +
@@ -384,7 +463,8 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
             // the primary rows validate against the oracle).
             HitSet primary_hits;
             primary_hits.resize(static_cast<std::uint32_t>(primary.ox.size()));
-            octray_simd_tracer(arena, kernel_table(isas.back()), view)(primary, primary_hits);
+            octray_simd_tracer(arena, kernel_table(isas.back()), fast_view)(primary,
+                                                                            primary_hits);
 
             for (Workload w : {Workload::primary, Workload::shadow, Workload::secondary}) {
                 if (!wants(w)) continue;
@@ -397,7 +477,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                  : w == Workload::shadow ? info.shadow_rays
                                          : info.secondary_rays) = set.count;
                 OracleHits oracle;
-                arena.execute([&] { oracle = oracle_hits(reference, set, o.validate_rays); });
+                arena.execute([&] { oracle = oracle_hits(reference, set, validate_rays); });
 
                 const auto measure = [&](BenchRow row, const Tracer& trace,
                                          const ValidationRule& rule, bool octray_any_hit) {
@@ -417,8 +497,8 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                                                             : "tolerance vs scalar oracle, ") +
                                      val.summary();
                     log_line(log, "  " + std::string(workload_name(w)) + " " + row.system +
-                                      " " + row.mode + " " + row.isa + " " + row.order + " " +
-                                      row.tile + ": " +
+                                      " " + row.mode + " " + row.isa + " " + row.accel_label() +
+                                      " " + row.order + " " + row.tile + ": " +
                                       format("%.2f Mrays/s", row.timing.mrays_median) +
                                       (row.valid ? "" : " (INVALID: " + val.summary() + ")"));
                     report.rows.push_back(std::move(row));
@@ -447,13 +527,17 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                         continue;
                     }
                     for (Isa isa : isas) {
-                        BenchRow row = base_row(w, v);
-                        row.system = "octray";
-                        row.mode = "packet8";
-                        row.isa = isa_name(isa);
-                        measure(std::move(row),
-                                octray_simd_tracer(arena, kernel_table(isa), view), kExactRule,
-                                w == Workload::shadow);
+                        for (const SimdConfig& config : simd_configs) {
+                            BenchRow row = base_row(w, v);
+                            row.system = "octray";
+                            row.mode = "packet8";
+                            row.isa = isa_name(isa);
+                            row.accel = config.bvh ? "bvh" : "none";
+                            row.packet_min_lanes = config.lanes;
+                            measure(std::move(row),
+                                    octray_simd_tracer(arena, kernel_table(isa), config.view),
+                                    kExactRule, w == Workload::shadow);
+                        }
                     }
                 }
             }
@@ -461,23 +545,35 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
 
         // Whole renders: the full Whitted workload, frame after frame.
         if (wants(Workload::whitted)) {
-            std::map<Isa, std::pair<bool, std::string>> render_validation;
+            std::map<std::pair<Isa, bool>, std::pair<bool, std::string>> render_validation;
             for (TileSize tile : o.tiles) {
                 for (TracePath path : o.paths) {
                     const std::vector<Isa> path_isas =
                         path == TracePath::simd ? isas : std::vector<Isa>{Isa::automatic};
-                    for (Isa isa : path_isas) {
+                    // Whole renders take --accel (one row each; the packet switch is the
+                    // renderer's default).
+                    std::vector<const SimdConfig*> configs;
+                    for (const SimdConfig& c : simd_configs)
+                        if (std::none_of(configs.begin(), configs.end(),
+                                         [&](const SimdConfig* k) { return k->bvh == c.bvh; }))
+                            configs.push_back(&c);
+                    if (path == TracePath::scalar || configs.empty()) configs = {nullptr};
+                    for (Isa isa : path_isas)
+                    for (const SimdConfig* config : configs) {
+                        const Accel accel = config ? config->accel : Accel::none;
                         BenchRow row =
                             base_row(Workload::whitted, Variant{PixelOrder::tiled, tile});
                         row.system = "octray";
                         row.mode = path == TracePath::simd ? "packet8" : "single";
                         row.isa = path == TracePath::simd ? isa_name(isa) : "scalar";
+                        if (config) row.accel = config->bvh ? "bvh" : "none";
                         if (path == TracePath::simd) {
-                            auto it = render_validation.find(isa);
+                            const auto key = std::make_pair(isa, config && config->bvh);
+                            auto it = render_validation.find(key);
                             if (it == render_validation.end()) {
                                 bool ok = false;
-                                std::string text = validate_render(spec, o, isa, ok);
-                                it = render_validation.emplace(isa, std::make_pair(ok, text))
+                                std::string text = validate_render(spec, o, isa, accel, ok);
+                                it = render_validation.emplace(key, std::make_pair(ok, text))
                                          .first;
                             }
                             row.valid = it->second.first;
@@ -490,6 +586,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                         ro.threads = ctx.threads;
                         ro.tile_width = tile.width;
                         ro.tile_height = tile.height;
+                        ro.accel = accel;
                         const auto render = [&] {
                             return path == TracePath::simd ? render_packet(compiled, ro, isa)
                                                            : render_reference(scene, ro);
@@ -507,8 +604,8 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                         row.frames_per_second = row.timing.seconds_median > 0.0
                                                     ? 1.0 / row.timing.seconds_median
                                                     : 0.0;
-                        log_line(log, "  whitted octray " + row.mode + " " + row.isa +
-                                          " tile " + row.tile + ": " +
+                        log_line(log, "  whitted octray " + row.mode + " " + row.isa + " " +
+                                          row.accel + " tile " + row.tile + ": " +
                                           format("%.3f frames/s", row.frames_per_second) +
                                           ", " +
                                           format("%.2f Mrays/s", row.timing.mrays_median));
@@ -540,6 +637,12 @@ void print_table(const BenchReport& report, std::ostream& out) {
             << " spheres, " << s.planes << " planes), " << s.lights << " lights; compile "
             << format("%.3f ms", s.compile_ms);
         if (s.embree_build_ms) out << ", Embree BVH " << format("%.3f ms", *s.embree_build_ms);
+        if (s.embree_bytes_per_sphere)
+            out << " (" << format("%.1f", *s.embree_bytes_per_sphere) << " bytes/sphere)";
+        if (s.bvh_build_ms)
+            out << ", octray BVH " << format("%.3f ms", *s.bvh_build_ms) << " ("
+                << format("%.1f", *s.bvh_bytes_per_sphere) << " bytes/sphere, " << s.bvh_nodes
+                << " nodes, " << s.bvh_leaves << " leaves, depth " << s.bvh_depth << ")";
         if (s.primary_rays || s.shadow_rays || s.secondary_rays)
             out << "; ray sets: " << s.primary_rays << " primary, " << s.shadow_rays
                 << " shadow, " << s.secondary_rays << " secondary";
@@ -548,9 +651,9 @@ void print_table(const BenchReport& report, std::ostream& out) {
     out << "\n";
     char line[512];
     std::snprintf(line, sizeof line,
-                  "%-14s %-9s %-6s %-7s %-6s %-8s %-5s %9s %6s %9s %9s %9s %8s %s\n", "scene",
-                  "rays", "system", "mode", "isa", "order", "tile", "count", "hit%", "Mrays/s",
-                  "min", "max", "oct/emb", "valid");
+                  "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9s %6s %9s %9s %9s %8s %s\n",
+                  "scene", "rays", "system", "mode", "isa", "accel", "order", "tile", "count",
+                  "hit%", "Mrays/s", "min", "max", "oct/emb", "valid");
     out << line;
     for (const BenchRow& r : report.rows) {
         const std::string ratio = r.ratio ? format("%.3f", *r.ratio) : "-";
@@ -558,9 +661,9 @@ void print_table(const BenchReport& report, std::ostream& out) {
             std::isnan(r.hit_fraction) ? "-" : format("%.1f", 100.0 * r.hit_fraction);
         std::snprintf(
             line, sizeof line,
-            "%-14s %-9s %-6s %-7s %-6s %-8s %-5s %9llu %6s %9.2f %9.2f %9.2f %8s %s\n",
+            "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9llu %6s %9.2f %9.2f %9.2f %8s %s\n",
             r.scene.c_str(), workload_name(r.workload), r.system.c_str(), r.mode.c_str(),
-            r.isa.c_str(), r.order.c_str(), r.tile.c_str(),
+            r.isa.c_str(), r.accel_label().c_str(), r.order.c_str(), r.tile.c_str(),
             static_cast<unsigned long long>(r.rays), hit.c_str(), r.timing.mrays_median,
             r.timing.mrays_min, r.timing.mrays_max, ratio.c_str(), r.valid ? "yes" : "NO");
         out << line;
@@ -615,6 +718,14 @@ std::string report_json(const BenchReport& report) {
                    {"shadow_rays", s.shadow_rays},
                    {"secondary_rays", s.secondary_rays}};
         js["embree_build_ms"] = s.embree_build_ms ? json(*s.embree_build_ms) : json(nullptr);
+        js["embree_bytes_per_sphere"] =
+            s.embree_bytes_per_sphere ? json(*s.embree_bytes_per_sphere) : json(nullptr);
+        js["bvh_build_ms"] = s.bvh_build_ms ? json(*s.bvh_build_ms) : json(nullptr);
+        js["bvh_bytes_per_sphere"] =
+            s.bvh_bytes_per_sphere ? json(*s.bvh_bytes_per_sphere) : json(nullptr);
+        js["bvh_nodes"] = s.bvh_nodes;
+        js["bvh_leaves"] = s.bvh_leaves;
+        js["bvh_depth"] = s.bvh_depth;
         j["scenes"].push_back(std::move(js));
     }
     j["rows"] = json::array();
@@ -625,6 +736,8 @@ std::string report_json(const BenchReport& report) {
             {"system", r.system},
             {"mode", r.mode},
             {"isa", r.isa},
+            {"accel", r.accel},
+            {"packet_min_lanes", r.packet_min_lanes},
             {"order", r.order},
             {"tile", r.tile},
             {"threads", r.threads},

@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "bench/ray_sets.h"
+#include "kernels/dispatch.h"
 #include "kernels/isa.h"
+#include "scene/accel.h"
 #include "render/types.h"
 
 namespace octray::bench {
@@ -41,6 +43,13 @@ struct BenchOptions {
     std::vector<PixelOrder> orders{PixelOrder::tiled};
     std::vector<Isa> isas{Isa::automatic};
     std::vector<TracePath> paths{TracePath::simd};
+    // The SIMD path's sphere acceleration (auto: a BVH from kBvhAutoMinSpheres spheres on)
+    // and, with a BVH, the live lanes below which a packet goes on ray by ray.
+    std::vector<Accel> accels{Accel::automatic};
+    std::vector<std::uint32_t> packet_lanes{kBvhPacketMinLanes};
+    // Brute force (accel none) is skipped on scenes with more spheres than this: on 10^6
+    // spheres a frame of it would take hours.
+    std::uint32_t brute_force_max_spheres = 1u << 14;
     bool embree = true;  // when compiled in
     // Rays checked against the scalar oracle per ray set (0: all of them).
     std::uint32_t validate_rays = 1u << 16;
@@ -65,6 +74,12 @@ struct BenchRow {
     std::string isa;     // octray: the kernels' ISA or "scalar"; embree: "embree"
     std::string order;   // pixel order of the rays
     std::string tile;    // tile size (tiled order, whole renders), "-" where it plays no part
+    std::string accel = "-";             // octray simd: "bvh" or "none"
+    std::uint32_t packet_min_lanes = 0;  // octray simd with the BVH
+    // "bvh/3" (the BVH, packets of fewer than 3 live lanes go on ray by ray), "none", "-".
+    std::string accel_label() const {
+        return accel == "bvh" ? "bvh/" + std::to_string(packet_min_lanes) : accel;
+    }
     int threads = 0;
     std::uint64_t rays = 0;  // per repetition
     RayCounts counts;        // the rays of one repetition by kind
@@ -85,6 +100,11 @@ struct SceneInfo {
     float epsilon = 0.0f;
     double compile_ms = 0.0;                                              // compile_scene()
     std::optional<double> embree_build_ms;                                // rtcCommitScene()
+    std::optional<double> embree_bytes_per_sphere;  // Embree's device memory after the build
+    // octray's sphere BVH (scene/bvh.h): build time, bytes per sphere (nodes and its copy of
+    // the spheres), 8-wide nodes, leaves, depth. Absent without spheres.
+    std::optional<double> bvh_build_ms, bvh_bytes_per_sphere;
+    std::uint32_t bvh_nodes = 0, bvh_leaves = 0, bvh_depth = 0;
     std::uint64_t primary_rays = 0, shadow_rays = 0, secondary_rays = 0;  // ray set sizes
 };
 

@@ -6,6 +6,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -40,6 +41,9 @@ struct EmbreeScene::Impl {
     std::vector<std::vector<std::int32_t>> object_of;
     double build_seconds = 0.0;
     std::string last_error;
+    // Bytes allocated minus bytes freed through the device (memory monitor callback).
+    std::atomic<std::int64_t> live_bytes{0};
+    std::int64_t bytes_after_build = 0;
 
     std::int32_t object(unsigned geom_id, unsigned prim_id) const {
         if (geom_id == RTC_INVALID_GEOMETRY_ID) return kernels::kNoHit;
@@ -57,6 +61,13 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         im.device,
         [](void* user, RTCError, const char* message) {
             static_cast<Impl*>(user)->last_error = message ? message : "";
+        },
+        &im);
+    rtcSetDeviceMemoryMonitorFunction(
+        im.device,
+        [](void* user, ssize_t bytes, bool) {
+            static_cast<Impl*>(user)->live_bytes += static_cast<std::int64_t>(bytes);
+            return true;
         },
         &im);
     im.scene = rtcNewScene(im.device);
@@ -134,6 +145,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (rtcGetDeviceError(im.device) != RTC_ERROR_NONE || !im.last_error.empty())
         throw std::runtime_error("Embree: scene build failed: " + im.last_error);
+    im.bytes_after_build = im.live_bytes.load();
 }
 
 EmbreeScene::~EmbreeScene() {
@@ -142,6 +154,8 @@ EmbreeScene::~EmbreeScene() {
 }
 
 double EmbreeScene::build_seconds() const { return impl_->build_seconds; }
+
+std::int64_t EmbreeScene::memory_bytes() const { return impl_->bytes_after_build; }
 
 std::string EmbreeScene::version() { return RTC_VERSION_STRING; }
 

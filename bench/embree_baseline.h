@@ -60,6 +60,10 @@ class EmbreeScene {
     // Seconds rtcCommitScene took (the BVH build), in the calling thread's TBB arena.
     double build_seconds() const;
 
+    // Bytes the device held once the scene was committed (its memory monitor callback:
+    // geometry buffers, BVH and build leftovers).
+    std::int64_t memory_bytes() const;
+
     // "3.13.5", and what the device reports (native packet support, ISA-relevant flags).
     static std::string version();
     std::string device_info() const;

@@ -151,4 +151,17 @@ kernels::SceneView make_scene_view(const CompiledScene& c) {
     return v;
 }
 
+kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& bvh,
+                                   std::uint32_t packet_min_lanes) {
+    kernels::SceneView v = make_scene_view(scene);
+    if (bvh.nodes.empty()) return v;
+    v.bvh_nodes = bvh.nodes.data();
+    v.bvh_cx = bvh.cx.data(), v.bvh_cy = bvh.cy.data(), v.bvh_cz = bvh.cz.data();
+    v.bvh_r2 = bvh.r2.data(), v.bvh_object = bvh.object.data();
+    for (int a = 0; a < 3; ++a) v.bvh_lo[a] = bvh.lo[a], v.bvh_hi[a] = bvh.hi[a];
+    v.bvh_min_r2 = bvh.min_r2, v.bvh_max_r2 = bvh.max_r2;
+    v.bvh_packet_min_lanes = packet_min_lanes;
+    return v;
+}
+
 }  // namespace octray

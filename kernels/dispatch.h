@@ -11,6 +11,7 @@
 #include "kernels/isa.h"
 #include "kernels/kernel_table.h"
 #include "kernels/kernel_types.h"
+#include "scene/bvh.h"
 #include "scene/compile.h"
 
 namespace octray {
@@ -46,5 +47,14 @@ const kernels::KernelTable& kernel_table(Isa isa);
 
 // The plain-pointer view the kernels read; valid while `scene` lives and is not changed.
 kernels::SceneView make_scene_view(const CompiledScene& scene);
+
+// Packets with fewer live lanes than this continue ray by ray in the BVH (measured:
+// kernels/README.md, "The BVH").
+inline constexpr std::uint32_t kBvhPacketMinLanes = 3;
+
+// The same with the spheres' BVH built from `scene` (scene/bvh.h); both must outlive the
+// view. An empty BVH (no spheres) leaves the view brute force.
+kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& bvh,
+                                   std::uint32_t packet_min_lanes = kBvhPacketMinLanes);
 
 }  // namespace octray

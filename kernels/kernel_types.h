@@ -10,6 +10,8 @@
 
 #include <cstdint>
 
+#include "scene/bvh_node.h"
+
 namespace octray::kernels {
 
 // Rays per packet. AVX2 holds a packet in one register, SSE in two.
@@ -67,6 +69,19 @@ struct SceneView {
     float ambient[3];
     float epsilon;  // ε_s
     std::int32_t max_depth;
+
+    // The sphere BVH (scene/bvh.h), or bvh_nodes == nullptr: closest_hit and any_hit test
+    // every sphere. Spheres in leaf order; node 0 is the root.
+    const BvhNode8* bvh_nodes;
+    const float *bvh_cx, *bvh_cy, *bvh_cz, *bvh_r2;
+    const std::uint32_t* bvh_object;
+    // The root's box and the extreme squared radii: the traversal's rounding margin
+    // (kernels/README.md, "The BVH").
+    float bvh_lo[3], bvh_hi[3];
+    float bvh_min_r2, bvh_max_r2;
+    // A packet with fewer live lanes than this goes on ray by ray (single-ray traversal);
+    // 0 or 1: packets all the way, 9: single rays only.
+    std::uint32_t bvh_packet_min_lanes;
 };
 
 // Film positions of camera samples, in [-1, 1]^2 with y up, plus the thin-lens aperture

@@ -5,6 +5,7 @@
 #define OCTRAY_KERNEL_NAMESPACE sse4_1
 #include "kernels/kernel_table.h"
 #include "kernels/packet_kernels.h"
+#include "kernels/bvh_kernels.h"
 
 namespace octray::kernels {
 

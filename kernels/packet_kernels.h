@@ -330,13 +330,50 @@ std::uint32_t camera_rays(const SceneView& s, const CameraSamples& in, std::uint
 }
 
 // ---------------------------------------------------------------------------------------
-// Closest hit over all spheres and planes (reference: ReferenceTracer::intersect).
+// Planes, for one register of rays: closest hit with ties to the lower file index, and
+// occlusion on (0, t_max). Shared by the brute-force kernels and the BVH traversal
+// (kernels/bvh_kernels.h): planes stay outside the BVH.
+template <class F>
+void closest_planes(const SceneView& s, const V3<F>& o, const V3<F>& d, const F& tmin,
+                    F& best_t, F& best_id) {
+    for (std::uint32_t i = 0; i < s.plane_count; ++i) {
+        // t = (d - O.N) / (V.N), d = P0.N; |V.N| < 1e-12 misses.
+        const V3<F> n{F(s.plane_nx[i]), F(s.plane_ny[i]), F(s.plane_nz[i])};
+        const F pd(s.plane_d[i]);
+        const F id(static_cast<float>(s.plane_object[i]));
+        const F denom = dot(d, n);
+        const F t = (pd - dot(o, n)) / denom;
+        const auto nearer = t < best_t || (t == best_t && id < best_id);
+        const auto hit = xsimd::abs(denom) >= F(kPlaneParallelEpsilon) && t > tmin && nearer;
+        best_t = xsimd::select(hit, t, best_t);
+        best_id = xsimd::select(hit, id, best_id);
+    }
+}
+
+template <class F>
+auto any_plane(const SceneView& s, const V3<F>& o, const V3<F>& d, const F& t_max) {
+    auto occluded = F(0.0f) != F(0.0f);  // all false
+    for (std::uint32_t i = 0; i < s.plane_count; ++i) {
+        const V3<F> n{F(s.plane_nx[i]), F(s.plane_ny[i]), F(s.plane_nz[i])};
+        const F pd(s.plane_d[i]);
+        const F denom = dot(d, n);
+        const F t = (pd - dot(o, n)) / denom;
+        occluded = occluded ||
+                   (xsimd::abs(denom) >= F(kPlaneParallelEpsilon) && t > F(0.0f) && t < t_max);
+    }
+    return occluded;
+}
+
+// ---------------------------------------------------------------------------------------
+// Closest hit over all spheres and planes, brute force (reference:
+// ReferenceTracer::intersect); closest_hit() in kernels/bvh_kernels.h calls it when the
+// scene has no BVH.
 // Spheres are broadcast one at a time against the packet. An object's candidate is its
 // first root above t_min; the hit is the smallest candidate, ties to the lower file index
 // (the reference walks objects in file order and keeps a hit only when strictly nearer).
 template <class Arch>
-void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count, float t_min,
-                 const HitStream& hits) {
+void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t count,
+                     float t_min, const HitStream& hits) {
     using F = xsimd::batch<float, Arch>;
     using M = xsimd::batch_bool<float, Arch>;
     constexpr std::uint32_t W = F::size;
@@ -381,21 +418,8 @@ void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count,
                 best_id[k] = xsimd::select(hit, id, best_id[k]);
             }
         }
-        for (std::uint32_t i = 0; i < s.plane_count; ++i) {
-            // t = (d - O.N) / (V.N), d = P0.N; |V.N| < 1e-12 misses.
-            const V3<F> n{F(s.plane_nx[i]), F(s.plane_ny[i]), F(s.plane_nz[i])};
-            const F pd(s.plane_d[i]);
-            const F id(static_cast<float>(s.plane_object[i]));
-            for (std::uint32_t k = 0; k < K; ++k) {
-                const F denom = dot(d[k], n);
-                const F t = (pd - dot(o[k], n)) / denom;
-                const M nearer = t < best_t[k] || (t == best_t[k] && id < best_id[k]);
-                const M hit =
-                    xsimd::abs(denom) >= F(kPlaneParallelEpsilon) && t > tmin && nearer;
-                best_t[k] = xsimd::select(hit, t, best_t[k]);
-                best_id[k] = xsimd::select(hit, id, best_id[k]);
-            }
-        }
+        for (std::uint32_t k = 0; k < K; ++k)
+            closest_planes(s, o[k], d[k], tmin, best_t[k], best_id[k]);
         for (std::uint32_t k = 0; k < K; ++k) {
             const std::uint32_t at = base + k * W;
             best_t[k].store_aligned(hits.t + at);
@@ -405,10 +429,11 @@ void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count,
 }
 
 // ---------------------------------------------------------------------------------------
-// Any hit for shadow rays on (0, t_max) (reference: ReferenceTracer::occluded). A packet
+// Any hit for shadow rays on (0, t_max), brute force (reference: ReferenceTracer::occluded);
+// any_hit() in kernels/bvh_kernels.h calls it when the scene has no BVH. A packet
 // stops testing objects once every live lane is occluded. occluded[i] is 1 or 0.
 template <class Arch>
-void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
+void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
              std::uint32_t* occluded) {
     using F = xsimd::batch<float, Arch>;
     using M = xsimd::batch_bool<float, Arch>;
@@ -453,16 +478,9 @@ void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
                           (t_far > zero && t_far < t_max[k]);
             }
         }
-        for (std::uint32_t i = 0; i < s.plane_count && !all_done(); ++i) {
-            const V3<F> n{F(s.plane_nx[i]), F(s.plane_ny[i]), F(s.plane_nz[i])};
-            const F pd(s.plane_d[i]);
-            for (std::uint32_t k = 0; k < K; ++k) {
-                const F denom = dot(d[k], n);
-                const F t = (pd - dot(o[k], n)) / denom;
-                done[k] = done[k] || (xsimd::abs(denom) >= F(kPlaneParallelEpsilon) &&
-                                      t > zero && t < t_max[k]);
-            }
-        }
+        if (!all_done())
+            for (std::uint32_t k = 0; k < K; ++k)
+                done[k] = done[k] || any_plane(s, o[k], d[k], t_max[k]);
         // Dead lanes come out as 1; nobody reads them.
         for (std::uint32_t k = 0; k < K; ++k)
             xsimd::to_int(xsimd::select(done[k], F(1.0f), zero))

@@ -22,6 +22,8 @@ struct BenchArguments {
     std::vector<std::string> orders;
     std::vector<std::string> isas;
     std::vector<std::string> paths;
+    std::vector<std::string> accels;
+    std::vector<std::uint32_t> packet_lanes;
     int threads = 0, reps = 5, warmup = 1, width = 1920, height = 1080;
     std::uint32_t validate_rays = 1u << 16;
     bool no_embree = false;
@@ -47,6 +49,12 @@ std::string command_line(const BenchArguments& a) {
     if (!a.orders.empty()) c += " --order " + join(a.orders);
     if (!a.isas.empty()) c += " --isa " + join(a.isas);
     if (!a.paths.empty()) c += " --path " + join(a.paths);
+    if (!a.accels.empty()) c += " --accel " + join(a.accels);
+    if (!a.packet_lanes.empty()) {
+        std::vector<std::string> lanes;
+        for (std::uint32_t l : a.packet_lanes) lanes.push_back(std::to_string(l));
+        c += " --packet-lanes " + join(lanes);
+    }
     if (a.validate_rays != (1u << 16))
         c += " --validate-rays " + std::to_string(a.validate_rays);
     if (a.no_embree) c += " --no-embree";
@@ -78,6 +86,8 @@ void run_bench_command(const BenchArguments& a) {
         parse_list<bench::PixelOrder>(a.orders, "--order", bench::parse_pixel_order, o.orders);
     o.isas = parse_list<Isa>(a.isas, "--isa", parse_isa, o.isas);
     o.paths = parse_list<bench::TracePath>(a.paths, "--path", bench::parse_trace_path, o.paths);
+    o.accels = parse_list<Accel>(a.accels, "--accel", parse_accel, o.accels);
+    if (!a.packet_lanes.empty()) o.packet_lanes = a.packet_lanes;
     for (Isa isa : o.isas)
         if (!isa_supported(isa))
             throw UsageError(std::string("--isa ") + isa_name(isa) +
@@ -150,6 +160,21 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
            "octray paths: simd (packet kernels), scalar (the reference) [default: simd]")
         ->delimiter(',')
         ->type_name("LIST");
+    cmd->add_option("--accel", a->accels,
+                    "octray's sphere acceleration: auto (a BVH from " +
+                        std::to_string(kBvhAutoMinSpheres) +
+                        " spheres on), bvh, none (brute force; skipped above " +
+                        std::to_string(bench::BenchOptions{}.brute_force_max_spheres) +
+                        " spheres) [default: auto]")
+        ->delimiter(',')
+        ->type_name("LIST");
+    cmd->add_option("--packet-lanes", a->packet_lanes,
+                    "With the BVH: packets with fewer live lanes go on ray by ray; 0 packets "
+                    "only, 9 single rays only [default: " +
+                        std::to_string(kBvhPacketMinLanes) + "]")
+        ->delimiter(',')
+        ->type_name("LIST")
+        ->check(CLI::Range(0, 9));
     cmd->add_option(
         "--validate-rays", a->validate_rays,
         "Rays per set checked against the scalar oracle, 0 for all [default: 65536]");
@@ -158,7 +183,10 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray bench                                   # the default table\n"
         "  octray bench random:1024 --rays primary,shadow --threads 2 --json out.json\n"
-        "  octray bench whitted --order rowmajor,tiled,morton --rays primary\n\n" +
+        "  octray bench whitted --order rowmajor,tiled,morton --rays primary\n"
+        "  octray bench random:65536 random:1048576 sphereflake:5 --rays primary,shadow "
+        "--threads 2\n"
+        "  octray bench random:256 --accel bvh,none --packet-lanes 0,3,5,9 --rays primary\n\n" +
         exit_code_help());
     cmd->callback([a, &run] { run.action = [a] { run_bench_command(*a); }; });
 }

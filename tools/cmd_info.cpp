@@ -1,5 +1,6 @@
 // `octray info [SCENE]`: what the CPU supports, which kernel ISAs this binary holds and
-// which one the SIMD path will use; with a scene, its object counts and compile time.
+// which one the SIMD path will use; with a scene, its object counts, compile time and the
+// sphere BVH (build time, memory per sphere, shape).
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -8,6 +9,7 @@
 
 #include "core/version.h"
 #include "kernels/dispatch.h"
+#include "scene/bvh.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 #include "tools/commands.h"
@@ -45,6 +47,20 @@ void run_info(const std::string& scene_spec) {
     std::printf("         %u materials, %u lights, epsilon %g\n", c.materials.count,
                 c.lights.count, static_cast<double>(c.epsilon));
     std::printf("compile  %.3f ms\n", c.compile_seconds * 1e3);
+    if (c.spheres.count == 0) {
+        std::printf("bvh      none (no spheres)\n");
+        return;
+    }
+    // Built on every core, as `octray render` builds it.
+    const SphereBvh bvh = build_sphere_bvh(c.spheres);
+    std::printf("bvh      built in %.3f ms: %zu bytes, %.1f bytes/sphere\n",
+                bvh.build_seconds * 1e3, bvh.memory_bytes(), bvh.bytes_per_sphere());
+    std::printf("         %zu 8-wide nodes, %u leaves (%.2f spheres/leaf), depth %u\n",
+                bvh.nodes.size(), bvh.leaf_count,
+                static_cast<double>(bvh.sphere_count) / bvh.leaf_count, bvh.depth);
+    std::printf("accel    --accel auto uses %s (the BVH from %u spheres on)\n",
+                accel_uses_bvh(Accel::automatic, c.spheres.count) ? "the BVH" : "brute force",
+                kBvhAutoMinSpheres);
 }
 
 }  // namespace
@@ -54,7 +70,8 @@ void add_info_command(CLI::App& app, CommandRunner& run) {
     CLI::App* cmd = app.add_subcommand(
         "info",
         "Show the CPU's instruction sets and the kernels octray will use; with a "
-        "scene, its object counts and compile time");
+        "scene, its object counts, compile time and sphere BVH (build time, bytes per "
+        "sphere)");
     cmd->add_option("scene", *scene, "Optional scene: a JSON file or a built-in")
         ->type_name("SCENE");
     cmd->callback([scene, &run] { run.action = [scene] { run_info(*scene); }; });

@@ -1,0 +1,576 @@
+// BVH traversal and the closest_hit / any_hit entry points of the kernel table. Included
+// ONLY by the per-ISA translation units, after kernels/packet_kernels.h, under the same
+// OCTRAY_KERNEL_NAMESPACE (kernels/README.md, "the ODR rule").
+//
+// The tree is scene/bvh.h's: 8-wide nodes with their children's boxes in SoA
+// (scene/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
+// - packet traversal (Wald et al. 2001, "Interactive rendering with coherent ray
+//   tracing", widened to 8-wide nodes): the 8-ray packet is tested against one child box
+//   at a time, lanes whose current closest hit lies before the box are culled, and
+//   children are visited nearest first along the packet's first live ray;
+// - single-ray traversal (Wald et al. 2008, "Getting rid of packets"; embree's BVH8): one
+//   ray against all 8 child boxes in one operation, near/far planes picked by the ray's
+//   direction signs (Williams et al. 2005), children visited nearest first.
+// A packet whose live lanes drop below SceneView::bvh_packet_min_lanes goes on ray by ray
+// from that node (embree's hybrid traversal).
+//
+// Bit-exactness. Leaves test spheres with the brute-force kernels' exact arithmetic (same
+// operands, same order), and a hit replaces the current one when it is nearer or equally
+// near with a lower file index: the brute-force result (the first listed object wins a
+// tie) whatever the visiting order. Box tests only decide which spheres are tested, so
+// they must never cull a sphere the brute-force quadratic would report. That quadratic
+// rounds: with u = 2^-24, its discriminant b² - (V·V)(O'·O' - r²) is off by at most
+// ~19u (V·V)(|O'|² + r²), and the point at a root it reports lies within
+// sqrt(r² + 19u(|O'|² + r²)) of the center instead of r (for a tiny sphere far from the
+// ray's origin that is far more than r: the brute force "hits" a fuzzy sphere of radius
+// ~sqrt(19u)|O'|). So every box is widened, per ray, by
+//   sqrt(r_min² + 32u(D² + r_max²)) - r_min + 64u(D + max|O|)
+// where D is the distance from the ray origin to the farthest corner of the root box
+// (bounding |O'| for every sphere), r_min / r_max the scene's extreme radii, and the last
+// term covers the rounding of the slab test itself (FMA: it decides visits, not values).
+// The tests (tests/kernels/bvh_traversal_test.cpp) check hit for hit against brute force
+// on degenerate scenes (radii from 1e-6 to 1e3, coincident spheres, spheres far apart).
+
+#ifndef OCTRAY_KERNEL_NAMESPACE
+#error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"
+#endif
+
+// Needs kernels/packet_kernels.h (included just before, by the same translation unit).
+
+namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
+
+// Entries of a traversal stack: a node pushes at most 8 children, and the builder keeps
+// the tree below 48 + 28 levels (scene/bvh.cpp, kMaxSahDepth).
+constexpr std::uint32_t kBvhStackSize = 1024;
+// 32u and 64u of the margin above.
+constexpr float kBvhFuzz = 0x1.0p-19f;
+constexpr float kBvhSlack = 0x1.0p-18f;
+// Direction components smaller than this are replaced by it (with their sign) before the
+// reciprocal, so that box tests never compute 0 * inf.
+constexpr float kBvhTinyDirection = 1e-18f;
+
+// One packet's rays as the traversal reads them, lane by lane in memory: the single-ray
+// traversal picks its lane's scalars from here.
+struct BvhPacket {
+    alignas(64) float ox[kPacketWidth], oy[kPacketWidth], oz[kPacketWidth];
+    alignas(64) float dx[kPacketWidth], dy[kPacketWidth], dz[kPacketWidth];
+    alignas(64) float a[kPacketWidth];  // V·V, as the sphere test computes it
+    alignas(64) float inv_x[kPacketWidth], inv_y[kPacketWidth], inv_z[kPacketWidth];
+    // (O + margin) * inv and (O - margin) * inv: a widened slab [min - m, max + m] is
+    // entered at min * inv - lo_off (positive direction) or max * inv - hi_off (negative).
+    alignas(64) float lo_off_x[kPacketWidth], lo_off_y[kPacketWidth], lo_off_z[kPacketWidth];
+    alignas(64) float hi_off_x[kPacketWidth], hi_off_y[kPacketWidth], hi_off_z[kPacketWidth];
+    // Closest hit: the nearest hit so far (t, file index). Any hit: t_max.
+    alignas(64) float best_t[kPacketWidth], best_id[kPacketWidth];
+};
+
+struct BvhStacks {
+    std::uint32_t packet_node[kBvhStackSize];
+    std::uint8_t packet_mask[kBvhStackSize];
+    std::uint32_t ray_node[kBvhStackSize];
+};
+
+// The widening of every box for rays from `o` (the margin derived above).
+template <class F>
+F bvh_margin(const SceneView& s, const V3<F>& o) {
+    const auto far_extent = [](const F& x, float lo, float hi) {
+        return xsimd::max(xsimd::abs(x - F(lo)), xsimd::abs(x - F(hi)));
+    };
+    const F ex = far_extent(o.x, s.bvh_lo[0], s.bvh_hi[0]);
+    const F ey = far_extent(o.y, s.bvh_lo[1], s.bvh_hi[1]);
+    const F ez = far_extent(o.z, s.bvh_lo[2], s.bvh_hi[2]);
+    const F d2 = ex * ex + ey * ey + ez * ez;
+    const F fuzz = F(kBvhFuzz) * (d2 + F(s.bvh_max_r2));
+    const F r_min(sqrtf(s.bvh_min_r2));
+    const F o_max = xsimd::max(xsimd::max(xsimd::abs(o.x), xsimd::abs(o.y)), xsimd::abs(o.z));
+    const F m = (xsimd::sqrt(F(s.bvh_min_r2) + fuzz) - r_min) +
+                F(kBvhSlack) * (xsimd::sqrt(d2) + o_max);
+    return m * F(1.0f + 0x1.0p-10f);  // the rounding of this very computation
+}
+
+template <class F>
+F safe_reciprocal(const F& d) {
+    const F tiny(kBvhTinyDirection);
+    return F(1.0f) / xsimd::select(xsimd::abs(d) < tiny, xsimd::copysign(tiny, d), d);
+}
+
+// Box tests stay finite while (|O| + margin + |box|) * |1/V| does; beyond this (scenes with
+// coordinates past ~1e19, or an overflowing margin) a packet falls back to brute force.
+constexpr float kBvhFiniteLimit = 1e37f;
+
+// Loads a packet's rays into `p`; best_t starts at `t_far` (+inf or t_max), best_id at -1.
+// Returns the lanes whose box tests stay finite (kBvhFiniteLimit).
+template <class F>
+std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* oy, const float* oz,
+                     const float* dx, const float* dy, const float* dz, const float* t_far,
+                     std::uint32_t base, BvhPacket& p) {
+    constexpr std::uint32_t W = F::size;
+    float box_max = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        box_max = fmaxf(box_max, fmaxf(fabsf(s.bvh_lo[a]), fabsf(s.bvh_hi[a])));
+    }
+    std::uint32_t finite = 0;
+    for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
+        const V3<F> o = load3<F>(ox, oy, oz, base + at);
+        const V3<F> d = load3<F>(dx, dy, dz, base + at);
+        store3(o, p.ox, p.oy, p.oz, at);
+        store3(d, p.dx, p.dy, p.dz, at);
+        dot(d, d).store_aligned(p.a + at);
+        const V3<F> inv{safe_reciprocal(d.x), safe_reciprocal(d.y), safe_reciprocal(d.z)};
+        store3(inv, p.inv_x, p.inv_y, p.inv_z, at);
+        const F m = bvh_margin(s, o);
+        const F o_max =
+            xsimd::max(xsimd::max(xsimd::abs(o.x), xsimd::abs(o.y)), xsimd::abs(o.z));
+        const F inv_max = xsimd::max(xsimd::max(xsimd::abs(inv.x), xsimd::abs(inv.y)),
+                                     xsimd::abs(inv.z));
+        finite |= mask_bits<F>((o_max + m + F(box_max)) * inv_max < F(kBvhFiniteLimit)) << at;
+        const V3<F> lo{o.x + m, o.y + m, o.z + m}, hi{o.x - m, o.y - m, o.z - m};
+        store3(hadamard(lo, inv), p.lo_off_x, p.lo_off_y, p.lo_off_z, at);
+        store3(hadamard(hi, inv), p.hi_off_x, p.hi_off_y, p.hi_off_z, at);
+        (t_far ? F::load_aligned(t_far + base + at) : F(kInf)).store_aligned(p.best_t + at);
+        F(-1.0f).store_aligned(p.best_id + at);
+    }
+    return finite;
+}
+
+inline std::uint32_t leaf_first(std::uint32_t ref) {
+    return (ref & ~kBvhLeafBit) >> kBvhLeafCountBits;
+}
+inline std::uint32_t leaf_count(std::uint32_t ref) {
+    return (ref & ((1u << kBvhLeafCountBits) - 1u)) + 1u;
+}
+
+// ---------------------------------------------------------------------------------------
+// Single ray: one ray against the 8 children of a node at once.
+
+// The ray of one lane, with its near and far planes chosen by its direction's signs.
+template <class F>
+struct BvhRay {
+    using Plane = const float (BvhNode8::*)[kBvhWidth];
+    Plane near_x, near_y, near_z, far_x, far_y, far_z;
+    F inv_x, inv_y, inv_z;
+    F near_off_x, near_off_y, near_off_z, far_off_x, far_off_y, far_off_z;
+    V3<F> o, d;
+    F a;
+
+    BvhRay(const BvhPacket& p, std::uint32_t lane) {
+        const auto axis = [&](float inv, float lo_off, float hi_off, Plane& near, Plane& far,
+                              F& near_off, F& far_off, Plane min, Plane max) {
+            // Positive direction: enter through min - m, leave through max + m.
+            const bool positive = inv >= 0.0f;
+            near = positive ? min : max;
+            far = positive ? max : min;
+            near_off = F(positive ? lo_off : hi_off);
+            far_off = F(positive ? hi_off : lo_off);
+        };
+        axis(p.inv_x[lane], p.lo_off_x[lane], p.hi_off_x[lane], near_x, far_x, near_off_x,
+             far_off_x, &BvhNode8::min_x, &BvhNode8::max_x);
+        axis(p.inv_y[lane], p.lo_off_y[lane], p.hi_off_y[lane], near_y, far_y, near_off_y,
+             far_off_y, &BvhNode8::min_y, &BvhNode8::max_y);
+        axis(p.inv_z[lane], p.lo_off_z[lane], p.hi_off_z[lane], near_z, far_z, near_off_z,
+             far_off_z, &BvhNode8::min_z, &BvhNode8::max_z);
+        inv_x = F(p.inv_x[lane]), inv_y = F(p.inv_y[lane]), inv_z = F(p.inv_z[lane]);
+        o = {F(p.ox[lane]), F(p.oy[lane]), F(p.oz[lane])};
+        d = {F(p.dx[lane]), F(p.dy[lane]), F(p.dz[lane])};
+        a = F(p.a[lane]);
+    }
+
+    // Bit i set when child i's widened box meets the ray on [t_near, t_far]; entry[i] is
+    // where the ray enters it.
+    std::uint32_t test(const BvhNode8& n, const F& t_near, const F& t_far, float* entry) const {
+        constexpr std::uint32_t W = F::size;
+        std::uint32_t bits = 0;
+        for (std::uint32_t at = 0; at < kBvhWidth; at += W) {
+            const F tnx = xsimd::fms(F::load_aligned((n.*near_x) + at), inv_x, near_off_x);
+            const F tny = xsimd::fms(F::load_aligned((n.*near_y) + at), inv_y, near_off_y);
+            const F tnz = xsimd::fms(F::load_aligned((n.*near_z) + at), inv_z, near_off_z);
+            const F tfx = xsimd::fms(F::load_aligned((n.*far_x) + at), inv_x, far_off_x);
+            const F tfy = xsimd::fms(F::load_aligned((n.*far_y) + at), inv_y, far_off_y);
+            const F tfz = xsimd::fms(F::load_aligned((n.*far_z) + at), inv_z, far_off_z);
+            const F tn = xsimd::max(xsimd::max(tnx, tny), xsimd::max(tnz, t_near));
+            const F tf = xsimd::min(xsimd::min(tfx, tfy), xsimd::min(tfz, t_far));
+            bits |= mask_bits<F>(tn <= tf) << at;
+            tn.store_aligned(entry + at);
+        }
+        return bits;
+    }
+};
+
+// Children of `n` in `bits`, nearest first by `entry`: the nearest is returned, the rest
+// pushed farthest first.
+inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
+                                   std::uint32_t* stack, std::uint32_t& sp) {
+    std::uint32_t order[kBvhWidth];
+    std::uint32_t count = 0;
+    while (bits != 0) {
+        const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
+        bits &= bits - 1;
+        std::uint32_t k = count++;
+        for (; k > 0 && entry[order[k - 1]] < entry[j]; --k) order[k] = order[k - 1];
+        order[k] = j;  // descending entry
+    }
+    for (std::uint32_t k = 0; k + 1 < count; ++k) stack[sp++] = n.child[order[k]];
+    return n.child[order[count - 1]];
+}
+
+// Closest hit of lane `lane` of `p` in the subtree `start`, on (t_min, best_t].
+template <class Arch>
+void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::uint32_t start,
+                     float t_min, std::uint32_t* stack) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    const BvhRay<F> ray(p, lane);
+    const F tmin(t_min), zero(0.0f);
+    float& best_t = p.best_t[lane];
+    float& best_id = p.best_id[lane];
+    alignas(64) float entry[kBvhWidth];
+    std::uint32_t sp = 0, node = start;
+    for (;;) {
+        if ((node & kBvhLeafBit) == 0) {
+            const BvhNode8& n = s.bvh_nodes[node];
+            const std::uint32_t bits = ray.test(n, tmin, F(best_t), entry);
+            if (bits != 0) {
+                node = push_children(n, bits, entry, stack, sp);
+                continue;
+            }
+        } else {
+            // Up to 8 spheres against the ray, the brute-force arithmetic per lane.
+            const std::uint32_t first = leaf_first(node), count = leaf_count(node);
+            for (std::uint32_t at = 0; at < count; at += W) {
+                const std::uint32_t i = first + at;
+                const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
+                              F::load_unaligned(s.bvh_cz + i)};
+                const V3<F> oc = sub(ray.o, c);
+                const F b = dot(oc, ray.d);
+                const F cc = dot(oc, oc) - F::load_unaligned(s.bvh_r2 + i);
+                const F disc = b * b - ray.a * cc;
+                const auto live = live_lanes<F>(at, count) && disc >= zero;
+                if (xsimd::none(live)) continue;
+                const F root = xsimd::sqrt(disc);
+                const F t_near = (-b - root) / ray.a;
+                const F t_far = (-b + root) / ray.a;
+                // The sphere's candidate is its first root above t_min.
+                const F t = xsimd::select(t_near > tmin, t_near, t_far);
+                std::uint32_t bits = mask_bits<F>(live && t > tmin && t <= F(best_t));
+                if (bits == 0) continue;
+                alignas(64) float ts[W];
+                t.store_aligned(ts);
+                for (; bits != 0; bits &= bits - 1) {
+                    const auto l = static_cast<std::uint32_t>(__builtin_ctz(bits));
+                    const auto id = static_cast<float>(s.bvh_object[i + l]);
+                    if (ts[l] < best_t || (ts[l] == best_t && id < best_id))
+                        best_t = ts[l], best_id = id;
+                }
+            }
+        }
+        if (sp == 0) return;
+        node = stack[--sp];
+    }
+}
+
+// Whether lane `lane` of `p` hits a sphere of the subtree `start` on (0, t_max).
+template <class Arch>
+bool bvh_occluded_ray(const SceneView& s, const BvhPacket& p, std::uint32_t lane,
+                      std::uint32_t start, std::uint32_t* stack) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    const BvhRay<F> ray(p, lane);
+    const F zero(0.0f), t_max(p.best_t[lane]);
+    alignas(64) float entry[kBvhWidth];
+    std::uint32_t sp = 0, node = start;
+    for (;;) {
+        if ((node & kBvhLeafBit) == 0) {
+            const BvhNode8& n = s.bvh_nodes[node];
+            const std::uint32_t bits = ray.test(n, zero, t_max, entry);
+            if (bits != 0) {
+                node = push_children(n, bits, entry, stack, sp);
+                continue;
+            }
+        } else {
+            const std::uint32_t first = leaf_first(node), count = leaf_count(node);
+            for (std::uint32_t at = 0; at < count; at += W) {
+                const std::uint32_t i = first + at;
+                const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
+                              F::load_unaligned(s.bvh_cz + i)};
+                const V3<F> oc = sub(ray.o, c);
+                const F b = dot(oc, ray.d);
+                const F cc = dot(oc, oc) - F::load_unaligned(s.bvh_r2 + i);
+                const F disc = b * b - ray.a * cc;
+                const auto live = live_lanes<F>(at, count) && disc >= zero;
+                if (xsimd::none(live)) continue;
+                const F root = xsimd::sqrt(disc);
+                const F t_near = (-b - root) / ray.a;
+                const F t_far = (-b + root) / ray.a;
+                if (xsimd::any(live && ((t_near > zero && t_near < t_max) ||
+                                        (t_far > zero && t_far < t_max))))
+                    return true;
+            }
+        }
+        if (sp == 0) return false;
+        node = stack[--sp];
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Packets: the 8 rays against one child box at a time.
+
+// Lanes of `mask` whose widened box of child j meets the ray on [t_near, t_far[lane]];
+// entry of the packet's representative lane `rep` in `key`.
+template <class F>
+std::uint32_t packet_child_test(const BvhNode8& n, std::uint32_t j, const BvhPacket& p,
+                                const F& t_near, const float* t_far, std::uint32_t rep,
+                                float& key) {
+    constexpr std::uint32_t W = F::size;
+    const F min_x(n.min_x[j]), max_x(n.max_x[j]), min_y(n.min_y[j]), max_y(n.max_y[j]);
+    const F min_z(n.min_z[j]), max_z(n.max_z[j]);
+    std::uint32_t bits = 0;
+    alignas(64) float entry[kPacketWidth];
+    for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
+        const F ix = F::load_aligned(p.inv_x + at), iy = F::load_aligned(p.inv_y + at),
+                iz = F::load_aligned(p.inv_z + at);
+        // Either slab plane may be the near one (lanes differ in sign): sort per lane.
+        const F ax = xsimd::fms(min_x, ix, F::load_aligned(p.lo_off_x + at));
+        const F bx = xsimd::fms(max_x, ix, F::load_aligned(p.hi_off_x + at));
+        const F ay = xsimd::fms(min_y, iy, F::load_aligned(p.lo_off_y + at));
+        const F by = xsimd::fms(max_y, iy, F::load_aligned(p.hi_off_y + at));
+        const F az = xsimd::fms(min_z, iz, F::load_aligned(p.lo_off_z + at));
+        const F bz = xsimd::fms(max_z, iz, F::load_aligned(p.hi_off_z + at));
+        const F tn = xsimd::max(xsimd::max(xsimd::min(ax, bx), xsimd::min(ay, by)),
+                                xsimd::max(xsimd::min(az, bz), t_near));
+        const F tf = xsimd::min(xsimd::min(xsimd::max(ax, bx), xsimd::max(ay, by)),
+                                xsimd::min(xsimd::max(az, bz), F::load_aligned(t_far + at)));
+        bits |= mask_bits<F>(tn <= tf) << at;
+        tn.store_aligned(entry + at);
+    }
+    key = entry[rep];
+    return bits;
+}
+
+// Pushes the children of `n` that some lane of `mask` enters, nearest (along the
+// representative lane) on top.
+template <class F>
+void push_packet_children(const BvhNode8& n, const BvhPacket& p, std::uint32_t mask,
+                          const F& t_near, const float* t_far, BvhStacks& st,
+                          std::uint32_t& sp) {
+    const auto rep = static_cast<std::uint32_t>(__builtin_ctz(mask));
+    std::uint32_t ref[kBvhWidth], lanes[kBvhWidth];
+    float key[kBvhWidth];
+    std::uint32_t count = 0;
+    for (std::uint32_t j = 0; j < kBvhWidth && n.child[j] != kBvhEmpty; ++j) {
+        float k;
+        const std::uint32_t bits = packet_child_test(n, j, p, t_near, t_far, rep, k) & mask;
+        if (bits == 0) continue;
+        std::uint32_t at = count++;
+        for (; at > 0 && key[at - 1] < k; --at) {  // descending: the nearest pushed last
+            ref[at] = ref[at - 1], lanes[at] = lanes[at - 1], key[at] = key[at - 1];
+        }
+        ref[at] = n.child[j], lanes[at] = bits, key[at] = k;
+    }
+    for (std::uint32_t k = 0; k < count; ++k) {
+        st.packet_node[sp] = ref[k];
+        st.packet_mask[sp++] = static_cast<std::uint8_t>(lanes[k]);
+    }
+}
+
+// Closest hits of the packet `p` (lanes `live`) among the BVH's spheres.
+template <class Arch>
+void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, float t_min,
+                        BvhStacks& st) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    constexpr std::uint32_t K = kPacketWidth / W;
+    const F tmin(t_min), zero(0.0f);
+    std::uint32_t sp = 0;
+    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
+    while (sp > 0) {
+        --sp;
+        const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp];
+        if (static_cast<std::uint32_t>(__builtin_popcount(mask)) < s.bvh_packet_min_lanes) {
+            for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1)
+                bvh_closest_ray<Arch>(s, p, static_cast<std::uint32_t>(__builtin_ctz(bits)),
+                                      node, t_min, st.ray_node);
+            continue;
+        }
+        if ((node & kBvhLeafBit) == 0) {
+            push_packet_children(s.bvh_nodes[node], p, mask, tmin, p.best_t, st, sp);
+            continue;
+        }
+        // A leaf: each sphere broadcast against the packet, as the brute-force kernel does,
+        // with ties to the lower file index.
+        V3<F> o[K], d[K];
+        F a[K], best_t[K], best_id[K];
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = k * W;
+            o[k] = load3<F>(p.ox, p.oy, p.oz, at);
+            d[k] = load3<F>(p.dx, p.dy, p.dz, at);
+            a[k] = F::load_aligned(p.a + at);
+            best_t[k] = F::load_aligned(p.best_t + at);
+            best_id[k] = F::load_aligned(p.best_id + at);
+        }
+        const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
+        for (std::uint32_t i = first; i < end; ++i) {
+            const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
+            const F r2(s.bvh_r2[i]);
+            F b[K], disc[K];
+            auto any_root = zero != zero;
+            for (std::uint32_t k = 0; k < K; ++k) {
+                const V3<F> oc = sub(o[k], c);
+                b[k] = dot(oc, d[k]);
+                const F cc = dot(oc, oc) - r2;
+                disc[k] = b[k] * b[k] - a[k] * cc;
+                any_root = any_root || disc[k] >= zero;
+            }
+            if (xsimd::none(any_root)) continue;
+            const F id(static_cast<float>(s.bvh_object[i]));
+            for (std::uint32_t k = 0; k < K; ++k) {
+                const F root = xsimd::sqrt(disc[k]);
+                const F t_near = (-b[k] - root) / a[k];
+                const F t_far = (-b[k] + root) / a[k];
+                const F t = xsimd::select(t_near > tmin, t_near, t_far);
+                const auto hit =
+                    t > tmin && (t < best_t[k] || (t == best_t[k] && id < best_id[k]));
+                best_t[k] = xsimd::select(hit, t, best_t[k]);
+                best_id[k] = xsimd::select(hit, id, best_id[k]);
+            }
+        }
+        for (std::uint32_t k = 0; k < K; ++k) {
+            best_t[k].store_aligned(p.best_t + k * W);
+            best_id[k].store_aligned(p.best_id + k * W);
+        }
+    }
+}
+
+// Sets bit i of the result for each lane of `live` that a sphere occludes on (0, t_max).
+template <class Arch>
+std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::uint32_t live,
+                                  BvhStacks& st) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    constexpr std::uint32_t K = kPacketWidth / W;
+    const F zero(0.0f);
+    std::uint32_t done = 0, sp = 0;
+    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
+    while (sp > 0 && done != live) {
+        --sp;
+        const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp] & ~done;
+        if (mask == 0) continue;
+        if (static_cast<std::uint32_t>(__builtin_popcount(mask)) < s.bvh_packet_min_lanes) {
+            for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1) {
+                const auto lane = static_cast<std::uint32_t>(__builtin_ctz(bits));
+                if (bvh_occluded_ray<Arch>(s, p, lane, node, st.ray_node)) done |= 1u << lane;
+            }
+            continue;
+        }
+        if ((node & kBvhLeafBit) == 0) {
+            push_packet_children(s.bvh_nodes[node], p, mask, zero, p.best_t, st, sp);
+            continue;
+        }
+        V3<F> o[K], d[K];
+        F a[K], t_max[K];
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = k * W;
+            o[k] = load3<F>(p.ox, p.oy, p.oz, at);
+            d[k] = load3<F>(p.dx, p.dy, p.dz, at);
+            a[k] = F::load_aligned(p.a + at);
+            t_max[k] = F::load_aligned(p.best_t + at);
+        }
+        const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
+        for (std::uint32_t i = first; i < end && (done & mask) != mask; ++i) {
+            const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
+            const F r2(s.bvh_r2[i]);
+            for (std::uint32_t k = 0; k < K; ++k) {
+                const V3<F> oc = sub(o[k], c);
+                const F b = dot(oc, d[k]);
+                const F cc = dot(oc, oc) - r2;
+                const F disc = b * b - a[k] * cc;
+                if (xsimd::none(disc >= zero)) continue;
+                const F root = xsimd::sqrt(disc);
+                const F t_near = (-b - root) / a[k];
+                const F t_far = (-b + root) / a[k];
+                const auto hit =
+                    (t_near > zero && t_near < t_max[k]) || (t_far > zero && t_far < t_max[k]);
+                done |= (mask_bits<F>(hit) << (k * W)) & mask;
+            }
+        }
+    }
+    return done;
+}
+
+// Lanes [base, base + 8) below count, as bits.
+inline std::uint32_t live_bits(std::uint32_t base, std::uint32_t count) {
+    const std::uint32_t left = count - base;
+    return left >= kPacketWidth ? (1u << kPacketWidth) - 1u : (1u << left) - 1u;
+}
+
+// ---------------------------------------------------------------------------------------
+// The kernel table's entry points: the BVH when the scene view has one, else brute force.
+
+template <class Arch>
+void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count, float t_min,
+                 const HitStream& hits) {
+    if (s.bvh_nodes == nullptr) return closest_hit_all<Arch>(s, rays, count, t_min, hits);
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    BvhPacket p;
+    BvhStacks st;
+    const F tmin(t_min);
+    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+        const std::uint32_t live = live_bits(base, count);
+        if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
+                                nullptr, base, p) &
+             live) != live) {
+            // Box tests would overflow: this packet against every sphere.
+            const RayStream one{rays.ox + base, rays.oy + base, rays.oz + base,
+                                rays.dx + base, rays.dy + base, rays.dz + base,
+                                rays.wr + base, rays.wg + base, rays.wb + base,
+                                rays.pixel + base};
+            closest_hit_all<Arch>(s, one, count - base < kPacketWidth ? count - base : kPacketWidth,
+                                  t_min, HitStream{hits.t + base, hits.object + base});
+            continue;
+        }
+        bvh_closest_packet<Arch>(s, p, live, t_min, st);
+        // Planes stay outside the tree.
+        for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
+            F best_t = F::load_aligned(p.best_t + at), best_id = F::load_aligned(p.best_id + at);
+            closest_planes(s, load3<F>(p.ox, p.oy, p.oz, at), load3<F>(p.dx, p.dy, p.dz, at),
+                           tmin, best_t, best_id);
+            best_t.store_aligned(hits.t + base + at);
+            xsimd::to_int(best_id).store_aligned(hits.object + base + at);  // ids < 2^24
+        }
+    }
+}
+
+template <class Arch>
+void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
+             std::uint32_t* occluded) {
+    if (s.bvh_nodes == nullptr) return any_hit_all<Arch>(s, rays, count, occluded);
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    BvhPacket p;
+    BvhStacks st;
+    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+        const std::uint32_t live = live_bits(base, count);
+        if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
+                                rays.t_max, base, p) &
+             live) != live) {
+            const ShadowStream one{rays.ox + base,     rays.oy + base,     rays.oz + base,
+                                   rays.dx + base,     rays.dy + base,     rays.dz + base,
+                                   rays.t_max + base,  rays.term_r + base, rays.term_g + base,
+                                   rays.term_b + base, rays.parent + base};
+            any_hit_all<Arch>(s, one, count - base < kPacketWidth ? count - base : kPacketWidth,
+                              occluded + base);
+            continue;
+        }
+        // Planes first: a lane they occlude needs no traversal.
+        std::uint32_t done = 0;
+        for (std::uint32_t at = 0; at < kPacketWidth; at += W)
+            done |= mask_bits<F>(any_plane(s, load3<F>(p.ox, p.oy, p.oz, at),
+                                           load3<F>(p.dx, p.dy, p.dz, at),
+                                           F::load_aligned(p.best_t + at)))
+                    << at;
+        done |= bvh_occluded_packet<Arch>(s, p, live & ~done, st);
+        for (std::uint32_t i = 0; i < kPacketWidth; ++i) occluded[base + i] = (done >> i) & 1u;
+    }
+}
+
+}  // namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE

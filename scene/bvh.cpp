@@ -1,0 +1,501 @@
+// The sphere BVH builder: binned SAH (Wald 2007, "On fast construction of SAH-based
+// bounding volume hierarchies") on a binary tree built in parallel over subtrees, then
+// collapsed into 8-wide nodes (Wald et al. 2008, "Getting rid of packets"; embree's
+// BVH8 collapse: open the child with the largest surface area until 8 children).
+//
+// Determinism: every decision depends only on the spheres of a subtree and its place in
+// the tree. Binning reduces boxes with min/max and counts with integer sums (both exact,
+// so any TBB split gives the same bins); partitions are std::partition on one range; each
+// binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
+// preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
+// depends on which thread got there first; the 8-wide collapse runs serially in preorder.
+
+#include "scene/bvh.h"
+
+#include <emmintrin.h>
+#include <math.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+namespace octray {
+
+const char* accel_name(Accel accel) {
+    switch (accel) {
+        case Accel::automatic:
+            return "auto";
+        case Accel::bvh:
+            return "bvh";
+        case Accel::none:
+            return "none";
+    }
+    return "?";
+}
+
+std::optional<Accel> parse_accel(std::string_view name) {
+    for (Accel a : {Accel::automatic, Accel::bvh, Accel::none})
+        if (name == accel_name(a)) return a;
+    return std::nullopt;
+}
+
+bool accel_uses_bvh(Accel accel, std::uint32_t sphere_count) {
+    switch (accel) {
+        case Accel::automatic:
+            return sphere_count >= kBvhAutoMinSpheres;
+        case Accel::bvh:
+            return sphere_count > 0;
+        case Accel::none:
+            return false;
+    }
+    return false;
+}
+
+std::size_t SphereBvh::memory_bytes() const {
+    return nodes.size() * sizeof(BvhNode8) +
+           cx.size() * (sizeof(float) * 4 + sizeof(std::uint32_t));
+}
+
+double SphereBvh::bytes_per_sphere() const {
+    return sphere_count > 0 ? static_cast<double>(memory_bytes()) / sphere_count : 0.0;
+}
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Binned SAH: 16 bins per axis (Wald 2007 found 16-32 as good as a full sweep).
+constexpr int kBins = 16;
+// A binary subtree becomes a leaf when the SAH prefers it and it holds at most this many
+// spheres (a leaf is one 8-wide test against one ray).
+constexpr std::uint32_t kMaxLeafSize = kBvhWidth;
+// SAH costs of a node visit and of one sphere test.
+constexpr float kTraversalCost = 1.0f;
+constexpr float kIntersectionCost = 0.25f;
+// Below this many spheres a subtree (or a binning pass) runs in one task.
+constexpr std::uint32_t kParallelSubtree = 4096;
+constexpr std::uint32_t kParallelBinning = 1u << 15;
+// Beyond this binary depth, subtrees are split at the middle index: the depth (and so the
+// kernels' traversal stack) stays bounded whatever the spheres' layout.
+constexpr std::uint32_t kMaxSahDepth = 48;
+
+// Boxes and primitive references in SSE registers (SSE2 is baseline x86-64; this file gets
+// no ISA flags): growing a box is one min and one max, binning one center three ways is a
+// handful of instructions (embree's binned builder does the same).
+struct Box {
+    __m128 lo = _mm_set1_ps(kInf);
+    __m128 hi = _mm_set1_ps(-kInf);
+
+    void grow(const Box& b) {
+        lo = _mm_min_ps(lo, b.lo);
+        hi = _mm_max_ps(hi, b.hi);
+    }
+    void grow(__m128 p) {
+        lo = _mm_min_ps(lo, p);
+        hi = _mm_max_ps(hi, p);
+    }
+    float lo_at(int a) const { return lane(lo, a); }
+    float hi_at(int a) const { return lane(hi, a); }
+    // Half the surface area; 0 for an empty box.
+    float half_area() const {
+        alignas(16) float d[4];
+        _mm_store_ps(d, _mm_sub_ps(hi, lo));
+        if (!(d[0] >= 0.0f)) return 0.0f;
+        return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+    }
+    static float lane(__m128 v, int a) {
+        alignas(16) float f[4];
+        _mm_store_ps(f, v);
+        return f[a];
+    }
+};
+
+// A sphere as the builder sees it: its conservative box; the w lanes hold the sphere's
+// index as a float (exact: at most 2^24 spheres), which min/max carry along harmlessly.
+struct PrimRef {
+    Box box;
+    __m128 center() const { return _mm_mul_ps(_mm_add_ps(box.lo, box.hi), _mm_set1_ps(0.5f)); }
+    std::uint32_t sphere() const { return static_cast<std::uint32_t>(Box::lane(box.lo, 3)); }
+};
+
+// Bounds of a range: the spheres' boxes and their centers.
+struct RangeBounds {
+    Box box, centers;
+    void grow(const PrimRef& p) {
+        box.grow(p.box);
+        centers.grow(p.center());
+    }
+    void grow(const RangeBounds& r) {
+        box.grow(r.box);
+        centers.grow(r.centers);
+    }
+};
+
+// A binary node. mid == 0 marks a leaf (an inner node's mid lies above its begin >= 0).
+// No initialisers: the slot array is allocated untouched and filled by the build tasks.
+struct BinaryNode {
+    float lo[3], hi[3];
+    std::uint32_t mid;
+};
+
+RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e) {
+    const auto serial = [refs](std::uint32_t first, std::uint32_t last, RangeBounds r) {
+        for (std::uint32_t i = first; i < last; ++i) r.grow(refs[i]);
+        return r;
+    };
+    if (e - b < kParallelBinning) return serial(b, e, RangeBounds{});
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(b, e, kParallelBinning / 4), RangeBounds{},
+        [&](const tbb::blocked_range<std::uint32_t>& r, RangeBounds init) {
+            return serial(r.begin(), r.end(), init);
+        },
+        [](RangeBounds x, const RangeBounds& y) {
+            x.grow(y);
+            return x;
+        });
+}
+
+// Maps a center to its bin along each axis; the partition uses the same function, so it
+// agrees with the bins' counts exactly.
+struct BinMapping {
+    __m128 lo;
+    __m128 scale;  // 0 on an axis without extent (and in w)
+    int axis_has_extent[3];
+    void bins(__m128 center, std::int32_t out[4]) const {
+        __m128 k = _mm_mul_ps(_mm_sub_ps(center, lo), scale);
+        k = _mm_min_ps(_mm_max_ps(k, _mm_setzero_ps()), _mm_set1_ps(kBins - 1));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_cvttps_epi32(k));
+    }
+};
+
+// Per axis and bin: the spheres' boxes, their centers' box (so that the children's bounds
+// come out of the bins, without another pass) and the count.
+struct Bins {
+    RangeBounds bounds[3][kBins];
+    std::uint32_t count[3][kBins] = {};
+
+    void add(const PrimRef& p, const BinMapping& m) {
+        std::int32_t k[4];
+        const __m128 center = p.center();
+        m.bins(center, k);
+        for (int a = 0; a < 3; ++a) {
+            bounds[a][k[a]].box.grow(p.box);
+            bounds[a][k[a]].centers.grow(center);
+            ++count[a][k[a]];
+        }
+    }
+    void merge(const Bins& o) {
+        for (int a = 0; a < 3; ++a)
+            for (int k = 0; k < kBins; ++k) {
+                bounds[a][k].grow(o.bounds[a][k]);
+                count[a][k] += o.count[a][k];
+            }
+    }
+};
+
+Bins bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m) {
+    if (e - b < kParallelBinning) {
+        Bins bins;
+        for (std::uint32_t i = b; i < e; ++i) bins.add(refs[i], m);
+        return bins;
+    }
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(b, e, kParallelBinning / 4), Bins{},
+        [&](const tbb::blocked_range<std::uint32_t>& r, Bins bins) {
+            for (std::uint32_t i = r.begin(); i < r.end(); ++i) bins.add(refs[i], m);
+            return bins;
+        },
+        [](Bins x, const Bins& y) {
+            x.merge(y);
+            return x;
+        });
+}
+
+struct Split {
+    int axis = -1;
+    int bin = 0;  // the left side holds bins [0, bin]
+    float cost = kInf;
+    RangeBounds left, right;
+};
+
+// The cheapest SAH split over every axis and bin boundary (ties: the lower axis, then
+// the lower bin).
+Split best_split(const Bins& bins, const BinMapping& m) {
+    Split best;
+    for (int a = 0; a < 3; ++a) {
+        if (!m.axis_has_extent[a]) continue;
+        float right_area[kBins];
+        std::uint32_t right_count[kBins];
+        Box acc;
+        std::uint32_t n = 0;
+        for (int k = kBins - 1; k > 0; --k) {
+            acc.grow(bins.bounds[a][k].box);
+            n += bins.count[a][k];
+            right_area[k] = acc.half_area();
+            right_count[k] = n;
+        }
+        Box left;
+        std::uint32_t nl = 0;
+        for (int k = 0; k < kBins - 1; ++k) {
+            left.grow(bins.bounds[a][k].box);
+            nl += bins.count[a][k];
+            const std::uint32_t nr = right_count[k + 1];
+            if (nl == 0 || nr == 0) continue;
+            const float cost = left.half_area() * static_cast<float>(nl) +
+                               right_area[k + 1] * static_cast<float>(nr);
+            if (cost < best.cost) {
+                best.axis = a;
+                best.bin = k;
+                best.cost = cost;
+            }
+        }
+    }
+    if (best.axis >= 0)
+        for (int k = 0; k < kBins; ++k)
+            (k <= best.bin ? best.left : best.right).grow(bins.bounds[best.axis][k]);
+    return best;
+}
+
+class Builder {
+  public:
+    Builder(PrimRef* refs, BinaryNode* nodes) : refs_(refs), nodes_(nodes) {}
+
+    // Builds the subtree of primitives [b, e) into slots [slot, slot + 2(e - b) - 1).
+    void build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
+               std::uint32_t depth) {
+        BinaryNode& node = nodes_[slot];
+        for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
+        node.mid = 0;
+        const std::uint32_t n = e - b;
+        if (n == 1) return;
+
+        std::uint32_t mid = 0;
+        RangeBounds left, right;
+        if (depth < kMaxSahDepth) {
+            BinMapping m{};
+            alignas(16) float scale[4] = {0, 0, 0, 0};
+            for (int a = 0; a < 3; ++a) {
+                const float extent = rb.centers.hi_at(a) - rb.centers.lo_at(a);
+                // Slightly fewer than kBins per extent, so the top center maps to the
+                // last bin rather than past it (clamped anyway).
+                scale[a] = extent > 0.0f ? (static_cast<float>(kBins) * 0.99999f) / extent : 0.0f;
+                if (!(scale[a] < kInf)) scale[a] = 0.0f;  // denormal extent
+                m.axis_has_extent[a] = scale[a] > 0.0f;
+            }
+            m.lo = rb.centers.lo;
+            m.scale = _mm_load_ps(scale);
+            const Split split = best_split(bin_range(refs_, b, e, m), m);
+            const float area = rb.box.half_area();
+            const float leaf_cost = kIntersectionCost * static_cast<float>(n);
+            const float split_cost =
+                split.axis < 0 ? kInf
+                : area > 0.0f  ? kTraversalCost + kIntersectionCost * split.cost / area
+                               : kTraversalCost + kIntersectionCost * static_cast<float>(n);
+            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return;
+            if (split.axis >= 0) {
+                const PrimRef* cut =
+                    std::partition(refs_ + b, refs_ + e, [&](const PrimRef& p) {
+                        std::int32_t k[4];
+                        m.bins(p.center(), k);
+                        return k[split.axis] <= split.bin;
+                    });
+                mid = static_cast<std::uint32_t>(cut - refs_);
+                left = split.left;
+                right = split.right;
+            }
+        } else if (n <= kMaxLeafSize) {
+            return;
+        }
+        // Every center in one bin (coincident spheres) or too deep: the middle index.
+        if (mid <= b || mid >= e) {
+            mid = b + n / 2;
+            left = range_bounds(refs_, b, mid);
+            right = range_bounds(refs_, mid, e);
+        }
+        node.mid = mid;
+        const std::uint32_t left_slot = slot + 1, right_slot = slot + 2 * (mid - b);
+        if (n >= kParallelSubtree) {
+            tbb::parallel_invoke([&] { build(left_slot, b, mid, left, depth + 1); },
+                                 [&] { build(right_slot, mid, e, right, depth + 1); });
+        } else {
+            build(left_slot, b, mid, left, depth + 1);
+            build(right_slot, mid, e, right, depth + 1);
+        }
+    }
+
+  private:
+    PrimRef* refs_;
+    BinaryNode* nodes_;
+};
+
+class Collapser {
+  public:
+    Collapser(const BinaryNode* binary, SphereBvh& out) : binary_(binary), out_(out) {}
+
+    std::uint32_t emit(std::uint32_t slot, std::uint32_t b, std::uint32_t e,
+                       std::uint32_t depth) {
+        out_.depth = std::max(out_.depth, depth);
+        struct Child {
+            std::uint32_t slot, b, e;
+        };
+        Child children[kBvhWidth];
+        std::uint32_t count = 0;
+        const auto open = [&](const Child& c, Child& first, Child& second) {
+            const std::uint32_t mid = binary_[c.slot].mid;
+            first = {c.slot + 1, c.b, mid};
+            second = {c.slot + 2 * (mid - c.b), mid, c.e};
+        };
+        if (binary_[slot].mid == 0) {
+            children[count++] = {slot, b, e};
+        } else {
+            open({slot, b, e}, children[0], children[1]);
+            count = 2;
+        }
+        // Open the inner child with the largest surface area until there are 8.
+        while (count < kBvhWidth) {
+            int pick = -1;
+            float pick_area = -1.0f;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                if (binary_[children[i].slot].mid == 0) continue;
+                const float area = half_area(children[i].slot);
+                if (area > pick_area) pick = static_cast<int>(i), pick_area = area;
+            }
+            if (pick < 0) break;
+            Child first, second;
+            open(children[pick], first, second);
+            for (std::uint32_t i = count; i > static_cast<std::uint32_t>(pick) + 1; --i)
+                children[i] = children[i - 1];
+            children[pick] = first;
+            children[pick + 1] = second;
+            ++count;
+        }
+
+        const auto index = static_cast<std::uint32_t>(out_.nodes.size());
+        out_.nodes.emplace_back();
+        std::uint32_t refs[kBvhWidth];
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const Child& c = children[i];
+            if (binary_[c.slot].mid == 0) {
+                ++out_.leaf_count;
+                refs[i] = kBvhLeafBit | (c.b << kBvhLeafCountBits) | (c.e - c.b - 1);
+            } else {
+                refs[i] = emit(c.slot, c.b, c.e, depth + 1);
+            }
+        }
+        BvhNode8& node = out_.nodes[index];  // after the recursion: emplace_back moves nodes
+        for (std::uint32_t i = 0; i < kBvhWidth; ++i) {
+            const bool used = i < count;
+            const BinaryNode* bn = used ? &binary_[children[i].slot] : nullptr;
+            node.min_x[i] = used ? bn->lo[0] : kInf, node.max_x[i] = used ? bn->hi[0] : -kInf;
+            node.min_y[i] = used ? bn->lo[1] : kInf, node.max_y[i] = used ? bn->hi[1] : -kInf;
+            node.min_z[i] = used ? bn->lo[2] : kInf, node.max_z[i] = used ? bn->hi[2] : -kInf;
+            node.child[i] = used ? refs[i] : kBvhEmpty;
+        }
+        return index;
+    }
+
+  private:
+    float half_area(std::uint32_t slot) const {
+        const BinaryNode& b = binary_[slot];
+        const float dx = b.hi[0] - b.lo[0], dy = b.hi[1] - b.lo[1], dz = b.hi[2] - b.lo[2];
+        return dx * dy + dy * dz + dz * dx;
+    }
+
+    const BinaryNode* binary_;
+    SphereBvh& out_;
+};
+
+}  // namespace
+
+SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::uint32_t n = spheres.count;
+    // Sphere indices travel as exact floats through the build (as hit ids do in the
+    // kernels): at most 2^24, the most objects a compiled scene has.
+    if (n > (1u << 24)) throw std::invalid_argument("a sphere BVH holds at most 2^24 spheres");
+    SphereBvh bvh;
+    bvh.sphere_count = n;
+    if (n == 0) {
+        bvh.build_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return bvh;
+    }
+
+    // Each sphere's box c ± sqrt(r2), computed in double and rounded outwards: it holds
+    // every point of the sphere the kernels intersect (which knows only r2).
+    std::unique_ptr<PrimRef[]> refs(new PrimRef[n]);
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) {
+                          // c -+ r rounded outwards in float: sqrtf is exact to half an
+                          // ulp, the factor and the relative and absolute steps cover
+                          // every rounding after it.
+                          const __m128 grow_r = _mm_set1_ps(1.0f + 0x1.0p-21f);
+                          const __m128 rel = _mm_set1_ps(0x1.0p-21f);
+                          const __m128 abs_mask =
+                              _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+                          const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
+                          for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                              const auto index = static_cast<float>(i);
+                              const __m128 c =
+                                  _mm_setr_ps(spheres.cx[i], spheres.cy[i], spheres.cz[i], 0.0f);
+                              const __m128 radius =
+                                  _mm_mul_ps(_mm_set1_ps(sqrtf(spheres.r2[i])), grow_r);
+                              __m128 lo = _mm_sub_ps(c, radius), hi = _mm_add_ps(c, radius);
+                              const auto step = [&](__m128 v) {
+                                  return _mm_add_ps(_mm_mul_ps(_mm_and_ps(v, abs_mask), rel),
+                                                    tiny);
+                              };
+                              lo = _mm_sub_ps(lo, step(lo));
+                              hi = _mm_add_ps(hi, step(hi));
+                              alignas(16) float l[4], h[4];
+                              _mm_store_ps(l, lo);
+                              _mm_store_ps(h, hi);
+                              refs[i].box.lo = _mm_setr_ps(l[0], l[1], l[2], index);
+                              refs[i].box.hi = _mm_setr_ps(h[0], h[1], h[2], index);
+                          }
+                      });
+
+    // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
+    std::unique_ptr<BinaryNode[]> binary(new BinaryNode[2 * static_cast<std::size_t>(n) - 1]);
+    Builder(refs.get(), binary.get()).build(0, 0, n, range_bounds(refs.get(), 0, n), 0);
+    const Box root{_mm_setr_ps(binary[0].lo[0], binary[0].lo[1], binary[0].lo[2], 0.0f),
+                   _mm_setr_ps(binary[0].hi[0], binary[0].hi[1], binary[0].hi[2], 0.0f)};
+
+    // 8-wide nodes, preorder.
+    bvh.nodes.reserve(n / 4 + 1);
+    Collapser(binary.get(), bvh).emit(0, 0, n, 1);
+    binary.reset();
+
+    // The spheres in leaf order, padded with a packet of never-hit entries.
+    const std::uint32_t padded = n + kBvhWidth;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    bvh.cx.assign(padded, nan), bvh.cy.assign(padded, nan), bvh.cz.assign(padded, nan);
+    bvh.r2.assign(padded, nan), bvh.object.assign(padded, 0u);
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) {
+                          for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                              const std::uint32_t s = refs[i].sphere();
+                              bvh.cx[i] = spheres.cx[s], bvh.cy[i] = spheres.cy[s];
+                              bvh.cz[i] = spheres.cz[s], bvh.r2[i] = spheres.r2[s];
+                              bvh.object[i] = spheres.object[s];
+                          }
+                      });
+
+    for (int a = 0; a < 3; ++a) bvh.lo[a] = root.lo_at(a), bvh.hi[a] = root.hi_at(a);
+    bvh.min_r2 = kInf, bvh.max_r2 = 0.0f;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        bvh.min_r2 = std::min(bvh.min_r2, spheres.r2[i]);
+        bvh.max_r2 = std::max(bvh.max_r2, spheres.r2[i]);
+    }
+    bvh.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return bvh;
+}
+
+}  // namespace octray

@@ -1,0 +1,51 @@
+#pragma once
+// An 8-wide bounding volume hierarchy over a compiled scene's spheres (planes stay outside
+// it: they are unbounded and tested directly). Built by binned SAH on a binary tree, in
+// parallel with TBB over subtrees, then collapsed into 8-wide nodes whose children's boxes
+// are stored in SoA (scene/bvh_node.h). Leaves hold up to 8 spheres, copied into SoA
+// arrays in leaf order (cx, cy, cz, r2, object: the layout the brute-force kernels read).
+//
+// Deterministic: the tree (every byte of it) does not depend on the number of threads.
+// Boxes are conservative: every sphere's box is rounded outwards, so that the box holds
+// the sphere exactly as the kernels' float arithmetic sees it (kernels/README.md,
+// "The BVH").
+
+#include <cstddef>
+#include <cstdint>
+
+#include "core/aligned.h"
+#include "scene/accel.h"
+#include "scene/bvh_node.h"
+#include "scene/compile.h"
+
+namespace octray {
+
+struct SphereBvh {
+    // Node 0 is the root (preorder). Empty when the scene has no spheres.
+    AlignedVector<BvhNode8> nodes;
+    // Spheres in leaf order, padded with kBvhWidth entries that never hit (NaN), so that
+    // a kernel may load 8 entries from any leaf's first sphere.
+    std::uint32_t sphere_count = 0;
+    AlignedVector<float> cx, cy, cz, r2;
+    AlignedVector<std::uint32_t> object;  // the file index, as in CompiledSpheres
+
+    // The root's box (of the spheres, not their centers) and the extreme squared radii:
+    // the kernels derive their rounding margin from them.
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    float min_r2 = 0.0f, max_r2 = 0.0f;
+
+    std::uint32_t leaf_count = 0;
+    std::uint32_t depth = 0;  // levels of 8-wide nodes (root alone: 1)
+    double build_seconds = 0.0;
+
+    // Bytes the BVH holds (nodes and its copy of the spheres), and per sphere.
+    std::size_t memory_bytes() const;
+    double bytes_per_sphere() const;
+};
+
+// Builds the BVH of `spheres` in the calling thread's TBB arena (a tbb::task_arena of N
+// threads limits it to N). Throws std::invalid_argument beyond 2^24 spheres (the most a
+// compiled scene holds).
+SphereBvh build_sphere_bvh(const CompiledSpheres& spheres);
+
+}  // namespace octray

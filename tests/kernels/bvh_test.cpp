@@ -1,0 +1,478 @@
+// The sphere BVH (scene/bvh.h) and its traversal (kernels/bvh_kernels.h).
+// Builder: every sphere in exactly one leaf, leaves of 1-8 spheres, every child box holds
+// its spheres (the exact spheres, in double precision) and its children's boxes, empty
+// slots last and never entered, the same bytes for any thread count.
+// Traversal, under every ISA the CPU runs and with packets, single rays and the switch
+// between them: closest hits equal the scalar reference's (brute force) bit for bit and
+// hit for hit on random rays over random and degenerate scenes (one sphere, all spheres at
+// one point, radii from 1e-6 to 1e3, spheres far apart along one axis, duplicates that tie,
+// planes); any-hit equals the reference's occlusion and agrees with closest hit.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <tbb/task_arena.h>
+#include <vector>
+
+#include "core/aligned.h"
+#include "kernels/dispatch.h"
+#include "render/reference.h"
+#include "scene/bvh.h"
+#include "scene/compile.h"
+
+namespace octray {
+namespace {
+
+using kernels::kPacketWidth;
+
+std::size_t padded(std::size_t n) {
+    return (n + kPacketWidth - 1) / kPacketWidth * kPacketWidth;
+}
+
+Object sphere(Vec3 c, float r) {
+    Object o;
+    o.type = ObjectType::sphere;
+    o.center = c;
+    o.radius = r;
+    return o;
+}
+
+Object plane(Vec3 p, Vec3 n) {
+    Object o;
+    o.type = ObjectType::plane;
+    o.point = p;
+    o.normal = normalize(n);
+    return o;
+}
+
+Scene scene_of(std::vector<Object> objects) {
+    Scene s;
+    s.image = {64, 48, 1};
+    s.materials.push_back({"m", Material{}});
+    s.objects = std::move(objects);
+    return s;
+}
+
+// The scenes every test runs on: name and objects.
+struct NamedScene {
+    std::string name;
+    Scene scene;
+};
+
+std::vector<NamedScene> test_scenes() {
+    std::vector<NamedScene> out;
+    std::mt19937 rng(12345);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), u01(0.0f, 1.0f);
+    {
+        std::vector<Object> o;
+        for (int i = 0; i < 700; ++i)
+            o.push_back(sphere({2 * unit(rng), 2 * unit(rng), 2 * unit(rng)},
+                               0.02f + 0.2f * u01(rng)));
+        out.push_back({"random", scene_of(o)});
+    }
+    out.push_back({"one sphere", scene_of({sphere({0.3f, -0.2f, 0.1f}, 0.7f)})});
+    {
+        std::vector<Object> o;
+        for (int i = 0; i < 40; ++i) o.push_back(sphere({0.5f, 0.5f, 0.5f}, 0.4f));
+        out.push_back({"coincident", scene_of(o)});
+    }
+    {
+        // Radii from 1e-6 to 1e3 (log-uniform), centers spread over a scale to match.
+        std::vector<Object> o;
+        for (int i = 0; i < 400; ++i) {
+            const float r = std::pow(10.0f, -6.0f + 9.0f * u01(rng));
+            o.push_back(sphere({3 * unit(rng), 3 * unit(rng), 3 * unit(rng)}, r));
+        }
+        for (int i = 0; i < 200; ++i)
+            o.push_back(sphere({2 * unit(rng), 2 * unit(rng), 2 * unit(rng)},
+                               std::pow(10.0f, -6.0f + 5.0f * u01(rng))));
+        out.push_back({"radii 1e-6 to 1e3", scene_of(o)});
+    }
+    {
+        // Far apart along x (exponentially), tiny along y and z.
+        std::vector<Object> o;
+        for (int i = 0; i < 300; ++i) {
+            const float x = (i % 2 ? 1.0f : -1.0f) * std::pow(2.0f, 0.1f * i);
+            o.push_back(sphere({x, 1e-3f * unit(rng), 1e-3f * unit(rng)}, 0.5f + u01(rng)));
+        }
+        out.push_back({"far apart along x", scene_of(o)});
+    }
+    {
+        // Duplicates (exact ties between different objects) among planes, in mixed order.
+        std::vector<Object> o;
+        for (int i = 0; i < 150; ++i) {
+            const Object s = sphere({unit(rng), unit(rng), unit(rng)}, 0.1f + 0.3f * u01(rng));
+            o.push_back(s);
+            if (i % 3 == 0) o.push_back(s);
+            if (i % 50 == 0) o.push_back(plane({0, unit(rng), 0}, {unit(rng), 1, unit(rng)}));
+        }
+        out.push_back({"duplicates and planes", scene_of(o)});
+    }
+    {
+        // Coordinates near the float range's end: box tests would overflow, so packets
+        // fall back to brute force; ordinary spheres beside them still go through the tree.
+        std::vector<Object> o;
+        for (int i = 0; i < 60; ++i)
+            o.push_back(sphere({unit(rng), unit(rng), unit(rng)}, 0.1f + 0.2f * u01(rng)));
+        o.push_back(sphere({1e30f, -1e30f, 3e29f}, 1e18f));
+        o.push_back(sphere({-2e30f, 1e29f, 0.0f}, 5e17f));
+        out.push_back({"huge coordinates", scene_of(o)});
+    }
+    {
+        // Tiny spheres far from the rays' origins: the brute force's quadratic rounds
+        // heavily there (its hits are fuzzy).
+        std::vector<Object> o;
+        for (int i = 0; i < 500; ++i)
+            o.push_back(sphere({0.01f * unit(rng), 0.01f * unit(rng), 0.01f * unit(rng)},
+                               1e-6f + 1e-4f * u01(rng)));
+        out.push_back({"tiny cluster", scene_of(o)});
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Builder invariants.
+
+struct DBox {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+};
+
+bool box_contains(const BvhNode8& n, int j, const double lo[3], const double hi[3]) {
+    return n.min_x[j] <= lo[0] && n.min_y[j] <= lo[1] && n.min_z[j] <= lo[2] &&
+           n.max_x[j] >= hi[0] && n.max_y[j] >= hi[1] && n.max_z[j] >= hi[2];
+}
+
+// Walks the tree; returns the subtree's exact box and counts each sphere's leaves.
+DBox check_node(const SphereBvh& bvh, std::uint32_t index, std::vector<int>& seen,
+                std::uint32_t depth, std::uint32_t& max_depth) {
+    max_depth = std::max(max_depth, depth);
+    const BvhNode8& n = bvh.nodes.at(index);
+    DBox all;
+    bool empty_seen = false;
+    for (int j = 0; j < 8; ++j) {
+        const std::uint32_t ref = n.child[j];
+        if (ref == kBvhEmpty) {
+            empty_seen = true;
+            EXPECT_EQ(n.min_x[j], INFINITY);
+            EXPECT_EQ(n.max_x[j], -INFINITY);
+            EXPECT_EQ(n.min_y[j], INFINITY);
+            EXPECT_EQ(n.max_z[j], -INFINITY);
+            continue;
+        }
+        EXPECT_FALSE(empty_seen) << "empty slots come last";
+        DBox box;
+        if (ref & kBvhLeafBit) {
+            const std::uint32_t first = (ref & ~kBvhLeafBit) >> kBvhLeafCountBits;
+            const std::uint32_t count = (ref & 7u) + 1;
+            EXPECT_LE(first + count, bvh.sphere_count);
+            for (std::uint32_t i = first; i < first + count && i < bvh.sphere_count; ++i) {
+                ++seen.at(i);
+                const double r = std::sqrt(static_cast<double>(bvh.r2[i]));
+                const double c[3] = {bvh.cx[i], bvh.cy[i], bvh.cz[i]};
+                for (int a = 0; a < 3; ++a) {
+                    box.lo[a] = std::min(box.lo[a], c[a] - r);
+                    box.hi[a] = std::max(box.hi[a], c[a] + r);
+                }
+            }
+        } else {
+            EXPECT_GT(ref, index) << "preorder";
+            box = check_node(bvh, ref, seen, depth + 1, max_depth);
+        }
+        EXPECT_TRUE(box_contains(n, j, box.lo, box.hi)) << "node " << index << " child " << j;
+        for (int a = 0; a < 3; ++a) {
+            all.lo[a] = std::min(all.lo[a], box.lo[a]);
+            all.hi[a] = std::max(all.hi[a], box.hi[a]);
+        }
+    }
+    EXPECT_NE(n.child[0], kBvhEmpty) << "a node has at least one child";
+    return all;
+}
+
+// Parents contain children: every child box of an inner child lies in the parent's slot.
+void check_nesting(const SphereBvh& bvh, std::uint32_t index) {
+    const BvhNode8& n = bvh.nodes[index];
+    for (int j = 0; j < 8; ++j) {
+        const std::uint32_t ref = n.child[j];
+        if (ref == kBvhEmpty || (ref & kBvhLeafBit)) continue;
+        const BvhNode8& c = bvh.nodes[ref];
+        for (int k = 0; k < 8 && c.child[k] != kBvhEmpty; ++k) {
+            const double lo[3] = {c.min_x[k], c.min_y[k], c.min_z[k]};
+            const double hi[3] = {c.max_x[k], c.max_y[k], c.max_z[k]};
+            EXPECT_TRUE(box_contains(n, j, lo, hi)) << "node " << index << " child " << j;
+        }
+        check_nesting(bvh, ref);
+    }
+}
+
+TEST(SphereBvh, Invariants) {
+    for (const NamedScene& ns : test_scenes()) {
+        SCOPED_TRACE(ns.name);
+        const CompiledScene c = compile_scene(ns.scene);
+        const SphereBvh bvh = build_sphere_bvh(c.spheres);
+        ASSERT_EQ(bvh.sphere_count, c.spheres.count);
+        ASSERT_FALSE(bvh.nodes.empty());
+        std::vector<int> seen(bvh.sphere_count, 0);
+        std::uint32_t depth = 0;
+        check_node(bvh, 0, seen, 1, depth);
+        check_nesting(bvh, 0);
+        EXPECT_EQ(depth, bvh.depth);
+        for (std::uint32_t i = 0; i < bvh.sphere_count; ++i)
+            EXPECT_EQ(seen[i], 1) << "sphere slot " << i << " in exactly one leaf";
+        // The leaf arrays are a permutation of the scene's spheres, objects once each.
+        std::vector<int> object_seen(c.objects.count, 0);
+        for (std::uint32_t i = 0; i < bvh.sphere_count; ++i) {
+            const std::uint32_t obj = bvh.object[i];
+            ASSERT_LT(obj, c.objects.count);
+            ++object_seen[obj];
+            EXPECT_EQ(c.objects.is_plane[obj], 0u);
+            EXPECT_EQ(bvh.cx[i], c.objects.cx[obj]);
+            EXPECT_EQ(bvh.r2[i], c.objects.radius[obj] * c.objects.radius[obj]);
+        }
+        for (std::uint32_t k = 0; k < c.objects.count; ++k)
+            EXPECT_EQ(object_seen[k], c.objects.is_plane[k] ? 0 : 1) << "object " << k;
+        // Padding: a packet of never-hit entries.
+        ASSERT_EQ(bvh.cx.size(), bvh.sphere_count + 8u);
+        EXPECT_TRUE(std::isnan(bvh.r2[bvh.sphere_count]));
+        EXPECT_GT(bvh.memory_bytes(), 0u);
+    }
+}
+
+TEST(SphereBvh, NoSpheresNoTree) {
+    const CompiledScene c = compile_scene(scene_of({plane({0, 0, 0}, {0, 1, 0})}));
+    const SphereBvh bvh = build_sphere_bvh(c.spheres);
+    EXPECT_TRUE(bvh.nodes.empty());
+    EXPECT_EQ(make_scene_view(c, bvh).bvh_nodes, nullptr);
+}
+
+// The same bytes whatever the number of threads (binning and subtrees run in parallel
+// above a few thousand spheres, so the scene is large enough for that).
+TEST(SphereBvh, DeterministicAcrossThreadCounts) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    std::vector<Object> o;
+    for (int i = 0; i < 40000; ++i)
+        o.push_back(sphere({unit(rng), unit(rng), 4 * unit(rng)}, 0.01f));
+    for (int i = 0; i < 3000; ++i) o.push_back(sphere({0.25f, 0.25f, 0.25f}, 0.02f));
+    const CompiledScene c = compile_scene(scene_of(o));
+    const auto build = [&](int threads) {
+        tbb::task_arena arena(threads);
+        SphereBvh bvh;
+        arena.execute([&] { bvh = build_sphere_bvh(c.spheres); });
+        return bvh;
+    };
+    const SphereBvh one = build(1);
+    for (int threads : {2, 3, 4}) {
+        SCOPED_TRACE(threads);
+        const SphereBvh other = build(threads);
+        ASSERT_EQ(one.nodes.size(), other.nodes.size());
+        EXPECT_EQ(0, std::memcmp(one.nodes.data(), other.nodes.data(),
+                                 one.nodes.size() * sizeof(BvhNode8)));
+        EXPECT_EQ(one.object, other.object);
+        EXPECT_EQ(one.depth, other.depth);
+        EXPECT_EQ(one.leaf_count, other.leaf_count);
+    }
+}
+
+TEST(Accel, NamesRoundTrip) {
+    for (Accel a : {Accel::automatic, Accel::bvh, Accel::none})
+        EXPECT_EQ(parse_accel(accel_name(a)), a);
+    EXPECT_FALSE(parse_accel("BVH").has_value());
+    EXPECT_FALSE(parse_accel("").has_value());
+    EXPECT_FALSE(accel_uses_bvh(Accel::none, 1000000));
+    EXPECT_TRUE(accel_uses_bvh(Accel::bvh, 1));
+    EXPECT_FALSE(accel_uses_bvh(Accel::bvh, 0));
+    EXPECT_FALSE(accel_uses_bvh(Accel::automatic, kBvhAutoMinSpheres - 1));
+    EXPECT_TRUE(accel_uses_bvh(Accel::automatic, kBvhAutoMinSpheres));
+}
+
+// ---------------------------------------------------------------------------------------
+// Traversal against brute force.
+
+template <Isa I>
+struct IsaTag {
+    static constexpr Isa isa = I;
+};
+using Isas = ::testing::Types<IsaTag<Isa::sse2>, IsaTag<Isa::sse4_1>, IsaTag<Isa::avx2>>;
+
+struct RaySoA {
+    AlignedVector<float> ox, oy, oz, dx, dy, dz, w, t_max, term;
+    AlignedVector<std::uint32_t> pixel;
+    std::size_t n = 0;
+    explicit RaySoA(const std::vector<Ray>& rays) : n(rays.size()) {
+        const std::size_t c = padded(n) + kPacketWidth;
+        for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &w, &t_max}) v->assign(c, 0.0f);
+        term.assign(3 * c, 0.0f);
+        pixel.assign(c, 0u);
+        for (std::size_t i = 0; i < n; ++i) {
+            const Ray& r = rays[i];
+            ox[i] = r.origin.x, oy[i] = r.origin.y, oz[i] = r.origin.z;
+            dx[i] = r.direction.x, dy[i] = r.direction.y, dz[i] = r.direction.z;
+            t_max[i] = r.t_max;
+        }
+    }
+    kernels::RayStream stream() {
+        return {ox.data(), oy.data(), oz.data(), dx.data(),    dy.data(),
+                dz.data(), w.data(),  w.data(),  w.data(),     pixel.data()};
+    }
+    kernels::ShadowStream shadow() {
+        const std::size_t c = t_max.size();
+        return {ox.data(),    oy.data(),          oz.data(),   dx.data(),
+                dy.data(),    dz.data(),          t_max.data(), term.data(),
+                term.data() + c, term.data() + 2 * c, pixel.data()};
+    }
+};
+
+// Random rays (random origins and directions, some unnormalised, some axis-aligned), and
+// coherent bundles from one point towards the scene (packets that stay together).
+std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_t count) {
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (std::uint32_t i = 0; i < c.spheres.count; ++i) {
+        const float p[3] = {c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+    }
+    if (c.spheres.count == 0) lo[0] = lo[1] = lo[2] = -1, hi[0] = hi[1] = hi[2] = 1;
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f), unit(-1.0f, 1.0f);
+    const auto in_box = [&](float grow) {
+        Vec3 p;
+        float* q[3] = {&p.x, &p.y, &p.z};
+        for (int a = 0; a < 3; ++a) {
+            const float ext = std::max(hi[a] - lo[a], 1e-3f);
+            *q[a] = lo[a] - grow * ext + (1 + 2 * grow) * ext * u01(rng);
+        }
+        return p;
+    };
+    std::vector<Ray> rays;
+    while (rays.size() < count) {
+        const int kind = static_cast<int>(rays.size() / 8 % 5);
+        if (kind == 4 && c.spheres.count > 0) {
+            // Aimed from afar (1 to 1000 units) at a sphere, missing its center by about
+            // its radius or by the brute force's rounding fuzz (~sqrt(u) * distance): the
+            // grazing rays whose hits only exact arithmetic decides.
+            const auto i = static_cast<std::uint32_t>(rng() % c.spheres.count);
+            const Vec3 center{c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
+            const float radius = c.spheres.radius[i];
+            const float distance = std::pow(10.0f, 3.0f * u01(rng));
+            const Vec3 from = normalize(Vec3{unit(rng), unit(rng), unit(rng)});
+            const float fuzz = 1e-3f * distance * u01(rng);
+            const float miss = (rng() % 2 ? radius : 0.0f) + (rng() % 2 ? fuzz : 0.0f);
+            const Vec3 side = normalize(cross(from, Vec3{0.577f, 0.577f, -0.577f}));
+            Ray r;
+            r.origin = center + from * distance;
+            r.direction = normalize(center + side * (miss * (u01(rng) * 2.0f)) - r.origin);
+            r.t_max = distance * (0.5f + u01(rng));
+            rays.push_back(r);
+            continue;
+        }
+        if (kind == 3) {
+            // A coherent packet: one origin, directions towards a small region.
+            const Vec3 origin = in_box(1.0f), target = in_box(0.0f);
+            for (int k = 0; k < 8; ++k) {
+                Ray r;
+                r.origin = origin;
+                const Vec3 jitter{0.02f * unit(rng), 0.02f * unit(rng), 0.02f * unit(rng)};
+                r.direction = normalize(target + jitter * (hi[0] - lo[0] + 1e-3f) - origin);
+                r.t_max = 0.5f + 2 * u01(rng);
+                rays.push_back(r);
+            }
+            continue;
+        }
+        Ray r;
+        r.origin = in_box(kind == 0 ? 0.2f : 1.0f);
+        if (kind == 2 && rays.size() % 3 == 0) {
+            const float sign = u01(rng) < 0.5f ? -1.0f : 1.0f;
+            const std::size_t axis = rays.size() % 9 / 3;
+            r.direction = {axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f,
+                           axis == 2 ? sign : 0.0f};
+        } else {
+            r.direction = (kind == 1 ? in_box(0.0f) - r.origin
+                                     : Vec3{unit(rng), unit(rng), unit(rng)});
+            if (!(length(r.direction) > 1e-3f)) r.direction = {0, 1, 0};
+            if (kind != 1) r.direction = normalize(r.direction);
+        }
+        r.t_max = kind == 1 ? u01(rng) * 1.2f : INFINITY;  // shadow-like rays end early
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+template <class Tag>
+class BvhTraversalTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        if (!isa_supported(Tag::isa)) GTEST_SKIP() << isa_name(Tag::isa) << " not on this CPU";
+    }
+
+    // closest_hit and any_hit with the BVH (with this packet/single-ray switch) against the
+    // reference, ray by ray; and any-hit against closest hit.
+    void check(const NamedScene& ns, std::uint32_t packet_min_lanes, std::size_t ray_count) {
+        SCOPED_TRACE(ns.name + ", packet_min_lanes " + std::to_string(packet_min_lanes));
+        const CompiledScene c = compile_scene(ns.scene);
+        const SphereBvh bvh = build_sphere_bvh(c.spheres);
+        const kernels::SceneView view = make_scene_view(c, bvh, packet_min_lanes);
+        ASSERT_NE(view.bvh_nodes, nullptr);
+        const kernels::KernelTable& k = kernel_table(Tag::isa);
+        const ReferenceTracer ref(ns.scene);
+        std::mt19937 rng(99 + packet_min_lanes);
+        const std::vector<Ray> rays = test_rays(c, rng, ray_count);
+        // Odd counts leave dead lanes in the last packet.
+        const auto n = static_cast<std::uint32_t>(rays.size() - 3);
+        RaySoA soa(rays);
+        int mismatches = 0;
+        for (const float t_min : {0.0f, 1e-3f}) {
+            AlignedVector<float> t(padded(n), -7.0f), t0(padded(n), -7.0f);
+            AlignedVector<std::int32_t> id(padded(n), -7);
+            k.closest_hit(view, soa.stream(), n, t_min, {t.data(), id.data()});
+            for (std::uint32_t i = 0; i < n && mismatches < 10; ++i) {
+                Ray r = rays[i];
+                r.t_min = t_min;
+                r.t_max = INFINITY;
+                const std::optional<SurfaceHit> hit = ref.intersect(r);
+                const std::int32_t want_id = hit ? static_cast<std::int32_t>(hit->object) : -1;
+                const float want_t = hit ? hit->t : INFINITY;
+                if (id[i] != want_id || !(t[i] == want_t)) {
+                    ++mismatches;
+                    ADD_FAILURE() << "closest hit, ray " << i << " t_min " << t_min << ": got "
+                                  << id[i] << " at " << t[i] << ", reference " << want_id
+                                  << " at " << want_t;
+                }
+            }
+        }
+        AlignedVector<std::uint32_t> occluded(padded(n) + kPacketWidth, 7u);
+        k.any_hit(view, soa.shadow(), n, occluded.data());
+        AlignedVector<float> t(padded(n), -7.0f);
+        AlignedVector<std::int32_t> id(padded(n), -7);
+        k.closest_hit(view, soa.stream(), n, 0.0f, {t.data(), id.data()});
+        for (std::uint32_t i = 0; i < n && mismatches < 10; ++i) {
+            Ray r = rays[i];
+            r.t_min = 0.0f;
+            const bool want = ref.occluded(r);
+            if (occluded[i] != (want ? 1u : 0u)) {
+                ++mismatches;
+                ADD_FAILURE() << "any hit, ray " << i << ": got " << occluded[i]
+                              << ", reference " << want;
+            }
+            // Occluded on (0, t_max) exactly when the closest hit on (0, inf) is nearer.
+            EXPECT_EQ(occluded[i], t[i] < rays[i].t_max ? 1u : 0u) << "ray " << i;
+        }
+    }
+};
+TYPED_TEST_SUITE(BvhTraversalTest, Isas);
+
+TYPED_TEST(BvhTraversalTest, PacketsSwitchingToSingleRays) {
+    for (const NamedScene& ns : test_scenes()) this->check(ns, 3, 1200);
+}
+
+TYPED_TEST(BvhTraversalTest, PacketsOnly) {
+    for (const NamedScene& ns : test_scenes()) this->check(ns, 0, 600);
+}
+
+TYPED_TEST(BvhTraversalTest, SingleRaysOnly) {
+    for (const NamedScene& ns : test_scenes()) this->check(ns, 9, 600);
+}
+
+}  // namespace
+}  // namespace octray
