@@ -10,8 +10,14 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfIntAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfOpaqueAttribute.h>
 #include <ImfOutputFile.h>
+#include <ImfRational.h>
+#include <ImfRationalAttribute.h>
+#include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
+#include <ImfVersion.h>
 #include <half.h>
 
 #include <algorithm>
@@ -22,7 +28,9 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <random>
+#include <set>
 #include <stdexcept>
 #include <system_error>
 
@@ -36,6 +44,11 @@ namespace fs = std::filesystem;
 static_assert(sizeof(Rgb) == 3 * sizeof(float));
 
 std::string errno_message(int error) { return std::generic_category().message(error); }
+
+std::string window_text(const PixelRect& r) {
+    return "(" + std::to_string(r.x0) + ", " + std::to_string(r.y0) + ")-(" +
+           std::to_string(r.x1) + ", " + std::to_string(r.y1) + ")";
+}
 
 // "<dir>/.<name>.tmp.<pid>.<random>": hidden, in the target's directory so that the final
 // rename stays on one file system (and so stays atomic), and unique per process and call.
@@ -95,55 +108,114 @@ constexpr std::array<std::pair<std::string_view, ExrCompression>, 10> kCompressi
     {"dwab", ExrCompression::dwab},
 }};
 
-void write_exr_file(const std::string& path, const Image& image,
-                    const ExrWriteOptions& options, const ExrAttributes& attributes) {
-    const int width = image.width();
-    const int height = image.height();
-    // The default data window is (0, 0)-(W-1, H-1) and the line order INCREASING_Y, so
-    // the file's first scan line is Image row 0, the top row.
-    Imf::Header header(width, height);
-    header.compression() = to_imf(options.compression);
-    for (const auto& [name, value] : attributes.strings)
-        header.insert(name, Imf::StringAttribute(value));
-    for (const auto& [name, value] : attributes.floats)
-        header.insert(name, Imf::FloatAttribute(value));
-    for (const auto& [name, value] : attributes.ints)
-        header.insert(name, Imf::IntAttribute(value));
-    for (const auto& [name, value] : attributes.doubles)
-        header.insert(name, Imf::DoubleAttribute(value));
+// OpenEXR boxes are inclusive: [x0, x1) becomes min x0, max x1 - 1.
+Imath::Box2i to_box(const PixelRect& r) {
+    return Imath::Box2i({r.x0, r.y0}, {r.x1 - 1, r.y1 - 1});
+}
 
-    const Imf::PixelType type = options.float32 ? Imf::FLOAT : Imf::HALF;
-    header.channels().insert("R", Imf::Channel(type));
-    header.channels().insert("G", Imf::Channel(type));
-    header.channels().insert("B", Imf::Channel(type));
-
-    const std::size_t row_stride = static_cast<std::size_t>(width) * 3;
-    Imf::FrameBuffer frame_buffer;
-    std::vector<half> halves;  // interleaved RGB, converted once up front
-    char* base = nullptr;
-    std::size_t element = 0;
-    if (options.float32) {
-        // OpenEXR only reads through the frame buffer, so pointing it at the image's own
-        // (const) floats is safe and saves a copy.
-        base = reinterpret_cast<char*>(const_cast<Rgb*>(image.data()));
-        element = sizeof(float);
-    } else {
-        halves.resize(row_stride * static_cast<std::size_t>(height));
-        const float* source = reinterpret_cast<const float*>(image.data());
-        std::transform(source, source + halves.size(), halves.begin(),
-                       [](float v) { return half(v); });
-        base = reinterpret_cast<char*>(halves.data());
-        element = sizeof(half);
+Imf::PixelType to_imf(ExrPixelType type) {
+    switch (type) {
+        case ExrPixelType::uint32: return Imf::UINT;
+        case ExrPixelType::half: return Imf::HALF;
+        case ExrPixelType::float32: return Imf::FLOAT;
     }
-    const std::size_t x_stride = 3 * element;
-    const std::size_t y_stride = row_stride * element;
-    frame_buffer.insert("R", Imf::Slice(type, base + 0 * element, x_stride, y_stride));
-    frame_buffer.insert("G", Imf::Slice(type, base + 1 * element, x_stride, y_stride));
-    frame_buffer.insert("B", Imf::Slice(type, base + 2 * element, x_stride, y_stride));
+    throw std::invalid_argument("unknown EXR pixel type");
+}
 
+// Attributes the writer derives from the image itself; a caller may not set them.
+constexpr std::array<std::string_view, 11> kStructuralAttributes{
+    "channels", "compression", "dataWindow", "displayWindow", "lineOrder", "tiles",
+    "type",     "name",        "version",    "chunkCount",    "maxSamplesPerPixel"};
+
+void insert_attribute(Imf::Header& header, std::set<std::string>& seen, const std::string& name,
+                      const Imf::Attribute& attribute) {
+    if (name.empty()) throw std::invalid_argument("an attribute has an empty name");
+    for (std::string_view structural : kStructuralAttributes)
+        if (name == structural)
+            throw std::invalid_argument("attribute '" + name +
+                                        "' is set by the writer and cannot be given");
+    if (!seen.insert(name).second)
+        throw std::invalid_argument("attribute '" + name + "' is given twice");
+    // Header::insert throws if the header already holds `name` with another type (the
+    // defaults pixelAspectRatio, screenWindowCenter, screenWindowWidth).
+    header.insert(name, attribute);
+}
+
+void insert_attributes(Imf::Header& header, const ExrAttributes& attributes) {
+    std::set<std::string> seen;
+    for (const auto& [name, value] : attributes.strings)
+        insert_attribute(header, seen, name, Imf::StringAttribute(value));
+    for (const auto& [name, value] : attributes.floats)
+        insert_attribute(header, seen, name, Imf::FloatAttribute(value));
+    for (const auto& [name, value] : attributes.ints)
+        insert_attribute(header, seen, name, Imf::IntAttribute(value));
+    for (const auto& [name, value] : attributes.doubles)
+        insert_attribute(header, seen, name, Imf::DoubleAttribute(value));
+    for (const auto& [name, m] : attributes.matrices) {
+        const Imath::M44f matrix(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9],
+                                 m[10], m[11], m[12], m[13], m[14], m[15]);
+        insert_attribute(header, seen, name, Imf::M44fAttribute(matrix));
+    }
+    for (const auto& [name, r] : attributes.rationals)
+        insert_attribute(header, seen, name,
+                         Imf::RationalAttribute(Imf::Rational(r.numerator, r.denominator)));
+    for (const ExrOpaqueAttribute& a : attributes.opaque) {
+        // Rebuilt from its stored bytes: a known type as that type (so that OpenEXR checks
+        // it), any other as an opaque blob.
+        std::unique_ptr<Imf::Attribute> attribute(
+            Imf::Attribute::knownType(a.type.c_str())
+                ? Imf::Attribute::newAttribute(a.type.c_str())
+                : new Imf::OpaqueAttribute(a.type.c_str()));
+        Imf::StdISStream in;
+        in.str(std::string(a.value.begin(), a.value.end()));
+        attribute->readValueFrom(in, static_cast<int>(a.value.size()), Imf::EXR_VERSION);
+        insert_attribute(header, seen, a.name, *attribute);
+    }
+}
+
+void check_exr_image(const ExrImage& image) {
+    if (image.display_window.empty())
+        throw std::invalid_argument("the display window " + window_text(image.display_window) +
+                                    " is empty");
+    if (image.data_window.empty())
+        throw std::invalid_argument("the data window " + window_text(image.data_window) +
+                                    " is empty");
+    if (image.channels.empty()) throw std::invalid_argument("the image has no channels");
+    std::set<std::string> names;
+    for (const ExrChannel& c : image.channels) {
+        if (c.name.empty()) throw std::invalid_argument("a channel has an empty name");
+        if (!names.insert(c.name).second)
+            throw std::invalid_argument("channel '" + c.name + "' is given twice");
+        const std::size_t expected = image.data_window.pixel_count() * sample_size(c.type);
+        if (c.samples.size() != expected)
+            throw std::invalid_argument(
+                "channel '" + c.name + "' holds " + std::to_string(c.samples.size()) +
+                " bytes, but the data window " + window_text(image.data_window) + " needs " +
+                std::to_string(expected));
+    }
+}
+
+void write_exr_file(const std::string& path, const ExrImage& image) {
+    // Line order INCREASING_Y: the file's first scan line is the top row.
+    Imf::Header header(to_box(image.display_window), to_box(image.data_window));
+    header.compression() = to_imf(image.compression);
+    insert_attributes(header, image.attributes);
+
+    const Imath::Box2i window = to_box(image.data_window);
+    const std::size_t width = static_cast<std::size_t>(image.data_window.width());
+    Imf::FrameBuffer frame_buffer;
+    for (const ExrChannel& c : image.channels) {
+        const Imf::PixelType type = to_imf(c.type);
+        header.channels().insert(c.name, Imf::Channel(type));
+        // OpenEXR only reads through the frame buffer when writing.
+        char* base = reinterpret_cast<char*>(const_cast<unsigned char*>(c.samples.data()));
+        const std::size_t element = sample_size(c.type);
+        frame_buffer.insert(c.name,
+                            Imf::Slice::Make(type, base, window, element, element * width));
+    }
     Imf::OutputFile file(path.c_str(), header);
     file.setFrameBuffer(frame_buffer);
-    file.writePixels(height);
+    file.writePixels(image.data_window.height());
 }
 
 // sRGB OETF (IEC 61966-2-1) of a linear value already clamped to [0, 1].
@@ -266,6 +338,127 @@ std::string_view to_string(ExrCompression compression) {
     return "unknown";
 }
 
+std::string_view to_string(ExrPixelType type) {
+    switch (type) {
+        case ExrPixelType::uint32: return "uint";
+        case ExrPixelType::half: return "half";
+        case ExrPixelType::float32: return "float";
+    }
+    return "unknown";
+}
+
+std::size_t sample_size(ExrPixelType type) { return type == ExrPixelType::half ? 2 : 4; }
+
+float ExrChannel::value(std::size_t k) const {
+    const unsigned char* p = samples.data() + k * sample_size(type);
+    switch (type) {
+        case ExrPixelType::half: {
+            half h;
+            std::uint16_t bits;
+            std::memcpy(&bits, p, sizeof bits);
+            h.setBits(bits);
+            return static_cast<float>(h);
+        }
+        case ExrPixelType::float32: {
+            float f;
+            std::memcpy(&f, p, sizeof f);
+            return f;
+        }
+        case ExrPixelType::uint32: {
+            std::uint32_t u;
+            std::memcpy(&u, p, sizeof u);
+            return static_cast<float>(u);
+        }
+    }
+    return 0.0f;
+}
+
+std::uint32_t ExrChannel::uint_value(std::size_t k) const {
+    if (type == ExrPixelType::uint32) {
+        std::uint32_t u;
+        std::memcpy(&u, samples.data() + k * sizeof u, sizeof u);
+        return u;
+    }
+    const float f = value(k);
+    // NaN and negatives give 0, values past the range the largest uint32.
+    if (!(f > 0.0f)) return 0;
+    if (f >= 4294967296.0f) return 0xffffffffu;
+    return static_cast<std::uint32_t>(f);
+}
+
+ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* values,
+                            std::size_t count, std::size_t stride) {
+    if (type == ExrPixelType::uint32)
+        throw std::invalid_argument("make_exr_channel: floats make half or float channels");
+    ExrChannel c{std::move(name), type, std::vector<unsigned char>(count * sample_size(type))};
+    unsigned char* out = c.samples.data();
+    for (std::size_t k = 0; k < count; ++k) {
+        const float v = values[k * stride];
+        if (type == ExrPixelType::half) {
+            const std::uint16_t bits = half(v).bits();
+            std::memcpy(out + 2 * k, &bits, sizeof bits);
+        } else {
+            std::memcpy(out + 4 * k, &v, sizeof v);
+        }
+    }
+    return c;
+}
+
+ExrChannel make_exr_channel(std::string name, const std::vector<std::uint32_t>& values) {
+    ExrChannel c{std::move(name), ExrPixelType::uint32,
+                 std::vector<unsigned char>(values.size() * sizeof(std::uint32_t))};
+    if (!values.empty()) std::memcpy(c.samples.data(), values.data(), c.samples.size());
+    return c;
+}
+
+const ExrChannel* ExrImage::find_channel(std::string_view name) const {
+    for (const ExrChannel& c : channels)
+        if (c.name == name) return &c;
+    return nullptr;
+}
+
+ExrRational exr_rational(double value) {
+    const Imf::Rational r(value);
+    return {r.n, r.d};
+}
+
+ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
+                        int full_height, const ExrWriteOptions& options,
+                        const ExrAttributes& attributes) {
+    if (image.width() != data_window.width() || image.height() != data_window.height())
+        throw std::invalid_argument("make_exr_image: a " + std::to_string(image.width()) + "x" +
+                                    std::to_string(image.height()) +
+                                    " image cannot fill the data window " +
+                                    window_text(data_window));
+    ExrImage exr;
+    exr.display_window = PixelRect{0, 0, full_width, full_height};
+    exr.data_window = data_window;
+    exr.compression = options.compression;
+    exr.attributes = attributes;
+    const ExrPixelType type = options.float32 ? ExrPixelType::float32 : ExrPixelType::half;
+    const float* rgb = reinterpret_cast<const float*>(image.data());
+    const std::size_t n = image.pixel_count();
+    exr.channels.push_back(make_exr_channel("R", type, rgb + 0, n, 3));
+    exr.channels.push_back(make_exr_channel("G", type, rgb + 1, n, 3));
+    exr.channels.push_back(make_exr_channel("B", type, rgb + 2, n, 3));
+    return exr;
+}
+
+ExrImage make_exr_image(const RenderResult& result, const ExrWriteOptions& options,
+                        const ExrAttributes& attributes) {
+    return make_exr_image(result.image, result.rect, result.full_width, result.full_height,
+                          options, attributes);
+}
+
+void write_exr(const std::string& path, const ExrImage& image) {
+    try {
+        check_exr_image(image);
+    } catch (const std::exception& e) {
+        throw IoError("cannot write " + path + ": " + e.what());
+    }
+    write_file_atomically(path, [&](const std::string& tmp) { write_exr_file(tmp, image); });
+}
+
 void write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options,
                const ExrAttributes& attributes) {
     try {
@@ -273,9 +466,8 @@ void write_exr(const std::string& path, const Image& image, const ExrWriteOption
     } catch (const std::exception& e) {
         throw IoError("cannot write " + path + ": " + e.what());
     }
-    write_file_atomically(path, [&](const std::string& tmp) {
-        write_exr_file(tmp, image, options, attributes);
-    });
+    write_exr(path, make_exr_image(image, PixelRect{0, 0, image.width(), image.height()},
+                                   image.width(), image.height(), options, attributes));
 }
 
 void write_png_preview(const std::string& path, const Image& image) {

@@ -2,6 +2,8 @@
 // Writing images: OpenEXR (the product) and 8-bit PNG previews. Every writer goes through
 // write_file_atomically(), so an interrupted run never leaves a partial image behind.
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "render/types.h"
 
 namespace octray {
 
@@ -37,15 +40,101 @@ struct ExrWriteOptions {
     ExrCompression compression = ExrCompression::zip;
 };
 
-// Extra header attributes, written as OpenEXR string / float / int / double attributes.
+// A 4x4 float matrix as OpenEXR's M44f (Imath) holds it: element (row, col) at
+// [4 * row + col], applied to row vectors (p' = p * M, translation in the last row).
+using Matrix44 = std::array<float, 16>;
+
+// OpenEXR's Rational (the framesPerSecond attribute): numerator / denominator.
+struct ExrRational {
+    int numerator = 0;
+    unsigned int denominator = 1;
+    friend bool operator==(const ExrRational&, const ExrRational&) = default;
+};
+
+// OpenEXR's own "nice fraction" for a value: 24 -> 24/1, 30000.0/1001 -> 30000/1001.
+ExrRational exr_rational(double value);
+
+// A header attribute of a type octray does not interpret, kept as OpenEXR serialized it
+// (read from one file, written to another unchanged: `octray assemble`).
+struct ExrOpaqueAttribute {
+    std::string name;
+    std::string type;                // OpenEXR's type name: "v2f", "chromaticities", ...
+    std::vector<unsigned char> value;  // the attribute's bytes as stored in a file
+};
+
+// Extra header attributes, written as OpenEXR string / float / int / double / M44f /
+// rational attributes, plus opaque ones carried over from a file. A name given twice, or
+// one of the structural attributes the writer sets itself (channels, compression,
+// dataWindow, displayWindow, lineOrder, ...), is refused by the writer.
 struct ExrAttributes {
     std::vector<std::pair<std::string, std::string>> strings;
     std::vector<std::pair<std::string, float>> floats;
     std::vector<std::pair<std::string, int>> ints;
     std::vector<std::pair<std::string, double>> doubles;
+    std::vector<std::pair<std::string, Matrix44>> matrices;  // M44f: worldToCamera, ...
+    std::vector<std::pair<std::string, ExrRational>> rationals;  // framesPerSecond
+    std::vector<ExrOpaqueAttribute> opaque;
 };
 
-// Writes R, G, B channels (row 0 on top). Throws IoError.
+// ---- Images of any channel set, with windows -----------------------------------------
+
+// OpenEXR's pixel types: UINT, HALF, FLOAT.
+enum class ExrPixelType { uint32, half, float32 };
+std::string_view to_string(ExrPixelType type);       // "uint", "half", "float"
+std::size_t sample_size(ExrPixelType type);           // 4, 2, 4 bytes
+
+// One channel: a sample per pixel of the data window, row by row (top row first), each in
+// the channel's own type and native byte order (half: the 16 bits of an IEEE binary16).
+struct ExrChannel {
+    std::string name;
+    ExrPixelType type = ExrPixelType::half;
+    std::vector<unsigned char> samples;
+
+    std::size_t size() const { return samples.size() / sample_size(type); }
+    // Sample k as a float (a uint32 is converted and may round above 2^24).
+    float value(std::size_t k) const;
+    // Sample k of a uint32 channel (else the float value truncated; negative -> 0).
+    std::uint32_t uint_value(std::size_t k) const;
+};
+
+// A half or float32 channel from `count` floats at `values`, `stride` floats apart
+// (half rounds to nearest even, as OpenEXR's half does).
+ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* values,
+                            std::size_t count, std::size_t stride = 1);
+// A uint32 channel.
+ExrChannel make_exr_channel(std::string name, const std::vector<std::uint32_t>& values);
+
+// A scanline OpenEXR image: its windows, channels, compression and extra attributes.
+// The display window is the whole picture; the data window the pixels the file holds
+// (a crop of a render: the crop inside the full image).
+struct ExrImage {
+    PixelRect display_window;
+    PixelRect data_window;
+    std::vector<ExrChannel> channels;  // any order: OpenEXR stores them sorted by name
+    ExrCompression compression = ExrCompression::zip;
+    ExrAttributes attributes;
+
+    // The channel called `name`, or nullptr.
+    const ExrChannel* find_channel(std::string_view name) const;
+};
+
+// R, G, B channels (half, or float32 with options.float32) of `image`; the data window is
+// `data_window` (the image's size) inside a display window of (0, 0)-(full_width,
+// full_height). Throws std::invalid_argument if the sizes disagree.
+ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
+                        int full_height, const ExrWriteOptions& options,
+                        const ExrAttributes& attributes = {});
+// The same for a render: data window result.rect, display window the full image.
+ExrImage make_exr_image(const RenderResult& result, const ExrWriteOptions& options,
+                        const ExrAttributes& attributes = {});
+
+// Writes `image` as a scanline OpenEXR file, atomically. Throws IoError naming the path
+// and the reason (an empty window, a channel whose sample count is not the data window's,
+// two channels or attributes of one name, ...).
+void write_exr(const std::string& path, const ExrImage& image);
+
+// Writes R, G, B channels (row 0 on top); data window = display window = the image.
+// Throws IoError.
 void write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options,
                const ExrAttributes& attributes = {});
 

@@ -6,7 +6,15 @@
 #include <ImfCompression.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
 #include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfRationalAttribute.h>
+#include <ImfStdIO.h>
+#include <ImfStringAttribute.h>
+#include <ImfVersion.h>
 
 #include <algorithm>
 #include <array>
@@ -224,6 +232,124 @@ ChannelImage read_exr_file(const std::string& path) {
     }
 }
 
+ExrCompression from_imf(Imf::Compression compression) {
+    switch (compression) {
+        case Imf::NO_COMPRESSION: return ExrCompression::none;
+        case Imf::RLE_COMPRESSION: return ExrCompression::rle;
+        case Imf::ZIPS_COMPRESSION: return ExrCompression::zips;
+        case Imf::ZIP_COMPRESSION: return ExrCompression::zip;
+        case Imf::PIZ_COMPRESSION: return ExrCompression::piz;
+        case Imf::PXR24_COMPRESSION: return ExrCompression::pxr24;
+        case Imf::B44_COMPRESSION: return ExrCompression::b44;
+        case Imf::B44A_COMPRESSION: return ExrCompression::b44a;
+        case Imf::DWAA_COMPRESSION: return ExrCompression::dwaa;
+        case Imf::DWAB_COMPRESSION: return ExrCompression::dwab;
+        default: return ExrCompression::zip;  // a codec newer than this list
+    }
+}
+
+PixelRect from_box(const Imath::Box2i& box) {
+    return PixelRect{box.min.x, box.min.y, box.max.x + 1, box.max.y + 1};
+}
+
+// The attributes write_exr() derives from the image itself, and so does not carry.
+bool is_structural(std::string_view name) {
+    static constexpr std::array<std::string_view, 11> names{
+        "channels", "compression", "dataWindow", "displayWindow", "lineOrder", "tiles",
+        "type",     "name",        "version",    "chunkCount",    "maxSamplesPerPixel"};
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+ExrAttributes read_attributes(const Imf::Header& header) {
+    ExrAttributes out;
+    for (auto it = header.begin(); it != header.end(); ++it) {
+        const std::string name = it.name();
+        if (is_structural(name)) continue;
+        const Imf::Attribute& a = it.attribute();
+        if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&a)) {
+            out.strings.emplace_back(name, s->value());
+        } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&a)) {
+            out.floats.emplace_back(name, f->value());
+        } else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a)) {
+            out.ints.emplace_back(name, i->value());
+        } else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&a)) {
+            out.doubles.emplace_back(name, d->value());
+        } else if (const auto* m = dynamic_cast<const Imf::M44fAttribute*>(&a)) {
+            Matrix44 matrix;
+            for (int r = 0; r < 4; ++r)
+                for (int c = 0; c < 4; ++c)
+                    matrix[static_cast<std::size_t>(4 * r + c)] = m->value()[r][c];
+            out.matrices.emplace_back(name, matrix);
+        } else if (const auto* q = dynamic_cast<const Imf::RationalAttribute*>(&a)) {
+            out.rationals.emplace_back(name, ExrRational{q->value().n, q->value().d});
+        } else {
+            Imf::StdOSStream stream;
+            a.writeValueTo(stream, Imf::EXR_VERSION);
+            const std::string bytes = stream.str();
+            out.opaque.push_back({name, a.typeName(), {bytes.begin(), bytes.end()}});
+        }
+    }
+    return out;
+}
+
+ExrImage read_exr_image_file(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imf::Header& header = file.header();
+        const Imath::Box2i window = header.dataWindow();
+        const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
+        const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
+        if (w <= 0 || h <= 0) fail(path, "OpenEXR file has an empty data window");
+        const Imath::Box2i display = header.displayWindow();
+        if (static_cast<long long>(display.max.x) < display.min.x ||
+            static_cast<long long>(display.max.y) < display.min.y)
+            fail(path, "OpenEXR file has an empty display window");
+
+        ExrImage image;
+        std::size_t channels = 0;
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+            if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+                fail(path, std::string("OpenEXR channel '") + it.name() +
+                               "' is subsampled, which is not supported");
+            ++channels;
+        }
+        if (channels == 0) fail(path, "OpenEXR file has no channels");
+        if (static_cast<unsigned long long>(w) * static_cast<unsigned long long>(h) *
+                channels > max_float_values)
+            fail(path, "image too large");
+        check_pixel_data_fits(path, header, w, h);
+
+        image.display_window = from_box(display);
+        image.data_window = from_box(window);
+        image.compression = from_imf(header.compression());
+        image.attributes = read_attributes(header);
+        const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+        Imf::FrameBuffer frame_buffer;
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+            const Imf::PixelType t = it.channel().type;
+            const ExrPixelType type = t == Imf::HALF    ? ExrPixelType::half
+                                      : t == Imf::FLOAT ? ExrPixelType::float32
+                                                        : ExrPixelType::uint32;
+            const std::size_t element = sample_size(type);
+            image.channels.push_back(
+                ExrChannel{it.name(), type, std::vector<unsigned char>(pixels * element)});
+            frame_buffer.insert(it.name(),
+                                Imf::Slice::Make(t, image.channels.back().samples.data(),
+                                                 window, element,
+                                                 element * static_cast<std::size_t>(w)));
+        }
+        file.setFrameBuffer(frame_buffer);
+        file.readPixels(window.min.y, window.max.y);
+        return image;
+    } catch (const IoError&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        fail(path, "out of memory reading OpenEXR file");
+    } catch (const std::exception& e) {
+        fail(path, std::string("truncated or corrupt OpenEXR file (") + e.what() + ")");
+    }
+}
+
 // ---- PNG -----------------------------------------------------------------------------
 // libpng reports errors by longjmp. The functions that call setjmp create no object with
 // a destructor after it, so the jump never skips one; everything that owns memory lives
@@ -384,6 +510,14 @@ ChannelImage read_image(const std::string& path) {
             break;
     }
     fail(path, "not an image (neither an OpenEXR nor a PNG signature)");
+}
+
+ExrImage read_exr_image(const std::string& path) {
+    const std::vector<unsigned char> signature = read_signature(path);
+    if (signature.empty()) fail(path, "empty file, not an OpenEXR image");
+    if (kind_of(signature) != FileKind::exr)
+        fail(path, "not an OpenEXR file (no OpenEXR signature)");
+    return read_exr_image_file(path);
 }
 
 }  // namespace octray

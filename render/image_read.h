@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "render/image_io.h"
+
 namespace octray {
 
 // A float image of named channels, stored planar (one full plane per channel), so that
@@ -56,5 +58,13 @@ private:
 // or RGBA. Throws IoError naming the path and the reason: missing, unreadable, not an image
 // (unknown magic bytes), truncated or corrupt.
 ChannelImage read_image(const std::string& path);
+
+// Reads a scanline or tiled OpenEXR file (its first part) as it is stored: the display and
+// data windows, every channel in its own pixel type (half stays half, bit for bit), the
+// compression and every other header attribute (strings, floats, ints, doubles, M44f and
+// rationals by type, any other type as an opaque blob), so that write_exr() can write
+// the same image again. Throws IoError naming the path and the reason, as read_image()
+// does; also for a PNG or a subsampled channel.
+ExrImage read_exr_image(const std::string& path);
 
 }  // namespace octray

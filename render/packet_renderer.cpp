@@ -10,6 +10,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <utility>
@@ -18,6 +19,8 @@
 #include "core/aligned.h"
 #include "core/random.h"
 #include "kernels/dispatch.h"
+#include "render/crop.h"
+#include "scene/bvh.h"
 #include "scene/camera.h"
 
 namespace octray {
@@ -152,7 +155,18 @@ void resolve_into_parents(const kernels::SurfaceColor& c, const kernels::ChildLi
 }
 
 struct Tile {
-    int x0, y0, width, height;
+    int x0, y0, width, height;  // in pixels of the full image
+};
+
+// Where a render's tiles go: the crop-sized image (and, for a progressive pass, the sums),
+// and which samples of each pixel to trace (render/crop.h).
+struct RenderTarget {
+    Image& image;
+    PixelRect rect;        // the pixels `image` holds; tiles lie inside it
+    SampleRange samples;   // [0, spp) for a plain render
+    bool partial = false;  // a progressive pass: start from start_sums, write sums
+    const Image* start_sums = nullptr;  // sums of samples [0, samples.begin) or nullptr
+    Image* sums = nullptr;
 };
 
 // Pixel blocks of 4 x 2 inside a tile: eight neighbouring pixels fill one packet at one
@@ -163,8 +177,11 @@ constexpr int kBlockHeight = 2;
 class PacketTracer {
   public:
     PacketTracer(const CompiledScene& scene, const kernels::KernelTable& table,
-                 std::uint32_t frame)
-        : scene_(scene), view_(make_scene_view(scene)), k_(table), frame_(frame) {
+                 std::uint32_t frame, const SphereBvh* bvh)
+        : scene_(scene),
+          view_(bvh ? make_scene_view(scene, *bvh) : make_scene_view(scene)),
+          k_(table),
+          frame_(frame) {
         // One sample per pixel sits at the pixel center: the film position of a column
         // (row) is the same for every row (column), computed once.
         for (int i = 0; i < scene.width; ++i) center_x_.push_back(film_x(i, 0.5f, scene.width));
@@ -172,13 +189,27 @@ class PacketTracer {
             center_y_.push_back(film_y(j, 0.5f, scene.height));
     }
 
-    void render_tile(const Tile& tile, TileScratch& s, Image& image) const {
+    void render_tile(const Tile& tile, TileScratch& s, const RenderTarget& target) const {
         const int spp = scene_.spp;
+        const int first_sample = target.samples.begin, end_sample = target.samples.end;
         const std::size_t pixels = static_cast<std::size_t>(tile.width) * tile.height;
-        const std::size_t samples = pixels * static_cast<std::size_t>(spp);
+        const std::size_t samples =
+            pixels * static_cast<std::size_t>(end_sample - first_sample);
         s.acc_r.assign(pixels, 0.0f);
         s.acc_g.assign(pixels, 0.0f);
         s.acc_b.assign(pixels, 0.0f);
+        // A progressive pass adds its samples onto the previous passes' sums, so each pixel
+        // still sums its samples one after the other in sample order.
+        const int ox = tile.x0 - target.rect.x0, oy = tile.y0 - target.rect.y0;
+        if (target.start_sums != nullptr)
+            for (int y = 0; y < tile.height; ++y)
+                for (int x = 0; x < tile.width; ++x) {
+                    const std::size_t p = static_cast<std::size_t>(y) * tile.width + x;
+                    const Rgb start = target.start_sums->at(ox + x, oy + y);
+                    s.acc_r[p] = start.r;
+                    s.acc_g[p] = start.g;
+                    s.acc_b[p] = start.b;
+                }
 
         // Camera samples: block by block, pixel by pixel, sample by sample. Every stream
         // below keeps this order per pixel, so a pixel's contributions arrive in the same
@@ -203,7 +234,7 @@ class PacketTracer {
                             spixel[n++] = static_cast<std::uint32_t>(y * tile.width + x);
                             continue;
                         }
-                        for (int k = 0; k < spp; ++k, ++n) {
+                        for (int k = first_sample; k < end_sample; ++k, ++n) {
                             const auto sample = static_cast<std::uint32_t>(k);
                             const PixelOffset o = pixel_sample_offset(
                                 frame_, ui, uj, sample, static_cast<std::uint32_t>(spp),
@@ -287,13 +318,14 @@ class PacketTracer {
             }
         }
 
-        // The mean of the samples.
-        const auto inv = static_cast<float>(spp);
+        // The mean of the samples (of the samples so far, for a progressive pass).
+        const auto inv = static_cast<float>(target.partial ? end_sample : spp);
         for (int y = 0; y < tile.height; ++y)
             for (int x = 0; x < tile.width; ++x) {
                 const std::size_t p = static_cast<std::size_t>(y) * tile.width + x;
-                image.at(tile.x0 + x, tile.y0 + y) =
-                    Rgb(s.acc_r[p], s.acc_g[p], s.acc_b[p]) / inv;
+                const Rgb sum(s.acc_r[p], s.acc_g[p], s.acc_b[p]);
+                if (target.sums != nullptr) target.sums->at(ox + x, oy + y) = sum;
+                target.image.at(ox + x, oy + y) = sum / inv;
             }
     }
 
@@ -310,13 +342,38 @@ class PacketTracer {
 RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options, Isa isa) {
     const auto start = std::chrono::steady_clock::now();
     const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
-    const PacketTracer tracer(scene, table, options.frame);
+    // The spheres' BVH (options.accel), built on the render's threads and timed with it.
+    SphereBvh bvh;
+    const bool use_bvh = accel_uses_bvh(options.accel, scene.spheres.count);
+    if (use_bvh) {
+        const auto build = [&] { bvh = build_sphere_bvh(scene.spheres); };
+        if (options.threads > 0)
+            tbb::task_arena(options.threads).execute(build);
+        else
+            build();
+    }
+    const PacketTracer tracer(scene, table, options.frame, use_bvh ? &bvh : nullptr);
 
     RenderResult result;
-    result.image = Image(scene.width, scene.height);
+    // The crop and the sample range (render/crop.h). Tiles are laid from the crop's corner;
+    // a pixel's value depends on neither.
+    const PixelRect rect = render_rect(options, scene.width, scene.height);
+    const SampleRange sample_range = render_sample_range(options, scene.spp, rect);
+    result.rect = rect;
+    result.full_width = scene.width;
+    result.full_height = scene.height;
+    result.image = Image(rect.width(), rect.height());
+    RenderTarget target{result.image, rect, sample_range};
+    if (options.samples) {
+        result.sample_sums = Image(rect.width(), rect.height());
+        target.partial = true;
+        target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
+        target.sums = &result.sample_sums;
+    }
     const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
-    const int tiles_x = (scene.width + tw - 1) / tw, tiles_y = (scene.height + th - 1) / th;
+    const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
     tbb::enumerable_thread_specific<TileScratch> scratch;
+    std::atomic<bool> cancelled{false};  // a tile was skipped because of options.cancel
 
     const auto render_tiles = [&] {
         tbb::parallel_for(
@@ -324,10 +381,21 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
             [&](const tbb::blocked_range<int>& range) {
                 TileScratch& s = scratch.local();
                 for (int t = range.begin(); t < range.end(); ++t) {
-                    const int x0 = (t % tiles_x) * tw, y0 = (t / tiles_x) * th;
-                    const Tile tile{x0, y0, std::min(tw, scene.width - x0),
-                                    std::min(th, scene.height - y0)};
-                    tracer.render_tile(tile, s, result.image);
+                    if (options.cancel != nullptr &&
+                        options.cancel->load(std::memory_order_relaxed)) {
+                        cancelled.store(true, std::memory_order_relaxed);
+                        return;
+                    }
+                    const int x0 = rect.x0 + (t % tiles_x) * tw;
+                    const int y0 = rect.y0 + (t / tiles_x) * th;
+                    const Tile tile{x0, y0, std::min(tw, rect.x1 - x0),
+                                    std::min(th, rect.y1 - y0)};
+                    tracer.render_tile(tile, s, target);
+                    if (options.pixels_done != nullptr)
+                        options.pixels_done->fetch_add(
+                            static_cast<std::uint64_t>(tile.width) *
+                                static_cast<std::uint64_t>(tile.height),
+                            std::memory_order_relaxed);
                 }
             },
             tbb::simple_partitioner());
@@ -338,6 +406,7 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     } else {
         render_tiles();
     }
+    if (cancelled.load()) throw RenderCancelled();
     for (const TileScratch& s : scratch) result.rays += s.counts;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

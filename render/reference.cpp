@@ -9,11 +9,13 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <numbers>
 
 #include "core/random.h"
+#include "render/crop.h"
 
 namespace octray {
 namespace {
@@ -162,6 +164,19 @@ Rgb ReferenceTracer::trace(const Ray& ray, int depth, Rgb weight, RayCounts& cou
     return shade(ray, *hit, depth, weight, counts);
 }
 
+Rgb ReferenceTracer::surface_color(const SurfaceHit& hit) const {
+    // Cd, or the checker's second color on odd squares (planes only).
+    const Object& object = scene_.objects[hit.object];
+    const Material& m = scene_.materials[object.material].material;
+    if (m.checker && object.type == ObjectType::plane) {
+        const TangentBasis& tb = checker_bases_[hit.object];
+        const float parity = floor_parity(dot(hit.point, tb.t1) / m.checker->size) +
+                             floor_parity(dot(hit.point, tb.t2) / m.checker->size);
+        if (parity == 1.0f) return m.checker->color;
+    }
+    return m.color;
+}
+
 Rgb ReferenceTracer::shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb weight,
                            RayCounts& counts) const {
     const Object& object = scene_.objects[hit.object];
@@ -172,14 +187,7 @@ Rgb ReferenceTracer::shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb
     const Vec3 n = dot(hit.normal, ray.direction) > 0.0f ? -hit.normal : hit.normal;
     const Vec3 w = -v_hat;
 
-    // Surface color: Cd, or the checker's second color on odd squares (planes only).
-    Rgb cd = m.color;
-    if (m.checker && object.type == ObjectType::plane) {
-        const TangentBasis& tb = checker_bases_[hit.object];
-        const float parity = floor_parity(dot(p, tb.t1) / m.checker->size) +
-                             floor_parity(dot(p, tb.t2) / m.checker->size);
-        if (parity == 1.0f) cd = m.checker->color;
-    }
+    const Rgb cd = surface_color(hit);
 
     // Ambient term.
     Rgb color = scene_.ambient * (cd * m.kd);
@@ -256,35 +264,70 @@ Rgb ReferenceTracer::shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb
     return color;
 }
 
-Rgb ReferenceTracer::render_pixel(int i, int j, std::uint32_t frame, RayCounts& counts) const {
-    Rgb sum;
-    const int spp = scene_.image.spp;
-    for (int s = 0; s < spp; ++s) {
+Rgb ReferenceTracer::sum_samples(int i, int j, std::uint32_t frame, SampleRange samples,
+                                 Rgb sum, RayCounts& counts) const {
+    for (int s = samples.begin; s < samples.end; ++s) {
         const std::optional<Ray> ray = camera_ray(i, j, static_cast<std::uint32_t>(s), frame);
         if (!ray) continue;  // fisheye sample outside the image circle: black
         ++counts.primary;
         sum += trace(*ray, 0, Rgb(1.0f), counts);
     }
-    return sum / static_cast<float>(spp);
+    return sum;
+}
+
+Rgb ReferenceTracer::render_pixel(int i, int j, std::uint32_t frame, RayCounts& counts) const {
+    const int spp = scene_.image.spp;
+    return sum_samples(i, j, frame, SampleRange{0, spp}, Rgb(), counts) /
+           static_cast<float>(spp);
 }
 
 RenderResult render_reference(const Scene& scene, const RenderOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     const ReferenceTracer tracer(scene);
     RenderResult result;
-    result.image = Image(scene.image.width, scene.image.height);
+    // The crop and the sample range (render/crop.h): pixel (i, j) of the full image lands
+    // at (i - rect.x0, j - rect.y0); its value does not depend on either.
+    const PixelRect rect = render_rect(options, scene.image.width, scene.image.height);
+    const SampleRange samples = render_sample_range(options, scene.image.spp, rect);
+    const bool partial_samples = options.samples.has_value();
+    result.rect = rect;
+    result.full_width = scene.image.width;
+    result.full_height = scene.image.height;
+    result.image = Image(rect.width(), rect.height());
+    if (partial_samples) result.sample_sums = Image(rect.width(), rect.height());
     tbb::combinable<RayCounts> counts;
+    std::atomic<bool> cancelled{false};  // a tile was skipped because of options.cancel
 
     const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
     const auto render_tiles = [&] {
         // Each pixel depends only on its own counters, so any split gives the same bits.
         tbb::parallel_for(
-            tbb::blocked_range2d<int>(0, scene.image.height, th, 0, scene.image.width, tw),
+            tbb::blocked_range2d<int>(rect.y0, rect.y1, th, rect.x0, rect.x1, tw),
             [&](const tbb::blocked_range2d<int>& tile) {
+                if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
+                    cancelled.store(true, std::memory_order_relaxed);
+                    return;
+                }
                 RayCounts& local = counts.local();
                 for (int j = tile.rows().begin(); j < tile.rows().end(); ++j)
-                    for (int i = tile.cols().begin(); i < tile.cols().end(); ++i)
-                        result.image.at(i, j) = tracer.render_pixel(i, j, options.frame, local);
+                    for (int i = tile.cols().begin(); i < tile.cols().end(); ++i) {
+                        const int x = i - rect.x0, y = j - rect.y0;
+                        if (!partial_samples) {
+                            result.image.at(x, y) =
+                                tracer.render_pixel(i, j, options.frame, local);
+                            continue;
+                        }
+                        const Rgb start =
+                            samples.begin > 0 ? options.sample_sums->at(x, y) : Rgb();
+                        const Rgb sum =
+                            tracer.sum_samples(i, j, options.frame, samples, start, local);
+                        result.sample_sums.at(x, y) = sum;
+                        result.image.at(x, y) = sum / static_cast<float>(samples.end);
+                    }
+                if (options.pixels_done != nullptr)
+                    options.pixels_done->fetch_add(
+                        static_cast<std::uint64_t>(tile.rows().size()) * tile.cols().size(),
+                        std::memory_order_relaxed);
             },
             tbb::simple_partitioner());
     };
@@ -294,6 +337,7 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
     } else {
         render_tiles();
     }
+    if (cancelled.load()) throw RenderCancelled();
     counts.combine_each([&](const RayCounts& c) { result.rays += c; });
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

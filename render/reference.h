@@ -43,6 +43,16 @@ public:
     // The mean of all samples of pixel (i, j).
     Rgb render_pixel(int i, int j, std::uint32_t frame, RayCounts& counts) const;
 
+    // `sum` plus the radiance of samples [samples.begin, samples.end) of pixel (i, j),
+    // added one after the other in sample order (progressive passes: render_pixel is
+    // sum_samples over [0, spp) from zero, divided by spp).
+    Rgb sum_samples(int i, int j, std::uint32_t frame, SampleRange samples, Rgb sum,
+                    RayCounts& counts) const;
+
+    // The diffuse color Cd of the surface at `hit`: the material's color, or the checker's
+    // second color on odd squares of a plane.
+    Rgb surface_color(const SurfaceHit& hit) const;
+
     float epsilon() const { return epsilon_; }
     const CameraFrame& camera() const { return camera_; }
 
@@ -58,8 +68,9 @@ private:
     std::vector<TangentBasis> checker_bases_;  // per object; planes only
 };
 
-// Renders the whole image; tiles may run in parallel (TBB), one ray at a time per thread.
-// The image is bit-identical for any thread count and tile size.
+// Renders the whole image, or options.crop of it, and options.samples of each pixel (see
+// render/types.h); tiles may run in parallel (TBB), one ray at a time per thread. The image
+// is bit-identical for any thread count, tile size and crop.
 RenderResult render_reference(const Scene& scene, const RenderOptions& options = {});
 
 }  // namespace octray

@@ -1,9 +1,14 @@
 #pragma once
 // What both render paths take and give back.
 
+#include <atomic>
+#include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <stdexcept>
 
 #include "core/image.h"
+#include "scene/accel.h"
 
 namespace octray {
 
@@ -23,15 +28,83 @@ struct RayCounts {
     }
 };
 
+// A half-open rectangle of pixels [x0, x1) x [y0, y1) of the full image, row 0 on top
+// (pixel (x, y) is column x, row y). A crop, an EXR data window, a part of `assemble`.
+struct PixelRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    bool empty() const { return x1 <= x0 || y1 <= y0; }
+    std::size_t pixel_count() const {
+        return empty() ? 0
+                       : static_cast<std::size_t>(width()) * static_cast<std::size_t>(height());
+    }
+    bool contains(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
+    // True if `r` lies wholly inside this rectangle (an empty `r` never does).
+    bool contains(const PixelRect& r) const {
+        return !r.empty() && r.x0 >= x0 && r.y0 >= y0 && r.x1 <= x1 && r.y1 <= y1;
+    }
+    friend bool operator==(const PixelRect&, const PixelRect&) = default;
+};
+
+// The pixels two rectangles share (empty() when none).
+inline PixelRect intersection(const PixelRect& a, const PixelRect& b) {
+    PixelRect r{a.x0 > b.x0 ? a.x0 : b.x0, a.y0 > b.y0 ? a.y0 : b.y0,
+                a.x1 < b.x1 ? a.x1 : b.x1, a.y1 < b.y1 ? a.y1 : b.y1};
+    if (r.empty()) r = PixelRect{};
+    return r;
+}
+
+// A range [begin, end) of the sample indices 0 .. spp-1 of every pixel (progressive passes).
+struct SampleRange {
+    int begin = 0;
+    int end = 0;
+};
+
 struct RenderOptions {
     int threads = 0;           // 0: every core TBB sees
     std::uint32_t frame = 0;   // the frame counter of the random hash
     int tile_width = 16;
     int tile_height = 16;
+    // Batch rendering (tools/cmd_render.cpp), both optional: the renderers poll *cancel
+    // between tiles and, once it is true, stop and throw RenderCancelled; they add each
+    // finished tile's pixel count to *pixels_done (progress).
+    const std::atomic<bool>* cancel = nullptr;
+    std::atomic<std::uint64_t>* pixels_done = nullptr;
+    // Render only these pixels of the full image (render/README.md, "Crops"): the result
+    // image is crop-sized and each pixel equals the same pixel of the full render bit for
+    // bit. Must be non-empty and inside the image (else std::invalid_argument).
+    std::optional<PixelRect> crop;
+    // Progressive passes (render/progressive.h): trace only samples [begin, end) of each
+    // pixel, adding them in sample order onto *sample_sums (the running sums of samples
+    // [0, begin), crop-sized; nullptr when begin == 0). The result then also carries the
+    // new sums; its image is sums / end. Unset: every sample, as a plain render.
+    std::optional<SampleRange> samples;
+    const Image* sample_sums = nullptr;
+    // The SIMD path's acceleration structure for spheres (`--accel`, scene/accel.h): auto
+    // builds a BVH from kBvhAutoMinSpheres spheres on. The image is the same either way;
+    // the scalar reference ignores it (brute force always).
+    Accel accel = Accel::automatic;
+};
+
+// Thrown by a render stopped through RenderOptions::cancel: no image is returned.
+class RenderCancelled : public std::runtime_error {
+public:
+    RenderCancelled() : std::runtime_error("render cancelled") {}
 };
 
 struct RenderResult {
-    Image image;
+    Image image;  // the pixels of `rect` (crop-sized); (0, 0) is pixel (rect.x0, rect.y0)
+    // Which pixels of the full_width x full_height image `image` holds: the crop, or the
+    // whole image. An EXR writer makes `rect` the data window and the full image the
+    // display window (render/image_io.h, make_exr_image).
+    PixelRect rect;
+    int full_width = 0;
+    int full_height = 0;
+    // With RenderOptions::samples: the per-pixel sums of samples [0, samples->end), to pass
+    // on as the next pass's sample_sums. Empty otherwise.
+    Image sample_sums;
     RayCounts rays;
     double seconds = 0.0;  // wall-clock time of the render itself
 };

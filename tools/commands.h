@@ -54,5 +54,6 @@ void add_compare_command(CLI::App& app, CommandRunner& run);
 void add_bench_command(CLI::App& app, CommandRunner& run);
 void add_verify_command(CLI::App& app, CommandRunner& run);
 void add_info_command(CLI::App& app, CommandRunner& run);
+void add_assemble_command(CLI::App& app, CommandRunner& run);
 
 }  // namespace octray::tools

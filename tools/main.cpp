@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -54,6 +55,9 @@ int run_command(const std::function<void()>& action) {
 
 int main(int argc, char** argv) {
     using namespace octray::tools;
+    // A write past `ulimit -f` then fails with EFBIG, reported as an I/O error with its
+    // temporary removed, instead of SIGXFSZ killing the process mid-file.
+    std::signal(SIGXFSZ, SIG_IGN);
 
     CLI::App app{"octray renders Whitted-style ray-traced images (OpenEXR, with PNG previews).",
                  "octray"};
@@ -82,6 +86,7 @@ int main(int argc, char** argv) {
     add_bench_command(app, run);
     add_verify_command(app, run);
     add_info_command(app, run);
+    add_assemble_command(app, run);
 
     try {
         app.parse(argc, argv);

@@ -1,0 +1,151 @@
+// AOVs from the scalar reference tracer: one primary ray per pixel (sample 0), its first
+// hit, and what the shading of that hit would use (render/README.md, "AOVs").
+
+#include "render/aov.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <array>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+#include "render/crop.h"
+#include "render/reference.h"
+
+namespace octray {
+namespace {
+
+constexpr std::array<std::string_view, 4> kAovNames{"depth", "normal", "albedo", "id"};
+
+bool* flag_of(AovSet& set, std::string_view name) {
+    if (name == "depth") return &set.depth;
+    if (name == "normal") return &set.normal;
+    if (name == "albedo") return &set.albedo;
+    if (name == "id") return &set.id;
+    return nullptr;
+}
+
+std::string known_names() {
+    std::string s;
+    for (std::string_view n : kAovNames) {
+        if (!s.empty()) s += ", ";
+        s += n;
+    }
+    return s;
+}
+
+}  // namespace
+
+std::optional<AovSet> parse_aov_list(std::string_view list, std::string* error) {
+    const auto failed = [&](std::string why) -> std::optional<AovSet> {
+        if (error != nullptr) *error = std::move(why);
+        return std::nullopt;
+    };
+    AovSet set;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = list.find(',', start);
+        const std::string_view item =
+            list.substr(start, comma == std::string_view::npos ? std::string_view::npos
+                                                               : comma - start);
+        if (item.empty()) {
+            std::string why = "empty item in the AOV list '";
+            why += list;
+            why += "' (known: " + known_names() + ")";
+            return failed(std::move(why));
+        }
+        bool* flag = flag_of(set, item);
+        if (flag == nullptr) {
+            std::string why = "unknown AOV '";
+            why += item;
+            why += "' (known: " + known_names() + ")";
+            return failed(std::move(why));
+        }
+        if (*flag) {
+            std::string why = "AOV '";
+            why += item;
+            why += "' is listed twice";
+            return failed(std::move(why));
+        }
+        *flag = true;
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    return set;
+}
+
+AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set) {
+    const PixelRect rect = render_rect(options, scene.image.width, scene.image.height);
+    AovImages out;
+    out.set = set;
+    out.rect = rect;
+    const std::size_t n = rect.pixel_count();
+    if (set.depth) out.depth.assign(n, std::numeric_limits<float>::infinity());
+    if (set.normal) out.normal.assign(n, Vec3{});
+    if (set.albedo) out.albedo.assign(n, Rgb{});
+    if (set.id) out.id.assign(n, 0u);
+    if (!set.any()) return out;
+
+    const ReferenceTracer tracer(scene);
+    const auto compute_rows = [&] {
+        tbb::parallel_for(tbb::blocked_range<int>(rect.y0, rect.y1), [&](const auto& rows) {
+            for (int j = rows.begin(); j < rows.end(); ++j)
+                for (int i = rect.x0; i < rect.x1; ++i) {
+                    // Sample 0's camera ray; a fisheye pixel outside the image circle has
+                    // none and keeps the miss values.
+                    const std::optional<Ray> ray = tracer.camera_ray(i, j, 0, options.frame);
+                    if (!ray) continue;
+                    const std::optional<SurfaceHit> hit = tracer.intersect(*ray);
+                    if (!hit) continue;
+                    const std::size_t k =
+                        static_cast<std::size_t>(j - rect.y0) * rect.width() + (i - rect.x0);
+                    if (set.depth) out.depth[k] = hit->t;
+                    if (set.normal)  // the normal shading uses: facing the incoming ray
+                        out.normal[k] = dot(hit->normal, ray->direction) > 0.0f ? -hit->normal
+                                                                                 : hit->normal;
+                    if (set.albedo) out.albedo[k] = tracer.surface_color(*hit);
+                    if (set.id) out.id[k] = hit->object + 1;
+                }
+        });
+    };
+    if (options.threads > 0) {
+        tbb::task_arena arena(options.threads);
+        arena.execute(compute_rows);
+    } else {
+        compute_rows();
+    }
+    return out;
+}
+
+void append_aov_channels(ExrImage& exr, const AovImages& aovs, ExrPixelType color_type) {
+    if (!(exr.data_window == aovs.rect))
+        throw std::invalid_argument("append_aov_channels: the AOVs cover " + to_string(aovs.rect) +
+                                    ", the image's data window is " +
+                                    to_string(exr.data_window));
+    if (color_type == ExrPixelType::uint32)
+        throw std::invalid_argument("append_aov_channels: colors are half or float");
+    const std::size_t n = aovs.rect.pixel_count();
+    if (aovs.set.depth)
+        exr.channels.push_back(
+            make_exr_channel("Z", ExrPixelType::float32, aovs.depth.data(), n));
+    if (aovs.set.normal) {
+        const float* v = reinterpret_cast<const float*>(aovs.normal.data());
+        static_assert(sizeof(Vec3) == 3 * sizeof(float));
+        exr.channels.push_back(make_exr_channel("N.X", color_type, v + 0, n, 3));
+        exr.channels.push_back(make_exr_channel("N.Y", color_type, v + 1, n, 3));
+        exr.channels.push_back(make_exr_channel("N.Z", color_type, v + 2, n, 3));
+    }
+    if (aovs.set.albedo) {
+        const float* c = reinterpret_cast<const float*>(aovs.albedo.data());
+        static_assert(sizeof(Rgb) == 3 * sizeof(float));
+        exr.channels.push_back(make_exr_channel("albedo.R", color_type, c + 0, n, 3));
+        exr.channels.push_back(make_exr_channel("albedo.G", color_type, c + 1, n, 3));
+        exr.channels.push_back(make_exr_channel("albedo.B", color_type, c + 2, n, 3));
+    }
+    if (aovs.set.id) exr.channels.push_back(make_exr_channel("id", aovs.id));
+}
+
+}  // namespace octray

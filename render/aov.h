@@ -1,0 +1,56 @@
+#pragma once
+// Arbitrary output variables: per-pixel data about the first surface each camera ray hits
+// (depth, normal, albedo, object id), written as extra channels of the render's EXR
+// (render/README.md, "AOVs"). They come from the scalar reference tracer, one primary ray
+// per pixel, so they are the same whichever path renders the color.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/vec3.h"
+#include "render/image_io.h"
+#include "render/types.h"
+#include "scene/scene.h"
+
+namespace octray {
+
+struct AovSet {
+    bool depth = false;   // Z
+    bool normal = false;  // N.X N.Y N.Z
+    bool albedo = false;  // albedo.R albedo.G albedo.B
+    bool id = false;      // id
+    bool any() const { return depth || normal || albedo || id; }
+    friend bool operator==(const AovSet&, const AovSet&) = default;
+};
+
+// Parses a comma-separated list of AOV names ("depth,normal,albedo,id"; each at most once,
+// no empty items). On failure returns nullopt and, if `error` is given, says why ("unknown
+// AOV 'foo' (known: depth, normal, albedo, id)").
+std::optional<AovSet> parse_aov_list(std::string_view list, std::string* error = nullptr);
+
+// The AOVs of the pixels of `rect`, row by row (top row first); a vector is empty unless
+// its AOV was asked for.
+struct AovImages {
+    AovSet set;
+    PixelRect rect;
+    std::vector<float> depth;          // t of the first hit along the unit primary ray; +inf: miss
+    std::vector<Vec3> normal;          // world-space unit normal facing the ray; 0: miss
+    std::vector<Rgb> albedo;           // Cd at the hit (checker included); 0: miss
+    std::vector<std::uint32_t> id;     // Scene::objects index + 1; 0: miss
+};
+
+// Computes `set` for the pixels of options.crop (or the whole image) of frame
+// options.frame, from sample 0's primary ray of each pixel (the pixel center at 1 spp), in
+// parallel over options.threads threads. The scene must have passed validate_scene().
+// Throws std::invalid_argument for a bad crop, as the renderers do.
+AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set);
+
+// Appends the AOV channels to `exr` (whose data window must be aovs.rect): Z float32; N.*
+// and albedo.* in `color_type` (the R, G, B type: half, or float32 with --float); id
+// uint32. Throws std::invalid_argument if the windows disagree.
+void append_aov_channels(ExrImage& exr, const AovImages& aovs, ExrPixelType color_type);
+
+}  // namespace octray

@@ -1,0 +1,157 @@
+// AOVs (render/aov.h): the list parser, the values on a scene whose answers are known (a
+// sphere straight ahead, a plane seen from behind, a checker, a miss), crops, and the EXR
+// channels with their pixel types.
+
+#include "render/aov.h"
+
+#include <gtest/gtest.h>
+#include <half.h>
+
+#include <cmath>
+#include <set>
+#include <tuple>
+
+#include "output_fixtures.h"
+#include "render/image_read.h"
+#include "scene_builders.h"
+
+namespace octray {
+namespace {
+
+TEST(Aov, ParsesListsAndNamesMistakes) {
+    EXPECT_EQ(parse_aov_list("depth"), (AovSet{true, false, false, false}));
+    EXPECT_EQ(parse_aov_list("id,albedo"), (AovSet{false, false, true, true}));
+    EXPECT_EQ(parse_aov_list("depth,normal,albedo,id"), (AovSet{true, true, true, true}));
+    std::string error;
+    EXPECT_FALSE(parse_aov_list("depth,colour", &error));
+    EXPECT_NE(error.find("unknown AOV 'colour'"), std::string::npos) << error;
+    EXPECT_NE(error.find("depth, normal, albedo, id"), std::string::npos) << error;
+    EXPECT_FALSE(parse_aov_list("depth,,id", &error));
+    EXPECT_NE(error.find("empty item"), std::string::npos) << error;
+    EXPECT_FALSE(parse_aov_list("", &error));
+    EXPECT_FALSE(parse_aov_list("id,id", &error));
+    EXPECT_NE(error.find("'id' is listed twice"), std::string::npos) << error;
+    EXPECT_FALSE(parse_aov_list("Depth"));
+}
+
+// The eye at (0, 0, 5) looking at the origin, 33x33 pixels, 60 degrees: pixel (16, 16)
+// looks straight down -Z. A red unit sphere at the origin (object 0), behind it a plane at
+// z = -3 whose normal points away from the eye (object 1), with a checker.
+Scene known_scene(int spp = 1) {
+    Scene s = test::empty_scene(33, 33);
+    s.image.spp = spp;
+    Material red;
+    red.color = {0.8f, 0.1f, 0.1f};
+    Material floor;
+    floor.color = {0.2f, 0.3f, 0.4f};
+    floor.checker = Checker{{0.9f, 0.8f, 0.7f}, 0.5f};
+    test::add_sphere(s, {0, 0, 0}, 1.0f, test::add_material(s, red));
+    test::add_plane(s, {0, 0, -3}, {0, 0, -1}, test::add_material(s, floor));
+    return s;
+}
+
+TEST(Aov, KnownValuesOfASphereAPlaneAndAMiss) {
+    Scene scene = known_scene();
+    const AovImages a = compute_aovs(scene, {}, AovSet{true, true, true, true});
+    ASSERT_EQ(a.rect, (PixelRect{0, 0, 33, 33}));
+    const auto at = [&](int x, int y) { return static_cast<std::size_t>(y) * 33 + x; };
+    // Straight ahead: the sphere's front at distance 4, normal -view = +Z, Cd, id 1.
+    EXPECT_EQ(a.depth[at(16, 16)], 4.0f);
+    EXPECT_EQ(a.normal[at(16, 16)], (Vec3{0, 0, 1}));
+    EXPECT_EQ(a.albedo[at(16, 16)], (Rgb{0.8f, 0.1f, 0.1f}));
+    EXPECT_EQ(a.id[at(16, 16)], 1u);
+    // A corner sees the plane from behind: the normal is flipped towards the eye, the
+    // depth is the distance along the ray (8 / cos of the angle off axis), id 2.
+    const std::size_t c = at(0, 0);
+    EXPECT_EQ(a.id[c], 2u);
+    EXPECT_EQ(a.normal[c], (Vec3{0, 0, 1}));
+    ReferenceTracer tracer(scene);
+    const Ray ray = *tracer.camera_ray(0, 0, 0);
+    EXPECT_NEAR(a.depth[c], 8.0f / -ray.direction.z, 1e-5f);
+    // The checker's two colors both occur on the plane, and nothing else.
+    std::set<std::tuple<float, float, float>> plane_colors;
+    for (std::size_t k = 0; k < a.id.size(); ++k)
+        if (a.id[k] == 2u) plane_colors.insert({a.albedo[k].r, a.albedo[k].g, a.albedo[k].b});
+    EXPECT_EQ(plane_colors, (std::set<std::tuple<float, float, float>>{
+                                {0.2f, 0.3f, 0.4f}, {0.9f, 0.8f, 0.7f}}));
+
+    // Without the plane the corner misses: Z = +inf, N = 0, albedo = 0, id = 0.
+    scene.objects.pop_back();
+    const AovImages m = compute_aovs(scene, {}, AovSet{true, true, true, true});
+    EXPECT_TRUE(std::isinf(m.depth[c]) && m.depth[c] > 0.0f);
+    EXPECT_EQ(m.normal[c], (Vec3{0, 0, 0}));
+    EXPECT_EQ(m.albedo[c], (Rgb{0, 0, 0}));
+    EXPECT_EQ(m.id[c], 0u);
+    EXPECT_EQ(m.id[at(16, 16)], 1u);
+}
+
+TEST(Aov, OnlyTheAskedAovsAndCropsAreTheFullImagesPixels) {
+    const Scene scene = test::golden_scene("thinlens_spp4", 23, 17);
+    const AovImages full = compute_aovs(scene, {}, AovSet{true, true, true, true});
+    RenderOptions options;
+    options.crop = PixelRect{4, 3, 15, 9};
+    options.threads = 1;
+    const AovImages part = compute_aovs(scene, options, AovSet{true, false, false, true});
+    EXPECT_EQ(part.rect, *options.crop);
+    EXPECT_TRUE(part.normal.empty());
+    EXPECT_TRUE(part.albedo.empty());
+    ASSERT_EQ(part.depth.size(), 11u * 6u);
+    for (int y = 3; y < 9; ++y)
+        for (int x = 4; x < 15; ++x) {
+            const std::size_t k = static_cast<std::size_t>(y - 3) * 11 + (x - 4);
+            const std::size_t f = static_cast<std::size_t>(y) * 23 + x;
+            EXPECT_EQ(part.depth[k], full.depth[f]);
+            EXPECT_EQ(part.id[k], full.id[f]);
+        }
+    options.crop = PixelRect{0, 0, 24, 1};
+    EXPECT_THROW(compute_aovs(scene, options, AovSet{true}), std::invalid_argument);
+}
+
+TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
+    const Scene scene = known_scene();
+    const std::filesystem::path dir = test::test_dir();
+    for (bool float32 : {false, true}) {
+        SCOPED_TRACE(float32 ? "float" : "half");
+        RenderOptions options;
+        options.crop = PixelRect{10, 12, 20, 21};
+        const RenderResult result = render_reference(scene, options);
+        const AovImages aovs = compute_aovs(scene, options, AovSet{true, true, true, true});
+        ExrImage exr = make_exr_image(result, ExrWriteOptions{float32, ExrCompression::zip});
+        const ExrPixelType color = float32 ? ExrPixelType::float32 : ExrPixelType::half;
+        append_aov_channels(exr, aovs, color);
+        const std::string path = (dir / "aovs.exr").string();
+        write_exr(path, exr);
+
+        const ExrImage back = read_exr_image(path);
+        EXPECT_EQ(back.data_window, *options.crop);
+        EXPECT_EQ(back.display_window, (PixelRect{0, 0, 33, 33}));
+        ASSERT_EQ(back.channels.size(), 11u);
+        const auto type_of = [&](const char* name) {
+            const ExrChannel* c = back.find_channel(name);
+            EXPECT_NE(c, nullptr) << name;
+            return c != nullptr ? c->type : ExrPixelType::uint32;
+        };
+        EXPECT_EQ(type_of("R"), color);
+        EXPECT_EQ(type_of("N.X"), color);
+        EXPECT_EQ(type_of("albedo.G"), color);
+        EXPECT_EQ(type_of("Z"), ExrPixelType::float32);
+        EXPECT_EQ(type_of("id"), ExrPixelType::uint32);
+        // Pixel (16, 16) of the full image is (6, 4) of the crop.
+        const std::size_t k = 4 * 10 + 6;
+        EXPECT_EQ(back.find_channel("Z")->value(k), 4.0f);
+        EXPECT_EQ(back.find_channel("id")->uint_value(k), 1u);
+        EXPECT_EQ(back.find_channel("N.Z")->value(k), 1.0f);
+        EXPECT_EQ(back.find_channel("albedo.R")->value(k), float32 ? 0.8f : float(half(0.8f)));
+        for (std::size_t p = 0; p < exr.data_window.pixel_count(); ++p)
+            EXPECT_EQ(back.find_channel("Z")->value(p), aovs.depth[p]);
+    }
+    ExrImage wrong = make_exr_image(render_reference(scene, {}), ExrWriteOptions{});
+    RenderOptions crop;
+    crop.crop = PixelRect{0, 0, 5, 5};
+    EXPECT_THROW(append_aov_channels(wrong, compute_aovs(scene, crop, AovSet{true}),
+                                     ExrPixelType::half),
+                 std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace octray
