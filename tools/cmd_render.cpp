@@ -1,75 +1,66 @@
-// `octray render`: load a scene, apply command-line overrides, render, write EXR (+ PNG).
+// `octray render`: load scenes, apply command-line overrides, then render a list of frames
+// (one still by default; animations, frame ranges, several scenes, shards of a farm job)
+// to EXR (+ PNG previews). The frame loop itself lives in render_batch.cpp.
 
 #include <CLI/CLI.hpp>
-#include <oneapi/tbb/global_control.h>
+#include <unistd.h>
 
-#include <cctype>
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
-#include <ctime>
+#include <cstdlib>
 #include <filesystem>
-#include <functional>
+#include <fstream>
+#include <map>
 #include <memory>
 #include <optional>
+#include <set>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
 
-#include "core/version.h"
+#include "core/sha256.h"
 #include "kernels/dispatch.h"
 #include "render/image_io.h"
-#include "render/packet_renderer.h"
-#include "render/reference.h"
-#include "render/types.h"
+#include "scene/animation.h"
 #include "scene/builtin.h"
+#include "scene/limits.h"
 #include "scene/load.h"
 #include "scene/scene.h"
 #include "scene/scene_error.h"
+#include "tools/batch.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
+#include "tools/render_batch.h"
 
 namespace octray::tools {
 namespace {
 
 namespace fs = std::filesystem;
 
-// ---- Render paths: the one place that knows which renderers exist -----------------------
-
-enum class RenderPath { scalar, simd };
-
-// What `octray render` uses without --path.
-constexpr RenderPath kDefaultRenderPath = RenderPath::simd;
-
-std::string_view to_string(RenderPath path) {
-    return path == RenderPath::scalar ? "scalar" : "simd";
-}
-
-using Renderer = std::function<RenderResult(const Scene&, const RenderOptions&)>;
-
-// Chosen before the scene is loaded, so an unavailable path (or an ISA this CPU lacks)
-// fails at once. `isa` is already resolved for the simd path.
-Renderer select_renderer(RenderPath path, Isa isa) {
-    switch (path) {
-        case RenderPath::scalar: return [](const Scene& scene, const RenderOptions& options) {
-            return render_reference(scene, options);
-        };
-        case RenderPath::simd: return [isa](const Scene& scene, const RenderOptions& options) {
-            return render_packet(scene, options, isa);
-        };
-    }
-    throw UsageError("unknown render path");
-}
-
 // ---- Options ---------------------------------------------------------------------------
 
 struct RenderArguments {
-    std::string scene = "whitted";
-    std::string output;  // empty: <scene name>.exr in the current directory
+    std::vector<std::string> scenes{"whitted"};
+    std::string output;  // a pattern; empty: {scene}.exr, or {scene}.####.exr for sequences
+    std::string frames;
+    std::string shard;
+    int shard_count = 0;
+    bool skip_existing = false;
+    bool placeholders = false;
+    std::string crop;
+    std::string aov;
+    std::string progress = "auto";
+    bool progressive = false;
+    std::string max_memory;
     int width = 0, height = 0, spp = 0, max_depth = 0;
     std::uint64_t seed = 0;
     int threads = 0;
-    std::string path{to_string(kDefaultRenderPath)};
+    std::string path{"simd"};
     std::string isa = "auto";
+    std::string accel = "auto";
     std::string png;
     bool float32 = false;
     std::string compression{to_string(ExrWriteOptions{}.compression)};
@@ -80,6 +71,7 @@ struct RenderArguments {
     CLI::Option* spp_option = nullptr;
     CLI::Option* max_depth_option = nullptr;
     CLI::Option* seed_option = nullptr;
+    CLI::Option* shard_count_option = nullptr;
 };
 
 struct TileSize {
@@ -107,84 +99,34 @@ std::optional<TileSize> parse_tile(const std::string& text) {
     return TileSize{*w, *h};
 }
 
-// The default output name: "whitted" -> whitted.exr, "random:8,width=32" -> random-8.exr,
-// "scenes/room.json" -> room.exr (always in the current directory).
-std::string default_output_name(const std::string& spec) {
-    std::string stem;
-    if (is_builtin_scene(spec)) {
-        stem = spec.substr(0, spec.find(','));
-        const std::size_t colon = stem.find(':');
-        if (colon != std::string::npos) stem[colon] = '-';
-    } else {
-        stem = fs::path(spec).stem().string();
+// ---- Pre-flight: everything that can be checked before the first frame ----------------
+
+// The scene's identity for the EXR: SHA-256 of the file's bytes (what `sha256sum` prints),
+// or for a built-in, of its JSON form (what `octray scene SPEC` prints).
+std::string scene_digest(const std::string& spec, const Scene& scene) {
+    if (!is_builtin_scene(spec)) {
+        std::ifstream in(spec, std::ios::binary);
+        std::ostringstream bytes;
+        bytes << in.rdbuf();
+        if (in) return sha256_hex(bytes.str());
     }
-    for (char& c : stem) {
-        const auto u = static_cast<unsigned char>(c);
-        if (!std::isalnum(u) && c != '-' && c != '_' && c != '.') c = '_';
-    }
-    if (stem.empty() || stem == "." || stem == "..") stem = "render";
-    return stem + ".exr";
+    return sha256_hex(scene_to_json(scene));
 }
 
-// Fails before the render when an output clearly cannot be written, rather than after
-// minutes of rendering. (The write itself still reports anything this misses.)
-void check_output_location(const std::string& path) {
-    fs::path dir = fs::path(path).parent_path();
-    if (dir.empty()) dir = ".";
-    std::error_code error;
-    if (!fs::is_directory(dir, error))
-        throw IoError("cannot write " + path + ": directory " + dir.string() +
-                      " does not exist");
-    if (fs::is_directory(path, error))
-        throw IoError("cannot write " + path + ": it is a directory");
+// Physical memory: the default --max-memory (0 if unknown: no limit).
+std::uint64_t physical_memory_bytes() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long page_size = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page_size <= 0) return 0;
+    return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
 }
 
-// EXR's capDate convention: "YYYY:MM:DD HH:MM:SS" in local time, with utcOffset holding
-// UTC minus local time in seconds.
-std::pair<std::string, float> capture_date() {
-    const std::time_t now = std::time(nullptr);
-    std::tm local{};
-    localtime_r(&now, &local);
-    char text[32];
-    std::strftime(text, sizeof text, "%Y:%m:%d %H:%M:%S", &local);
-    return {text, static_cast<float>(-local.tm_gmtoff)};
-}
-
-std::string describe_counts(const RayCounts& rays) {
-    char text[256];
-    std::snprintf(text, sizeof text,
-                  "%llu (primary %llu, shadow %llu, reflected %llu, refracted %llu)",
-                  static_cast<unsigned long long>(rays.total()),
-                  static_cast<unsigned long long>(rays.primary),
-                  static_cast<unsigned long long>(rays.shadow),
-                  static_cast<unsigned long long>(rays.reflected),
-                  static_cast<unsigned long long>(rays.refracted));
-    return text;
-}
-
-void run_render(const RenderArguments& args) {
-    // Everything about the command line first: no render time is spent on a bad one.
-    const RenderPath path = args.path == "simd" ? RenderPath::simd : RenderPath::scalar;
-    Isa isa = Isa::automatic;
-    if (path == RenderPath::simd) {
-        try {
-            isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
-        } catch (const std::runtime_error& e) {
-            throw UsageError(std::string("--isa: ") + e.what());
-        }
-    }
-    const Renderer render = select_renderer(path, isa);
-    const auto tile = parse_tile(args.tile);
-    if (!tile) throw UsageError("--tile: expected WxH, e.g. 16x16");
-    const auto compression = parse_exr_compression(args.compression);
-    if (!compression) throw UsageError("--compression: unknown codec " + args.compression);
-    const std::string output = args.output.empty() ? default_output_name(args.scene) : args.output;
-    if (!args.png.empty() && fs::path(args.png) == fs::path(output))
-        throw UsageError("-o and --png name the same file: " + output);
-    check_output_location(output);
-    if (!args.png.empty()) check_output_location(args.png);
-
-    Scene scene = load_scene(args.scene);
+BatchScene load_batch_scene(const std::string& spec, const RenderArguments& args) {
+    BatchScene loaded;
+    loaded.spec = spec;
+    loaded.name = batch::scene_display_name(spec);
+    loaded.scene = load_scene(spec);
+    Scene& scene = loaded.scene;
     const bool overridden = args.width_option->count() || args.height_option->count() ||
                             args.spp_option->count() || args.max_depth_option->count() ||
                             args.seed_option->count();
@@ -201,71 +143,203 @@ void run_render(const RenderArguments& args) {
             throw UsageError(std::string("the options make the scene invalid: ") + e.what());
         }
     }
+    loaded.sha256 = scene_digest(spec, scene);
+    return loaded;
+}
 
-    // Limit TBB for the whole process; 0 keeps its default (every core it may use).
-    std::optional<tbb::global_control> thread_limit;
-    if (args.threads > 0)
-        thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
-                             static_cast<std::size_t>(args.threads));
-    const std::size_t threads =
-        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-
-    RenderOptions options;
-    options.threads = args.threads;
-    options.tile_width = tile->width;
-    options.tile_height = tile->height;
-
-    std::printf("scene    %s (%zu objects, %zu lights)\n", args.scene.c_str(),
-                scene.objects.size(), scene.lights.size());
-    std::printf("image    %dx%d, %d spp, max depth %d, seed %llu\n", scene.image.width,
-                scene.image.height, scene.image.spp, scene.render.max_depth,
-                static_cast<unsigned long long>(scene.render.seed));
-    const std::string path_name =
-        path == RenderPath::simd ? args.path + " (" + isa_name(isa) + ")" : args.path;
-    std::printf("render   %s path, %zu threads, %dx%d tiles\n", path_name.c_str(), threads,
-                tile->width, tile->height);
-    std::fflush(stdout);
-
-    const RenderResult result = render(scene, options);
-
-    const double mrays_per_second =
-        result.seconds > 0.0 ? static_cast<double>(result.rays.total()) / result.seconds / 1e6
-                             : 0.0;
-    std::printf("time     %.3f s\n", result.seconds);
-    std::printf("rays     %s\n", describe_counts(result.rays).c_str());
-    std::printf("rate     %.2f Mrays/s\n", mrays_per_second);
-
-    const auto [date, utc_offset] = capture_date();
-    ExrAttributes attributes;
-    attributes.strings = {
-        {"software", std::string("octray ") + kVersion},
-        {"capDate", date},
-        {"octray.scene", args.scene},
-        {"octray.path", path_name},
-        // A string keeps all 64 bits of the seed.
-        {"octray.seed", std::to_string(scene.render.seed)},
-    };
-    attributes.floats = {{"utcOffset", utc_offset}};
-    attributes.ints = {
-        {"samplesPerPixel", scene.image.spp},
-        {"octray.maxDepth", scene.render.max_depth},
-    };
-    // Ray counts are 64-bit; a double holds them exactly up to 2^53 (9e15 rays).
-    attributes.doubles = {
-        {"renderTimeSeconds", result.seconds},
-        {"octray.rays.primary", static_cast<double>(result.rays.primary)},
-        {"octray.rays.shadow", static_cast<double>(result.rays.shadow)},
-        {"octray.rays.reflected", static_cast<double>(result.rays.reflected)},
-        {"octray.rays.refracted", static_cast<double>(result.rays.refracted)},
-        {"octray.rays.total", static_cast<double>(result.rays.total())},
-    };
-    write_exr(output, result.image, {args.float32, *compression}, attributes);
-    std::printf("wrote    %s (%s, %s)\n", output.c_str(), args.float32 ? "float" : "half",
-                args.compression.c_str());
-    if (!args.png.empty()) {
-        write_png_preview(args.png, result.image);
-        std::printf("wrote    %s (8-bit sRGB preview)\n", args.png.c_str());
+// The frames of one scene: --frames, else the scene's own (0..frames-1, or 0 for a still).
+std::vector<int> frames_of(const Scene& scene, const std::string& spec) {
+    if (spec.empty()) return default_frames(scene);
+    try {
+        return batch::parse_frame_spec(spec);
+    } catch (const batch::SpecError& e) {
+        throw UsageError(std::string("--frames: ") + e.what());
     }
+}
+
+std::string default_pattern(bool sequence) {
+    return sequence ? "{scene}.####.exr" : "{scene}.exr";
+}
+
+// Fails before the render when an output directory clearly cannot be written, rather than
+// after hours of rendering. (The writes themselves still report anything this misses.)
+void check_output_directory(const fs::path& file) {
+    fs::path dir = file.parent_path();
+    if (dir.empty()) dir = ".";
+    std::error_code error;
+    if (!fs::is_directory(dir, error))
+        throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
+                      " does not exist");
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
+                      " is not writable");
+}
+
+// The frame list of the whole run, in order: each scene's frames, scene after scene.
+std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
+                                const RenderArguments& args) {
+    std::vector<BatchJob> jobs;
+    std::size_t total = 0;
+    std::vector<std::vector<int>> frames(scenes.size());
+    for (std::size_t s = 0; s < scenes.size(); ++s) {
+        frames[s] = frames_of(scenes[s].scene, args.frames);
+        total += frames[s].size();
+    }
+    const std::string pattern =
+        args.output.empty() ? default_pattern(total > scenes.size()) : args.output;
+    try {
+        for (std::size_t s = 0; s < scenes.size(); ++s) {
+            if (frames[s].size() > 1 && !batch::pattern_has_frame_field(pattern))
+                throw UsageError("-o " + pattern + " has no frame field (#### or {frame:04d}) but " +
+                                 std::to_string(frames[s].size()) + " frames of " +
+                                 scenes[s].spec + " are to be rendered");
+            if (!args.png.empty() && frames[s].size() > 1 &&
+                !batch::pattern_has_frame_field(args.png))
+                throw UsageError("--png " + args.png +
+                                 " has no frame field (#### or {frame:04d}) but " +
+                                 std::to_string(frames[s].size()) + " frames are to be rendered");
+            for (const int frame : frames[s]) {
+                BatchJob job;
+                job.scene = s;
+                job.frame = frame;
+                job.output = batch::expand_output_pattern(pattern, frame, scenes[s].name);
+                if (!args.png.empty())
+                    job.png = batch::expand_output_pattern(args.png, frame, scenes[s].name);
+                jobs.push_back(std::move(job));
+            }
+        }
+    } catch (const batch::SpecError& e) {
+        throw UsageError(std::string("output pattern: ") + e.what());
+    }
+
+    // Two frames must never share a file (several scenes without {scene}, say).
+    std::map<std::string, std::size_t> owner;
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+        if (!jobs[j].png.empty() && fs::path(jobs[j].png) == fs::path(jobs[j].output))
+            throw UsageError("-o and --png name the same file: " + jobs[j].output);
+        for (const std::string* file : {&jobs[j].output, &jobs[j].png}) {
+            if (file->empty()) continue;
+            const std::string key = fs::absolute(*file).lexically_normal().string();
+            const auto [it, inserted] = owner.emplace(key, j);
+            if (!inserted) {
+                const BatchJob& other = jobs[it->second];
+                throw UsageError(
+                    "two frames would write the same file " + *file + ": " +
+                    scenes[other.scene].spec + " frame " + std::to_string(other.frame) + " and " +
+                    scenes[jobs[j].scene].spec + " frame " + std::to_string(jobs[j].frame) +
+                    (scenes.size() > 1 ? " (put {scene} in the pattern)"
+                                       : " (put #### or {frame:04d} in the pattern)"));
+            }
+        }
+    }
+    return jobs;
+}
+
+batch::Shard resolve_shard(const RenderArguments& args) {
+    try {
+        if (args.shard == "auto") {
+            std::optional<int> count;
+            if (args.shard_count_option->count()) count = args.shard_count;
+            return batch::shard_from_environment([](const char* name) { return std::getenv(name); },
+                                                 count);
+        }
+        if (args.shard_count_option->count())
+            throw UsageError("--shard-count goes with --shard auto (Kubernetes Indexed Jobs)");
+        return batch::parse_shard(args.shard);
+    } catch (const batch::SpecError& e) {
+        throw UsageError(std::string("--shard: ") + e.what());
+    }
+}
+
+void run_render(const RenderArguments& args) {
+    // Everything about the command line first: no render time is spent on a bad one.
+    BatchSettings settings;
+    settings.path = args.path == "simd" ? RenderPath::simd : RenderPath::scalar;
+    if (settings.path == RenderPath::simd) {
+        try {
+            settings.isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
+        } catch (const std::runtime_error& e) {
+            throw UsageError(std::string("--isa: ") + e.what());
+        }
+    }
+    const auto tile = parse_tile(args.tile);
+    if (!tile) throw UsageError("--tile: expected WxH, e.g. 16x16");
+    settings.options.tile_width = tile->width;
+    settings.options.tile_height = tile->height;
+    settings.options.threads = args.threads;
+    const auto compression = parse_exr_compression(args.compression);
+    if (!compression) throw UsageError("--compression: unknown codec " + args.compression);
+    settings.exr = {args.float32, *compression};
+    settings.progressive = args.progressive;
+    settings.skip_existing = args.skip_existing;
+    settings.placeholders = args.placeholders;
+    const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
+    if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
+    settings.progress = *progress;
+    if (!args.aov.empty()) settings.aovs = parse_aov_option(args.aov);
+    settings.options.accel = parse_accel_option(args.accel);
+    std::uint64_t memory_limit = physical_memory_bytes();
+    if (!args.max_memory.empty()) {
+        const auto limit = parse_memory_size(args.max_memory);
+        if (!limit)
+            throw UsageError("--max-memory: expected a size such as 512M, 4G or 1T, not " +
+                             args.max_memory);
+        memory_limit = *limit;
+    }
+    batch::Shard shard{0, 1};
+    if (!args.shard.empty()) shard = resolve_shard(args);
+    else if (args.shard_count_option->count())
+        throw UsageError("--shard-count goes with --shard auto (Kubernetes Indexed Jobs)");
+
+    std::vector<BatchScene> scenes;
+    for (const std::string& spec : args.scenes) scenes.push_back(load_batch_scene(spec, args));
+
+    RenderMemoryParams memory;
+    memory.threads = args.threads;
+    memory.tile_width = tile->width;
+    memory.tile_height = tile->height;
+    memory.packet_path = settings.path == RenderPath::simd;
+    memory.float32_output = args.float32;
+    for (BatchScene& scene : scenes) {
+        if (!args.crop.empty()) {
+            try {
+                scene.crop = batch::parse_crop(args.crop, scene.scene.image.width,
+                                               scene.scene.image.height);
+            } catch (const batch::SpecError& e) {
+                throw UsageError("--crop for " + scene.spec + ": " + e.what());
+            }
+        }
+        if (memory_limit > 0) {
+            try {
+                check_memory_limit(scene.scene, memory_limit, memory);
+            } catch (const SceneError& e) {
+                throw UsageError(std::string(e.what()) +
+                                 (args.max_memory.empty()
+                                      ? " (the limit is this machine's memory; --max-memory "
+                                        "sets another)"
+                                      : " (--max-memory " + args.max_memory + ")"));
+            }
+        }
+    }
+
+    std::vector<BatchJob> jobs = plan_jobs(scenes, args);
+    const std::size_t planned = jobs.size();
+    jobs = select_jobs(jobs, shard);
+    std::set<std::string> directories;
+    for (const BatchJob& job : jobs) {
+        for (const std::string* file : {&job.output, &job.png}) {
+            if (file->empty()) continue;
+            const fs::path path(*file);
+            if (directories.insert(path.parent_path().string()).second)
+                check_output_directory(path);
+        }
+    }
+    if (shard.count > 1 && settings.progress != ProgressMode::json)
+        std::printf("shard    %d/%d: %zu of %zu frames\n", shard.index, shard.count, jobs.size(),
+                    planned);
+
+    const int status = run_batch(scenes, jobs, settings);
+    if (status != kExitSuccess) throw CommandExit{status};
 }
 
 // A validator whose range or set is already spelled out in the option's help text, so
@@ -276,17 +350,65 @@ CLI::Validator quiet(CLI::Validator validator) { return validator.description(""
 
 void add_render_command(CLI::App& app, CommandRunner& run) {
     auto args = std::make_shared<RenderArguments>();
-    CLI::App* cmd = app.add_subcommand("render", "Render a scene to an OpenEXR image");
+    CLI::App* cmd = app.add_subcommand(
+        "render", "Render scenes, stills or animations, to OpenEXR images");
 
-    cmd->add_option("scene", args->scene,
-                    "Scene: a JSON file or a built-in (whitted, random:N, sphereflake:L, each\n"
-                    "with optional ,width=W,height=H,spp=N,seed=S,max_depth=D)")
-        ->type_name("SCENE")
+    cmd->add_option("scenes", args->scenes,
+                    "Scenes: JSON files or built-ins (whitted, random:N, sphereflake:L, each\n"
+                    "with optional ,width=W,height=H,spp=N,seed=S,max_depth=D); several are\n"
+                    "rendered one after another")
+        ->type_name("SCENE...")
         ->capture_default_str();
     cmd->add_option("-o,--output", args->output,
-                    "Output EXR file [default: <scene name>.exr in the current directory,\n"
-                    "e.g. whitted.exr, random-8.exr, room.exr for scenes/room.json]")
-        ->type_name("FILE");
+                    "Output EXR file or pattern: # runs or {frame:04d} become the frame\n"
+                    "number, {scene} the scene's name [default: {scene}.exr for a still,\n"
+                    "{scene}.####.exr for a sequence, in the current directory]")
+        ->type_name("PATTERN");
+    cmd->add_option("--frames", args->frames,
+                    "Frames to render: 5, 1-100, 1-100:2 (every 2nd), lists: 1-10,20,30-40:5\n"
+                    "[default: the scene's animation frames 0..frames-1, or 0 for a still]")
+        ->type_name("SPEC");
+    cmd->add_option("--shard", args->shard,
+                    "Render only the i-th of n interleaved subsets of the frame list: i/n with\n"
+                    "0 <= i < n, or auto: Slurm's SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT\n"
+                    "(minus SLURM_ARRAY_TASK_MIN), or Kubernetes' JOB_COMPLETION_INDEX with\n"
+                    "--shard-count")
+        ->type_name("i/n|auto");
+    args->shard_count_option =
+        cmd->add_option("--shard-count", args->shard_count,
+                        "The number of shards for --shard auto with JOB_COMPLETION_INDEX")
+            ->type_name("N")
+            ->check(quiet(CLI::Range(1, 1 << 20)));
+    cmd->add_flag("--skip-existing", args->skip_existing,
+                  "Resume: leave frames whose output already exists (outputs are written\n"
+                  "atomically, so an existing file is a finished frame; an empty one is a\n"
+                  "--placeholders claim)");
+    cmd->add_flag("--placeholders", args->placeholders,
+                  "Claim each frame with an empty output file before rendering it, so runs\n"
+                  "sharing one output directory never render a frame twice (claims of a run\n"
+                  "that crashed stay: delete empty files to release them)");
+    cmd->add_option("--crop", args->crop,
+                    "Render only pixels x0..x1-1, y0..y1-1 (row 0 on top) into an EXR whose\n"
+                    "data window is that region; `octray assemble` stitches regions together")
+        ->type_name("x0,y0,x1,y1");
+    cmd->add_option("--aov", args->aov,
+                    "Extra channels from each pixel's first camera ray: depth (Z), normal\n"
+                    "(N.X N.Y N.Z), albedo (albedo.R albedo.G albedo.B), id (UINT, object index\n"
+                    "+ 1, 0 = background); comma-separated")
+        ->type_name("LIST");
+    cmd->add_option("--progress", args->progress,
+                    "auto (bar on a terminal, else lines), bar, lines (one line per frame and\n"
+                    "'Progress: NN%' lines), json (one JSON object per line), none")
+        ->type_name("MODE")
+        ->check(quiet(CLI::IsMember({"auto", "bar", "lines", "json", "none"})))
+        ->capture_default_str();
+    cmd->add_flag("--progressive", args->progressive,
+                  "Render each frame in passes of 1, 2, 4, ... samples per pixel, rewriting\n"
+                  "the image after each; the final image equals the plain render bit for bit");
+    cmd->add_option("--max-memory", args->max_memory,
+                    "Refuse a render whose memory estimate exceeds this (512M, 4G, ...)\n"
+                    "[default: this machine's physical memory]")
+        ->type_name("SIZE");
     args->width_option =
         cmd->add_option("--width", args->width, "Image width in pixels, 1..65536 (overrides the scene)")
             ->type_name("W")
@@ -335,7 +457,14 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("ISA")
         ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
-    cmd->add_option("--png", args->png, "Also write an 8-bit sRGB PNG preview (clamped to [0,1])")
+    cmd->add_option("--accel", args->accel,
+                    "Sphere acceleration of the simd path: auto (a BVH above a measured sphere\n"
+                    "count), bvh or none (brute force); the image does not depend on it")
+        ->type_name("MODE")
+        ->check(quiet(CLI::IsMember({"auto", "bvh", "none"})))
+        ->capture_default_str();
+    cmd->add_option("--png", args->png,
+                    "Also write an 8-bit sRGB PNG preview (clamped to [0,1]); a pattern like -o")
         ->type_name("FILE");
     cmd->add_flag("--float", args->float32, "Write 32-bit float channels instead of half");
     cmd->add_option("--compression", args->compression,
@@ -358,14 +487,23 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         "  octray render                                  # whitted scene -> whitted.exr\n"
         "  octray render whitted -o whitted.exr --png whitted.png\n"
         "  octray render random:1024,width=640,height=360 --spp 4 -o random.exr\n"
-        "  octray render scene.json --width 320 --height 240 --threads 2 --float\n"
-        "  octray render sphereflake:3 --compression piz --tile 32x8\n\n"
-        "The EXR carries the attributes software, capDate, utcOffset, samplesPerPixel,\n"
-        "renderTimeSeconds (double), octray.scene, octray.path, octray.seed (string),\n"
-        "octray.maxDepth (int) and octray.rays.{primary,shadow,reflected,refracted,total}\n"
-        "(doubles: exact up to 2^53). Files are written to a temporary and renamed, so an\n"
-        "output is either complete or absent.\n\n" +
-        exit_code_help());
+        "  octray render shot.json --frames 1-100:2,150 -o out/shot.####.exr\n"
+        "  octray render a.json b.json -o 'out/{scene}.{frame:04d}.exr' --skip-existing\n"
+        "  octray render shot.json --shard auto --placeholders -o out/shot.####.exr\n"
+        "  octray render whitted --crop 0,0,640,360 -o part0.exr   # then octray assemble\n\n"
+        "Each frame's randomness is hash(seed, frame): a frame rendered alone equals the same\n"
+        "frame of a whole sequence. Files are written to a hidden temporary and renamed, so an\n"
+        "output is either complete or absent. A frame that fails is reported and the others\n"
+        "go on. Ctrl-C (or SIGTERM) stops after abandoning the frame in progress; a second\n"
+        "one kills at once.\n\n"
+        "The EXR carries software, capDate, utcOffset, samplesPerPixel, framesPerSecond,\n"
+        "worldToCamera, worldToNDC, renderTimeSeconds, and octray.scene, octray.sceneSha256,\n"
+        "octray.frame, octray.time, octray.path, octray.seed, octray.maxDepth,\n"
+        "octray.rays.{primary,shadow,reflected,refracted,total}.\n\n" +
+        exit_code_help() +
+        "  3  also: a frame failed with a scene error (not worth retrying)\n"
+        "  4  also: frames failed only with I/O errors (worth retrying: --skip-existing)\n"
+        "130  interrupted by Ctrl-C (SIGINT); 143 by SIGTERM; finished frames stay\n");
     cmd->callback([args, &run] { run.action = [args] { run_render(*args); }; });
 }
 

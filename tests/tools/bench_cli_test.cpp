@@ -1,0 +1,119 @@
+// `octray bench` end to end: the table, the JSON report and its required keys, Embree
+// side by side when it was built in (and the one-line notice when it was not), and the
+// exit codes of bad input. Tiny frames and one repetition: this checks behaviour, not
+// speed (speed lives in bench/).
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "bench/embree_baseline.h"
+#include "run_octray.h"
+
+namespace octray {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::run_octray;
+
+class BenchCliTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "bench_cli" /
+               ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    fs::path dir_;
+};
+
+bool contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+nlohmann::json read_json(const fs::path& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+}
+
+TEST_F(BenchCliTest, JsonReportHasContextAndValidatedRowsForEveryRayKind) {
+    const auto r = run_octray({"bench", "random:16", "--width", "48", "--height", "32", "--reps",
+                               "2", "--warmup", "1", "--threads", "2", "--rays",
+                               "primary,shadow,secondary,whitted", "--json", "report.json"},
+                              dir_);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "Mrays/s") || contains(r.output, "mrays")) << r.output;
+    const nlohmann::json report = read_json(dir_ / "report.json");
+    ASSERT_TRUE(report.contains("context")) << report.dump(2);
+    for (const char* key : {"cpu", "threads", "isa", "compiler", "date"})
+        EXPECT_TRUE(report["context"].contains(key)) << key << "\n" << report["context"].dump(2);
+    ASSERT_TRUE(report["rows"].is_array());
+    std::set<std::string> kinds, systems;
+    for (const auto& row : report["rows"]) {
+        for (const char* key : {"scene", "ray_kind", "system", "mode", "threads", "mrays_median",
+                                "mrays_min", "mrays_max", "valid"})
+            ASSERT_TRUE(row.contains(key)) << key << "\n" << row.dump(2);
+        kinds.insert(row["ray_kind"].get<std::string>());
+        systems.insert(row["system"].get<std::string>());
+        EXPECT_EQ(row["scene"], "random:16");
+        EXPECT_EQ(row["threads"], 2);
+        EXPECT_TRUE(row["valid"].get<bool>()) << row.dump(2);
+        const double lo = row["mrays_min"], mid = row["mrays_median"], hi = row["mrays_max"];
+        EXPECT_GT(lo, 0.0) << row.dump(2);
+        EXPECT_LE(lo, mid);
+        EXPECT_LE(mid, hi);
+    }
+    EXPECT_EQ(kinds, (std::set<std::string>{"primary", "shadow", "secondary", "whitted"}));
+    EXPECT_TRUE(systems.count("octray"));
+    if (bench::embree_compiled()) {
+        EXPECT_TRUE(systems.count("embree")) << "Embree was built in but has no rows";
+    } else {
+        EXPECT_FALSE(systems.count("embree"));
+        EXPECT_TRUE(contains(r.output, "Embree 3 was not found")) << r.output;
+    }
+}
+
+TEST_F(BenchCliTest, NoEmbreeMeasuresOctrayAlone) {
+    const auto r = run_octray({"bench", "whitted", "--width", "32", "--height", "24", "--reps",
+                               "1", "--rays", "primary", "--no-embree", "--json", "r.json"},
+                              dir_);
+    ASSERT_EQ(r.status, 0) << r.output;
+    const nlohmann::json report = read_json(dir_ / "r.json");
+    ASSERT_FALSE(report["rows"].empty());
+    for (const auto& row : report["rows"]) EXPECT_EQ(row["system"], "octray") << row.dump(2);
+}
+
+TEST_F(BenchCliTest, ScalarAndSimdPathsAreBothRowsOfOneRun) {
+    const auto r = run_octray({"bench", "random:16", "--width", "32", "--height", "24", "--reps",
+                               "1", "--rays", "primary", "--path", "scalar,simd", "--no-embree",
+                               "--json", "r.json"},
+                              dir_);
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::set<std::string> modes;
+    const nlohmann::json report = read_json(dir_ / "r.json");
+    for (const auto& row : report["rows"])
+        modes.insert(row["mode"].get<std::string>());
+    EXPECT_GE(modes.size(), 2u) << "one mode per path expected";
+}
+
+TEST_F(BenchCliTest, BadInputExitsWithItsCode) {
+    EXPECT_EQ(run_octray({"bench", "--rays", "sideways"}, dir_).status, 2);
+    EXPECT_EQ(run_octray({"bench", "--reps", "0"}, dir_).status, 2);
+    EXPECT_EQ(run_octray({"bench", "--order", "spiral"}, dir_).status, 2);
+    const auto scene = run_octray({"bench", "no-such-scene.json", "--reps", "1"}, dir_);
+    EXPECT_EQ(scene.status, 3) << scene.output;
+    EXPECT_TRUE(contains(scene.output, "no-such-scene.json")) << scene.output;
+    const auto io = run_octray({"bench", "random:4", "--width", "16", "--height", "16", "--reps",
+                                "1", "--rays", "primary", "--no-embree", "--json",
+                                "missing/dir/r.json"},
+                               dir_);
+    EXPECT_EQ(io.status, 4) << io.output;
+    EXPECT_TRUE(contains(io.output, "missing/dir/r.json")) << io.output;
+}
+
+}  // namespace
+}  // namespace octray

@@ -1,0 +1,412 @@
+#include "tools/render_batch.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <oneapi/tbb/global_control.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <new>
+#include <system_error>
+#include <utility>
+
+#include "core/version.h"
+#include "kernels/dispatch.h"
+#include "render/aov.h"
+#include "render/camera_matrices.h"
+#include "render/packet_renderer.h"
+#include "render/progressive.h"
+#include "render/reference.h"
+#include "scene/animation.h"
+#include "scene/scene_error.h"
+#include "tools/commands.h"
+#include "tools/interrupt.h"
+
+namespace octray::tools {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// The attribute that marks an image written by a --progressive pass before the last one:
+// --skip-existing does not count such a file as a finished frame.
+constexpr const char* kSamplesSoFarAttribute = "octray.samplesSoFar";
+
+enum class FailureKind { none, scene, io, internal, interrupted };
+
+struct FrameResult {
+    FrameReport report;
+    FailureKind failure = FailureKind::none;
+};
+
+std::string_view path_name(RenderPath path) { return path == RenderPath::scalar ? "scalar" : "simd"; }
+
+RenderResult render_still(const BatchSettings& settings, const Scene& scene,
+                          const RenderOptions& options) {
+    if (settings.path == RenderPath::scalar) return render_reference(scene, options);
+    return render_packet(scene, options, settings.isa);
+}
+
+// EXR's capDate convention: "YYYY:MM:DD HH:MM:SS" in local time, with utcOffset holding
+// UTC minus local time in seconds.
+std::pair<std::string, float> capture_date() {
+    const std::time_t now = std::time(nullptr);
+    std::tm local{};
+    localtime_r(&now, &local);
+    char text[32];
+    std::strftime(text, sizeof text, "%Y:%m:%d %H:%M:%S", &local);
+    return {text, static_cast<float>(-local.tm_gmtoff)};
+}
+
+// A finished frame: a non-empty file that is not an unfinished --progressive pass.
+// An empty file is a --placeholders claim.
+enum class Existing { none, claim, finished, unfinished };
+
+Existing existing_output(const std::string& path) {
+    std::error_code error;
+    if (!fs::exists(path, error)) return Existing::none;
+    const auto size = fs::file_size(path, error);
+    if (error) return Existing::finished;  // not a regular file: never overwrite it blindly
+    if (size == 0) return Existing::claim;
+    try {
+        Imf::InputFile file(path.c_str());
+        const auto* samples = file.header().findTypedAttribute<Imf::IntAttribute>(
+            kSamplesSoFarAttribute);
+        if (samples != nullptr) return Existing::unfinished;
+    } catch (const std::exception&) {
+        // Not an EXR octray can read (a PNG preview target, or a damaged file): it exists.
+    }
+    return Existing::finished;
+}
+
+// Removes hidden temporaries (".<name>.tmp.*", see render/image_io.cpp) that a killed run
+// left next to `target`. Only this run renders `target` now, so any of them is stale.
+void remove_stale_temporaries(const std::string& target) {
+    const fs::path path(target);
+    fs::path dir = path.parent_path();
+    if (dir.empty()) dir = ".";
+    const std::string prefix = "." + path.filename().string() + ".tmp.";
+    std::error_code error;
+    for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
+        const std::string name = it->path().filename().string();
+        if (name.compare(0, prefix.size(), prefix) == 0) fs::remove(it->path(), error);
+    }
+}
+
+// Claims `path` with an empty file; false if another run got there first.
+bool claim(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        if (errno == EEXIST) return false;
+        throw IoError("cannot claim " + path + " with a placeholder: " + std::strerror(errno));
+    }
+    ::close(fd);
+    return true;
+}
+
+// Gives a claim back after a failed or interrupted frame, if it is still our empty file.
+void release_claim(const std::string& path) {
+    std::error_code error;
+    if (fs::exists(path, error) && fs::file_size(path, error) == 0 && !error)
+        fs::remove(path, error);
+}
+
+class BatchRunner {
+public:
+    BatchRunner(const std::vector<BatchScene>& scenes, const BatchSettings& settings,
+                ProgressReporter& progress)
+        : scenes_(scenes), settings_(settings), progress_(progress) {}
+
+    FrameResult run(std::size_t index, const BatchJob& job);
+
+private:
+    std::uint64_t frame_work(const BatchScene& scene) const;
+    ExrAttributes attributes(const BatchScene& scene, const Scene& posed, int frame,
+                             const RenderResult& result, int samples_so_far) const;
+    void write_outputs(const BatchScene& scene, const BatchJob& job, const Scene& posed,
+                       const RenderResult& result, const AovImages& aovs,
+                       int samples_so_far) const;
+
+    const std::vector<BatchScene>& scenes_;
+    const BatchSettings& settings_;
+    ProgressReporter& progress_;
+};
+
+std::uint64_t BatchRunner::frame_work(const BatchScene& scene) const {
+    const Scene& s = scene.scene;
+    std::uint64_t pixels = static_cast<std::uint64_t>(s.image.width) *
+                           static_cast<std::uint64_t>(s.image.height);
+    if (scene.crop)
+        pixels = static_cast<std::uint64_t>(scene.crop->x1 - scene.crop->x0) *
+                 static_cast<std::uint64_t>(scene.crop->y1 - scene.crop->y0);
+    return pixels * static_cast<std::uint64_t>(s.image.spp);
+}
+
+ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
+                                      const RenderResult& result, int samples_so_far) const {
+    const auto [date, utc_offset] = capture_date();
+    std::string path = std::string(path_name(settings_.path));
+    if (settings_.path == RenderPath::simd) path.append(" (").append(isa_name(settings_.isa)).append(")");
+    ExrAttributes a;
+    a.strings = {
+        {"software", std::string("octray ") + kVersion},
+        {"capDate", date},
+        {"octray.scene", scene.spec},
+        {"octray.sceneSha256", scene.sha256},
+        {"octray.path", path},
+        // A string keeps all 64 bits of the seed.
+        {"octray.seed", std::to_string(posed.render.seed)},
+    };
+    a.floats = {{"utcOffset", utc_offset}};
+    a.ints = {
+        {"samplesPerPixel", posed.image.spp},
+        {"octray.maxDepth", posed.render.max_depth},
+        {"octray.frame", frame},
+    };
+    if (samples_so_far < posed.image.spp) a.ints.emplace_back(kSamplesSoFarAttribute, samples_so_far);
+    // Ray counts are 64-bit; a double holds them exactly up to 2^53 (9e15 rays).
+    a.doubles = {
+        {"renderTimeSeconds", result.seconds},
+        {"octray.time", frame_time(scene.scene, frame)},
+        {"octray.rays.primary", static_cast<double>(result.rays.primary)},
+        {"octray.rays.shadow", static_cast<double>(result.rays.shadow)},
+        {"octray.rays.reflected", static_cast<double>(result.rays.reflected)},
+        {"octray.rays.refracted", static_cast<double>(result.rays.refracted)},
+        {"octray.rays.total", static_cast<double>(result.rays.total())},
+    };
+    add_camera_attributes(a, posed);
+    const double fps = scene.scene.animation ? scene.scene.animation->fps : kStillFps;
+    a.rationals = {{"framesPerSecond", exr_rational(fps)}};
+    return a;
+}
+
+void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job, const Scene& posed,
+                                const RenderResult& result, const AovImages& aovs,
+                                int samples_so_far) const {
+    ExrImage exr = make_exr_image(result, settings_.exr,
+                                  attributes(scene, posed, job.frame, result, samples_so_far));
+    if (aovs.set.any())
+        append_aov_channels(exr, aovs,
+                            settings_.exr.float32 ? ExrPixelType::float32 : ExrPixelType::half);
+    write_exr(job.output, exr);
+    if (!job.png.empty()) write_png_preview(job.png, result.image);
+}
+
+FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
+    const BatchScene& scene = scenes_[job.scene];
+    FrameResult out;
+    out.report.index = index;
+    out.report.scene = scene.name;
+    out.report.frame = job.frame;
+    out.report.output = job.output;
+    out.report.preview = job.png;
+    const std::uint64_t work = frame_work(scene);
+
+    // Resume and claims.
+    if (settings_.skip_existing || settings_.placeholders) {
+        const Existing existing = existing_output(job.output);
+        if (existing == Existing::finished) {
+            out.report.outcome = FrameOutcome::skipped_existing;
+            progress_.frame_finished(out.report, work);
+            return out;
+        }
+        if (existing == Existing::claim) {
+            out.report.outcome = FrameOutcome::skipped_claimed;
+            progress_.frame_finished(out.report, work);
+            return out;
+        }
+    }
+    bool claimed = false;
+    const auto started = Clock::now();
+    try {
+        if (settings_.placeholders) {
+            // An unfinished progressive image is ours to replace: claim by truncating it
+            // would race, so only a missing file is claimed; an existing one is rendered
+            // over (it was not a claim).
+            if (!fs::exists(job.output)) {
+                if (!claim(job.output)) {
+                    out.report.outcome = FrameOutcome::skipped_claimed;
+                    progress_.frame_finished(out.report, work);
+                    return out;
+                }
+                claimed = true;
+            }
+        }
+        remove_stale_temporaries(job.output);
+        progress_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
+
+        const Scene posed = scene_at_frame(scene.scene, job.frame);
+        RenderOptions options = settings_.options;
+        options.frame = static_cast<std::uint32_t>(job.frame);
+        options.cancel = &InterruptGuard::flag();
+        options.pixels_done = &progress_.pixel_counter();
+        if (scene.crop)
+            options.crop = PixelRect{scene.crop->x0, scene.crop->y0, scene.crop->x1, scene.crop->y1};
+        const AovImages aovs = compute_aovs(posed, options, settings_.aovs);
+
+        RenderResult result;
+        if (settings_.progressive) {
+            result = render_progressive(
+                [&](const RenderOptions& o) { return render_still(settings_, posed, o); },
+                posed.image.spp, options, [&](const RenderResult& pass, int samples_so_far) {
+                    if (samples_so_far < posed.image.spp)
+                        write_outputs(scene, job, posed, pass, aovs, samples_so_far);
+                });
+        } else {
+            result = render_still(settings_, posed, options);
+        }
+        write_outputs(scene, job, posed, result, aovs, posed.image.spp);
+        out.report.rays = result.rays.total();
+        out.report.outcome = FrameOutcome::rendered;
+    } catch (const RenderCancelled&) {
+        out.failure = FailureKind::interrupted;
+        out.report.outcome = FrameOutcome::failed;
+        out.report.message = "interrupted";
+    } catch (const SceneError& e) {
+        out.failure = FailureKind::scene;
+        out.report.outcome = FrameOutcome::failed;
+        out.report.message = std::string("scene error: ") + e.what();
+    } catch (const IoError& e) {
+        out.failure = FailureKind::io;
+        out.report.outcome = FrameOutcome::failed;
+        out.report.message = std::string("I/O error: ") + e.what();
+    } catch (const std::bad_alloc&) {
+        out.failure = FailureKind::internal;
+        out.report.outcome = FrameOutcome::failed;
+        out.report.message = "out of memory";
+    } catch (const std::exception& e) {
+        out.failure = FailureKind::internal;
+        out.report.outcome = FrameOutcome::failed;
+        out.report.message = std::string("internal error: ") + e.what();
+    }
+    if (out.failure != FailureKind::none && claimed) release_claim(job.output);
+    out.report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
+    if (out.failure != FailureKind::interrupted) {
+        if (out.failure != FailureKind::none)
+            progress_.note("octray: frame " + std::to_string(job.frame) + " of " + scene.spec +
+                           " failed: " + out.report.message);
+        progress_.frame_finished(out.report, work);
+    }
+    return out;
+}
+
+void print_header(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
+                  const BatchSettings& settings) {
+    for (std::size_t s = 0; s < scenes.size(); ++s) {
+        const Scene& scene = scenes[s].scene;
+        std::size_t frames = 0;
+        for (const BatchJob& job : jobs) frames += job.scene == s ? 1 : 0;
+        std::printf("scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp, max depth %d, "
+                    "seed %llu, %zu frame%s\n",
+                    scenes[s].spec.c_str(), scene.objects.size(), scene.lights.size(),
+                    scene.animation ? ", animated" : "", scene.image.width, scene.image.height,
+                    scene.image.spp, scene.render.max_depth,
+                    static_cast<unsigned long long>(scene.render.seed), frames,
+                    frames == 1 ? "" : "s");
+    }
+    const std::size_t threads =
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    std::string path(path_name(settings.path));
+    if (settings.path == RenderPath::simd) path.append(" (").append(isa_name(settings.isa)).append(")");
+    std::printf("render   %s path, %zu threads, %dx%d tiles\n", path.c_str(), threads,
+                settings.options.tile_width, settings.options.tile_height);
+    std::fflush(stdout);
+}
+
+}  // namespace
+
+AovSet parse_aov_option(const std::string& text) {
+    std::string error;
+    const auto set = parse_aov_list(text, &error);
+    if (!set) throw UsageError("--aov: " + error);
+    return *set;
+}
+
+Accel parse_accel_option(const std::string& text) {
+    const auto accel = parse_accel(text);
+    if (!accel) throw UsageError("--accel: expected auto, bvh or none, not " + text);
+    return *accel;
+}
+
+std::vector<BatchJob> select_jobs(const std::vector<BatchJob>& jobs, batch::Shard shard) {
+    std::vector<BatchJob> selected;
+    for (std::size_t k = 0; k < jobs.size(); ++k)
+        if (k % static_cast<std::size_t>(shard.count) == static_cast<std::size_t>(shard.index))
+            selected.push_back(jobs[k]);
+    return selected;
+}
+
+int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
+              const BatchSettings& settings) {
+    // Limit TBB for the whole run; 0 keeps its default (every core it may use).
+    std::optional<tbb::global_control> thread_limit;
+    if (settings.options.threads > 0)
+        thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
+                             static_cast<std::size_t>(settings.options.threads));
+    if (settings.progress != ProgressMode::json && settings.progress != ProgressMode::none)
+        print_header(scenes, jobs, settings);
+
+    std::uint64_t total_work = 0;
+    for (const BatchJob& job : jobs) {
+        const Scene& s = scenes[job.scene].scene;
+        const auto& crop = scenes[job.scene].crop;
+        const std::uint64_t pixels =
+            crop ? static_cast<std::uint64_t>(crop->x1 - crop->x0) *
+                       static_cast<std::uint64_t>(crop->y1 - crop->y0)
+                 : static_cast<std::uint64_t>(s.image.width) *
+                       static_cast<std::uint64_t>(s.image.height);
+        total_work += pixels * static_cast<std::uint64_t>(s.image.spp);
+    }
+
+    InterruptGuard interrupt;
+    ProgressReporter progress(settings.progress, jobs.size(), total_work);
+    BatchRunner runner(scenes, settings, progress);
+    BatchSummary summary;
+    bool scene_failure = false, io_failure = false, internal_failure = false;
+    const auto started = Clock::now();
+    for (std::size_t k = 0; k < jobs.size(); ++k) {
+        if (InterruptGuard::flag().load()) {
+            summary.not_started = jobs.size() - k;
+            break;
+        }
+        const FrameResult result = runner.run(k + 1, jobs[k]);
+        switch (result.report.outcome) {
+            case FrameOutcome::rendered:
+                ++summary.rendered;
+                summary.rays += result.report.rays;
+                break;
+            case FrameOutcome::skipped_existing:
+            case FrameOutcome::skipped_claimed: ++summary.skipped; break;
+            case FrameOutcome::failed:
+                if (result.failure == FailureKind::interrupted) {
+                    summary.not_started = jobs.size() - k;  // this one included: not done
+                    k = jobs.size();
+                } else {
+                    ++summary.failed;
+                }
+                break;
+        }
+        scene_failure |= result.failure == FailureKind::scene;
+        io_failure |= result.failure == FailureKind::io;
+        internal_failure |= result.failure == FailureKind::internal;
+    }
+    summary.interrupted = InterruptGuard::flag().load();
+    summary.seconds = std::chrono::duration<double>(Clock::now() - started).count();
+    progress.finish(summary);
+
+    if (summary.interrupted) return 128 + InterruptGuard::signal_number();
+    if (scene_failure) return kExitScene;
+    if (io_failure) return kExitIo;
+    if (internal_failure) return kExitInternal;
+    return kExitSuccess;
+}
+
+}  // namespace octray::tools
