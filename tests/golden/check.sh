@@ -28,6 +28,15 @@ size=(--width 96 --height 64)
 fail_threshold=0.002
 
 scenes=("$here"/scenes/*.json)
+
+# An animated scene is checked at one frame, named in its file name: name_f17.json is
+# frame 17 (rendered alone, which equals frame 17 of the sequence).
+frame_args() {
+    local name=$1
+    if [[ $name =~ _f([0-9]+)$ ]]; then
+        echo "--frames ${BASH_REMATCH[1]}"
+    fi
+}
 if [[ ${#scenes[@]} -eq 0 ]]; then
     echo "no scenes in $here/scenes" >&2
     exit 1
@@ -36,7 +45,9 @@ fi
 if [[ ${OCTRAY_UPDATE_GOLDEN:-0} == 1 ]]; then
     for scene in "${scenes[@]}"; do
         name=$(basename "$scene" .json)
-        "$octray" render "$scene" --path scalar "${size[@]}" -o "$here/$name.exr" >/dev/null
+        # shellcheck disable=SC2046  # frame_args is one option and a number, or nothing
+        "$octray" render "$scene" --path scalar "${size[@]}" $(frame_args "$name") \
+            -o "$here/$name.exr" >/dev/null
         echo "rewrote $here/$name.exr ($(stat -c %s "$here/$name.exr") bytes)"
     done
     echo "review the new references (git diff --stat tests/golden) before committing them"
@@ -87,7 +98,9 @@ for scene in "${scenes[@]}"; do
     fi
     for path in scalar simd; do
         out=$tmp/$name-$path.exr
-        if ! "$octray" render "$scene" --path "$path" "${size[@]}" -o "$out" >"$tmp/render.log" 2>&1; then
+        # shellcheck disable=SC2046  # frame_args is one option and a number, or nothing
+        if ! "$octray" render "$scene" --path "$path" "${size[@]}" $(frame_args "$name") \
+            -o "$out" >"$tmp/render.log" 2>&1; then
             echo "FAIL $name ($path): render failed"
             cat "$tmp/render.log"
             failures=$((failures + 1))
