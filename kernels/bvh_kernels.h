@@ -196,6 +196,31 @@ struct BvhRay {
     }
 };
 
+// A ray against spheres i ... i + W - 1 of a leaf (lanes at ... of its `count`): the
+// brute-force arithmetic of packet_kernels.h, operation for operation, so the BVH finds
+// the same t as brute force. `live`: lanes holding a sphere with real roots.
+template <class F>
+struct LeafRoots {
+    typename F::batch_bool_type live;
+    F t_near, t_far;
+};
+
+template <class F>
+LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t i,
+                        std::uint32_t at, std::uint32_t count) {
+    const F zero(0.0f);
+    const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
+                  F::load_unaligned(s.bvh_cz + i)};
+    const V3<F> oc = sub(ray.o, c);
+    const F b = dot(oc, ray.d);
+    const F cc = dot(oc, oc) - F::load_unaligned(s.bvh_r2 + i);
+    const F disc = b * b - ray.a * cc;
+    const auto live = live_lanes<F>(at, count) && disc >= zero;
+    if (xsimd::none(live)) return {live, zero, zero};
+    const F root = xsimd::sqrt(disc);
+    return {live, (-b - root) / ray.a, (-b + root) / ray.a};
+}
+
 // Children of `n` in `bits`, nearest first by `entry`: the nearest is returned, the rest
 // pushed farthest first.
 inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
@@ -238,17 +263,11 @@ void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::
             const std::uint32_t first = leaf_first(node), count = leaf_count(node);
             for (std::uint32_t at = 0; at < count; at += W) {
                 const std::uint32_t i = first + at;
-                const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
-                              F::load_unaligned(s.bvh_cz + i)};
-                const V3<F> oc = sub(ray.o, c);
-                const F b = dot(oc, ray.d);
-                const F cc = dot(oc, oc) - F::load_unaligned(s.bvh_r2 + i);
-                const F disc = b * b - ray.a * cc;
-                const auto live = live_lanes<F>(at, count) && disc >= zero;
-                if (xsimd::none(live)) continue;
-                const F root = xsimd::sqrt(disc);
-                const F t_near = (-b - root) / ray.a;
-                const F t_far = (-b + root) / ray.a;
+                const LeafRoots<F> r = leaf_roots(s, ray, i, at, count);
+                if (xsimd::none(r.live)) continue;
+                const auto& live = r.live;
+                const F& t_near = r.t_near;
+                const F& t_far = r.t_far;
                 // The sphere's candidate is its first root above t_min.
                 const F t = xsimd::select(t_near > tmin, t_near, t_far);
                 std::uint32_t bits = mask_bits<F>(live && t > tmin && t <= F(best_t));
@@ -290,17 +309,11 @@ bool bvh_occluded_ray(const SceneView& s, const BvhPacket& p, std::uint32_t lane
             const std::uint32_t first = leaf_first(node), count = leaf_count(node);
             for (std::uint32_t at = 0; at < count; at += W) {
                 const std::uint32_t i = first + at;
-                const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
-                              F::load_unaligned(s.bvh_cz + i)};
-                const V3<F> oc = sub(ray.o, c);
-                const F b = dot(oc, ray.d);
-                const F cc = dot(oc, oc) - F::load_unaligned(s.bvh_r2 + i);
-                const F disc = b * b - ray.a * cc;
-                const auto live = live_lanes<F>(at, count) && disc >= zero;
-                if (xsimd::none(live)) continue;
-                const F root = xsimd::sqrt(disc);
-                const F t_near = (-b - root) / ray.a;
-                const F t_far = (-b + root) / ray.a;
+                const LeafRoots<F> r = leaf_roots(s, ray, i, at, count);
+                if (xsimd::none(r.live)) continue;
+                const auto& live = r.live;
+                const F& t_near = r.t_near;
+                const F& t_far = r.t_far;
                 if (xsimd::any(live && ((t_near > zero && t_near < t_max) ||
                                         (t_far > zero && t_far < t_max))))
                     return true;

@@ -61,6 +61,20 @@ constexpr std::size_t max_float_values = std::size_t{1} << 30;
     throw IoError("cannot read '" + path + "': " + reason);
 }
 
+// Called in a catch block of an OpenEXR read: the exception in flight as an IoError.
+[[noreturn]] void fail_reading_exr(const std::string& path) {
+    try {
+        throw;
+    } catch (const IoError&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        fail(path, "out of memory reading OpenEXR file");
+    } catch (const std::exception& e) {
+        // OpenEXR says the same things for a cut-off file and a damaged one.
+        fail(path, std::string("truncated or corrupt OpenEXR file (") + e.what() + ")");
+    }
+}
+
 enum class FileKind { exr, png, unknown };
 
 constexpr std::array<unsigned char, 4> exr_magic{0x76, 0x2f, 0x31, 0x01};
@@ -222,13 +236,8 @@ ChannelImage read_exr_file(const std::string& path) {
         file.setFrameBuffer(frame_buffer);
         file.readPixels(window.min.y, window.max.y);
         return image;
-    } catch (const IoError&) {
-        throw;
-    } catch (const std::bad_alloc&) {
-        fail(path, "out of memory reading OpenEXR file");
-    } catch (const std::exception& e) {
-        // OpenEXR says the same things for a cut-off file and a damaged one.
-        fail(path, std::string("truncated or corrupt OpenEXR file (") + e.what() + ")");
+    } catch (...) {
+        fail_reading_exr(path);
     }
 }
 
@@ -341,12 +350,8 @@ ExrImage read_exr_image_file(const std::string& path) {
         file.setFrameBuffer(frame_buffer);
         file.readPixels(window.min.y, window.max.y);
         return image;
-    } catch (const IoError&) {
-        throw;
-    } catch (const std::bad_alloc&) {
-        fail(path, "out of memory reading OpenEXR file");
-    } catch (const std::exception& e) {
-        fail(path, std::string("truncated or corrupt OpenEXR file (") + e.what() + ")");
+    } catch (...) {
+        fail_reading_exr(path);
     }
 }
 
