@@ -3,17 +3,53 @@
 // is read; the cameras flip the row index when turning a pixel into a ray.
 
 #include <cstddef>
+#include <memory>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/color.h"
 
 namespace octray {
 
+// std::allocator, except that a value-less construct() leaves the element's bytes alone:
+// a vector of trivially copyable pixels can then be sized without writing them.
+template <class T>
+struct UninitializedAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+        using other = UninitializedAllocator<U>;
+    };
+    UninitializedAllocator() = default;
+    template <class U>
+    UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+
+    template <class U>
+    void construct(U*) noexcept {
+        static_assert(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>);
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
 class Image {
-public:
+  public:
+    // A renderer about to write every pixel (in parallel) asks for unwritten storage: the
+    // pages are then first touched by the threads that fill them, not zeroed serially.
+    struct Uninitialized {};
+
     Image() = default;
+    // Every pixel black.
     Image(int width, int height)
-        : width_(width), height_(height),
+        : width_(width),
+          height_(height),
+          pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Rgb()) {}
+    // Pixel values undefined until written: the caller writes every one.
+    Image(int width, int height, Uninitialized)
+        : width_(width),
+          height_(height),
           pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {}
 
     int width() const { return width_; }
@@ -26,13 +62,13 @@ public:
 
     Rgb* data() { return pixels_.data(); }
     const Rgb* data() const { return pixels_.data(); }
-    const std::vector<Rgb>& pixels() const { return pixels_; }
+    const std::vector<Rgb, UninitializedAllocator<Rgb>>& pixels() const { return pixels_; }
 
     friend bool operator==(const Image& a, const Image& b) {
         return a.width_ == b.width_ && a.height_ == b.height_ && a.pixels_ == b.pixels_;
     }
 
-private:
+  private:
     std::size_t index(int x, int y) const {
         return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
                static_cast<std::size_t>(x);
@@ -40,7 +76,7 @@ private:
 
     int width_ = 0;
     int height_ = 0;
-    std::vector<Rgb> pixels_;
+    std::vector<Rgb, UninitializedAllocator<Rgb>> pixels_;
 };
 
 }  // namespace octray

@@ -12,7 +12,7 @@
 namespace octray {
 
 class Sha256 {
-public:
+  public:
     void update(std::string_view bytes) {
         for (const char c : bytes) {
             block_[fill_++] = static_cast<std::uint8_t>(c);
@@ -34,7 +34,8 @@ public:
             fill_ = 0;
         }
         while (fill_ < 56) block_[fill_++] = 0;
-        for (int i = 7; i >= 0; --i) block_[fill_++] = static_cast<std::uint8_t>(bits >> (8 * i));
+        for (int i = 7; i >= 0; --i)
+            block_[fill_++] = static_cast<std::uint8_t>(bits >> (8 * i));
         compress();
         static constexpr char kHex[] = "0123456789abcdef";
         std::string text;
@@ -43,7 +44,7 @@ public:
         return text;
     }
 
-private:
+  private:
     static constexpr std::uint32_t rotr(std::uint32_t x, int n) {
         return (x >> n) | (x << (32 - n));
     }
@@ -65,15 +66,16 @@ private:
             w[i] = std::uint32_t{block_[4 * i]} << 24 | std::uint32_t{block_[4 * i + 1]} << 16 |
                    std::uint32_t{block_[4 * i + 2]} << 8 | std::uint32_t{block_[4 * i + 3]};
         for (int i = 16; i < 64; ++i) {
-            const std::uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
+            const std::uint32_t s0 =
+                rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
             const std::uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
             w[i] = w[i - 16] + s0 + w[i - 7] + s1;
         }
         std::uint32_t a = state_[0], b = state_[1], c = state_[2], d = state_[3];
         std::uint32_t e = state_[4], f = state_[5], g = state_[6], h = state_[7];
         for (int i = 0; i < 64; ++i) {
-            const std::uint32_t t1 =
-                h + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) + ((e & f) ^ (~e & g)) + k[i] + w[i];
+            const std::uint32_t t1 = h + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) +
+                                     ((e & f) ^ (~e & g)) + k[i] + w[i];
             const std::uint32_t t2 =
                 (rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
             h = g;

@@ -362,10 +362,11 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     result.rect = rect;
     result.full_width = scene.width;
     result.full_height = scene.height;
-    result.image = Image(rect.width(), rect.height());
+    // Every pixel of the rectangle is written by its tile.
+    result.image = Image(rect.width(), rect.height(), Image::Uninitialized{});
     RenderTarget target{result.image, rect, sample_range};
     if (options.samples) {
-        result.sample_sums = Image(rect.width(), rect.height());
+        result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});
         target.partial = true;
         target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
         target.sums = &result.sample_sums;

@@ -293,8 +293,10 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
     result.rect = rect;
     result.full_width = scene.image.width;
     result.full_height = scene.image.height;
-    result.image = Image(rect.width(), rect.height());
-    if (partial_samples) result.sample_sums = Image(rect.width(), rect.height());
+    // Every pixel of the rectangle is written by its tile.
+    result.image = Image(rect.width(), rect.height(), Image::Uninitialized{});
+    if (partial_samples)
+        result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});
     tbb::combinable<RayCounts> counts;
     std::atomic<bool> cancelled{false};  // a tile was skipped because of options.cancel
 

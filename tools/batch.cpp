@@ -64,8 +64,8 @@ std::int64_t parse_number(std::string_view text, std::int64_t max, std::string_v
         throw SpecError(context + "expected " + std::string(what) + ", found nothing");
     }
     if (t.front() == '-') {
-        throw SpecError(context + "expected " + std::string(what) + " (numbers start at 0), found " +
-                        quote(t));
+        throw SpecError(context + "expected " + std::string(what) +
+                        " (numbers start at 0), found " + quote(t));
     }
     if (!std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; })) {
         throw SpecError(context + "expected " + std::string(what) +
@@ -88,7 +88,8 @@ constexpr std::string_view kFrameSpecForms =
 std::vector<int> parse_frame_spec(std::string_view spec) {
     const std::string head = "frame spec " + quote(spec) + ": ";
     if (trim(spec).empty()) {
-        throw SpecError(head + "the frame list is empty; expected " + std::string(kFrameSpecForms));
+        throw SpecError(head + "the frame list is empty; expected " +
+                        std::string(kFrameSpecForms));
     }
     struct Item {
         std::int64_t first, last, step;
@@ -98,11 +99,14 @@ std::vector<int> parse_frame_spec(std::string_view spec) {
     std::size_t start = 0;
     for (;;) {
         const std::size_t comma = spec.find(',', start);
-        const std::string_view item = spec.substr(start, comma == spec.npos ? spec.npos : comma - start);
+        const std::string_view item =
+            spec.substr(start, comma == spec.npos ? spec.npos : comma - start);
         const std::string context = head + "in item " + quote(trim(item)) + ": ";
         if (trim(item).empty()) {
-            throw SpecError(head + "empty item (two commas in a row, or a comma at an end); "
-                                   "expected " + std::string(kFrameSpecForms));
+            throw SpecError(head +
+                            "empty item (two commas in a row, or a comma at an end); "
+                            "expected " +
+                            std::string(kFrameSpecForms));
         }
         // item := N | N-M | N-M:S. A leading '-' is a negative number, not a range.
         const std::string_view body = trim(item);
@@ -111,19 +115,22 @@ std::vector<int> parse_frame_spec(std::string_view spec) {
         std::int64_t first = 0, last = 0, step = 1;
         if (dash == std::string_view::npos) {
             if (colon != std::string_view::npos) {
-                throw SpecError(context + "a step needs a range; expected N-M:S such as "
-                                          "\"1-100:2\"");
+                throw SpecError(context +
+                                "a step needs a range; expected N-M:S such as "
+                                "\"1-100:2\"");
             }
             first = last = parse_number(body, kMaxFrame, "a frame number", context);
         } else {
             if (colon != std::string_view::npos && colon < dash) {
-                throw SpecError(context + "expected N-M:S (the step after the range), such as "
-                                          "\"1-100:2\"");
+                throw SpecError(context +
+                                "expected N-M:S (the step after the range), such as "
+                                "\"1-100:2\"");
             }
             first = parse_number(body.substr(0, dash), kMaxFrame, "a first frame", context);
             const std::string_view rest = body.substr(dash + 1);
             const std::size_t c = rest.find(':');
-            last = parse_number(rest.substr(0, c), kMaxFrame, "a last frame after '-'", context);
+            last =
+                parse_number(rest.substr(0, c), kMaxFrame, "a last frame after '-'", context);
             if (c != std::string_view::npos) {
                 step = parse_number(rest.substr(c + 1), kMaxFrame, "a step after ':'", context);
                 if (step == 0) {
@@ -131,9 +138,10 @@ std::vector<int> parse_frame_spec(std::string_view spec) {
                 }
             }
             if (last < first) {
-                throw SpecError(context + "the range runs backwards; expected the first frame <= "
-                                          "the last (write \"" + std::to_string(last) + "-" +
-                                          std::to_string(first) + "\")");
+                throw SpecError(context +
+                                "the range runs backwards; expected the first frame <= "
+                                "the last (write \"" +
+                                std::to_string(last) + "-" + std::to_string(first) + "\")");
             }
         }
         const std::int64_t count = (last - first) / step + 1;
@@ -213,16 +221,18 @@ std::vector<PatternPart> parse_pattern(std::string_view pattern) {
                 parts.push_back({PatternPart::frame, {}, 0});
             } else if (field == "scene") {
                 parts.push_back({PatternPart::scene, {}, 0});
-            } else if (field.size() == 9 && field.substr(0, 7) == "frame:0" && field[7] >= '1' &&
-                       field[7] <= '9' && field[8] == 'd') {
-                parts.push_back({PatternPart::frame, {}, static_cast<std::size_t>(field[7] - '0')});
+            } else if (field.size() == 9 && field.substr(0, 7) == "frame:0" &&
+                       field[7] >= '1' && field[7] <= '9' && field[8] == 'd') {
+                parts.push_back(
+                    {PatternPart::frame, {}, static_cast<std::size_t>(field[7] - '0')});
             } else if (field.substr(0, 6) == "frame:") {
                 throw SpecError(head + "unsupported frame format " +
                                 quote("{" + std::string(field) + "}") + "; " +
                                 std::string(kPatternFields));
             } else {
-                throw SpecError(head + "unknown field " + quote("{" + std::string(field) + "}") +
-                                "; " + std::string(kPatternFields));
+                throw SpecError(head + "unknown field " +
+                                quote("{" + std::string(field) + "}") + "; " +
+                                std::string(kPatternFields));
             }
             i = close + 1;
         } else {
@@ -244,8 +254,8 @@ bool pattern_has_frame_field(std::string_view pattern) {
 std::string expand_output_pattern(std::string_view pattern, int frame,
                                   std::string_view scene_name) {
     if (frame < 0) {
-        throw SpecError("output pattern " + quote(pattern) + ": expected a frame number >= 0, found " +
-                        std::to_string(frame));
+        throw SpecError("output pattern " + quote(pattern) +
+                        ": expected a frame number >= 0, found " + std::to_string(frame));
     }
     const std::string digits = std::to_string(frame);
     std::string out;
@@ -278,7 +288,8 @@ Shard parse_shard(std::string_view text) {
         parse_number(text.substr(slash + 1), kMaxFrame, "a shard count after '/'", head);
     if (count < 1) throw SpecError(head + "expected a shard count >= 1, found 0");
     if (index >= count) {
-        throw SpecError(head + "expected a shard index below the count (shards are numbered 0 to " +
+        throw SpecError(head +
+                        "expected a shard index below the count (shards are numbered 0 to " +
                         std::to_string(count - 1) + "), found " + std::to_string(index));
     }
     return {static_cast<int>(index), static_cast<int>(count)};
@@ -288,7 +299,8 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
                              std::optional<int> shard_count) {
     const std::string head = "shard auto: ";
     if (shard_count && *shard_count < 1) {
-        throw SpecError(head + "expected a shard count >= 1, found " + std::to_string(*shard_count));
+        throw SpecError(head + "expected a shard count >= 1, found " +
+                        std::to_string(*shard_count));
     }
     const auto get = [&getenv_fn](const char* name) -> std::optional<std::string> {
         const char* value = getenv_fn(name);
@@ -303,7 +315,8 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
                                  const std::string& how) -> Shard {
         if (index >= count) {
             throw SpecError(head + how + " gives shard " + std::to_string(index) + " of " +
-                            std::to_string(count) + "; expected an index below the count (an "
+                            std::to_string(count) +
+                            "; expected an index below the count (an "
                             "array of consecutive task ids, or give the shard as i/n)");
         }
         return {static_cast<int>(index), static_cast<int>(count)};
@@ -320,7 +333,8 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
         if (const auto t = get("SLURM_ARRAY_TASK_STEP")) {
             step = number("SLURM_ARRAY_TASK_STEP", *t);
             how += ", SLURM_ARRAY_TASK_STEP=" + *t;
-            if (step < 1) throw SpecError(head + "SLURM_ARRAY_TASK_STEP=\"0\": expected a step >= 1");
+            if (step < 1)
+                throw SpecError(head + "SLURM_ARRAY_TASK_STEP=\"0\": expected a step >= 1");
         }
         if (id < min || (id - min) % step != 0) {
             throw SpecError(head + how + ": expected a task id of the form MIN + k * STEP");
@@ -329,7 +343,8 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
         if (const auto t = get("SLURM_ARRAY_TASK_COUNT")) {
             count = number("SLURM_ARRAY_TASK_COUNT", *t);
             how += ", SLURM_ARRAY_TASK_COUNT=" + *t;
-            if (*count < 1) throw SpecError(head + "SLURM_ARRAY_TASK_COUNT=\"0\": expected a count >= 1");
+            if (*count < 1)
+                throw SpecError(head + "SLURM_ARRAY_TASK_COUNT=\"0\": expected a count >= 1");
             if (shard_count && *shard_count != *count) {
                 throw SpecError(head + "the shard count " + std::to_string(*shard_count) +
                                 " disagrees with SLURM_ARRAY_TASK_COUNT=" + *t +
@@ -338,9 +353,10 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
         } else if (shard_count) {
             count = *shard_count;
         } else {
-            throw SpecError(head + "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; "
-                                   "expected both (Slurm sets them for job arrays), or a shard "
-                                   "count");
+            throw SpecError(head +
+                            "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; "
+                            "expected both (Slurm sets them for job arrays), or a shard "
+                            "count");
         }
         return checked((id - min) / step, *count, how);
     }
@@ -353,15 +369,16 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
         }
         return checked(index, *shard_count, "JOB_COMPLETION_INDEX=" + *index_text);
     }
-    throw SpecError(head + "no array job found in the environment; expected SLURM_ARRAY_TASK_ID "
-                           "(a Slurm job array) or JOB_COMPLETION_INDEX (a Kubernetes Indexed "
-                           "Job), or give the shard as i/n");
+    throw SpecError(head +
+                    "no array job found in the environment; expected SLURM_ARRAY_TASK_ID "
+                    "(a Slurm job array) or JOB_COMPLETION_INDEX (a Kubernetes Indexed "
+                    "Job), or give the shard as i/n");
 }
 
 std::vector<int> select_shard(const std::vector<int>& frames, Shard shard) {
     if (shard.count < 1 || shard.index < 0 || shard.index >= shard.count) {
-        throw SpecError("shard " + std::to_string(shard.index) + "/" + std::to_string(shard.count) +
-                        ": expected 0 <= index < count");
+        throw SpecError("shard " + std::to_string(shard.index) + "/" +
+                        std::to_string(shard.count) + ": expected 0 <= index < count");
     }
     std::vector<int> out;
     for (std::size_t k = static_cast<std::size_t>(shard.index); k < frames.size();
@@ -382,25 +399,28 @@ CropRect parse_crop(std::string_view text, int image_width, int image_height) {
         start = comma + 1;
     }
     if (fields.size() != 4) {
-        throw SpecError(head + "expected four pixel coordinates x0,y0,x1,y1 (columns x0 to x1 - 1, "
-                               "rows y0 to y1 - 1), such as \"0,0,64,48\"");
+        throw SpecError(head +
+                        "expected four pixel coordinates x0,y0,x1,y1 (columns x0 to x1 - 1, "
+                        "rows y0 to y1 - 1), such as \"0,0,64,48\"");
     }
     static constexpr std::string_view names[4] = {"x0", "y0", "x1", "y1"};
     const std::int64_t limits[4] = {image_width, image_height, image_width, image_height};
     std::int64_t v[4];
     for (int i = 0; i < 4; ++i) {
-        v[i] = parse_number(fields[static_cast<std::size_t>(i)], std::max<std::int64_t>(limits[i], 0),
-                            std::string(names[i]) + " (a pixel coordinate within the " +
-                                std::to_string(image_width) + " x " + std::to_string(image_height) +
-                                " image)",
-                            head);
+        v[i] = parse_number(
+            fields[static_cast<std::size_t>(i)], std::max<std::int64_t>(limits[i], 0),
+            std::string(names[i]) + " (a pixel coordinate within the " +
+                std::to_string(image_width) + " x " + std::to_string(image_height) + " image)",
+            head);
     }
     if (v[0] >= v[2]) {
-        throw SpecError(head + "expected x0 < x1 (a crop at least one pixel wide), found x0 = " +
+        throw SpecError(head +
+                        "expected x0 < x1 (a crop at least one pixel wide), found x0 = " +
                         std::to_string(v[0]) + ", x1 = " + std::to_string(v[2]));
     }
     if (v[1] >= v[3]) {
-        throw SpecError(head + "expected y0 < y1 (a crop at least one pixel high), found y0 = " +
+        throw SpecError(head +
+                        "expected y0 < y1 (a crop at least one pixel high), found y0 = " +
                         std::to_string(v[1]) + ", y1 = " + std::to_string(v[3]));
     }
     return {static_cast<int>(v[0]), static_cast<int>(v[1]), static_cast<int>(v[2]),

@@ -2,9 +2,9 @@
 // (one still by default; animations, frame ranges, several scenes, shards of a farm job)
 // to EXR (+ PNG previews). The frame loop itself lives in render_batch.cpp.
 
-#include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
@@ -190,14 +190,15 @@ std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
     try {
         for (std::size_t s = 0; s < scenes.size(); ++s) {
             if (frames[s].size() > 1 && !batch::pattern_has_frame_field(pattern))
-                throw UsageError("-o " + pattern + " has no frame field (#### or {frame:04d}) but " +
+                throw UsageError("-o " + pattern +
+                                 " has no frame field (#### or {frame:04d}) but " +
                                  std::to_string(frames[s].size()) + " frames of " +
                                  scenes[s].spec + " are to be rendered");
             if (!args.png.empty() && frames[s].size() > 1 &&
                 !batch::pattern_has_frame_field(args.png))
-                throw UsageError("--png " + args.png +
-                                 " has no frame field (#### or {frame:04d}) but " +
-                                 std::to_string(frames[s].size()) + " frames are to be rendered");
+                throw UsageError(
+                    "--png " + args.png + " has no frame field (#### or {frame:04d}) but " +
+                    std::to_string(frames[s].size()) + " frames are to be rendered");
             for (const int frame : frames[s]) {
                 BatchJob job;
                 job.scene = s;
@@ -225,8 +226,9 @@ std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
                 const BatchJob& other = jobs[it->second];
                 throw UsageError(
                     "two frames would write the same file " + *file + ": " +
-                    scenes[other.scene].spec + " frame " + std::to_string(other.frame) + " and " +
-                    scenes[jobs[j].scene].spec + " frame " + std::to_string(jobs[j].frame) +
+                    scenes[other.scene].spec + " frame " + std::to_string(other.frame) +
+                    " and " + scenes[jobs[j].scene].spec + " frame " +
+                    std::to_string(jobs[j].frame) +
                     (scenes.size() > 1 ? " (put {scene} in the pattern)"
                                        : " (put #### or {frame:04d} in the pattern)"));
             }
@@ -240,8 +242,8 @@ batch::Shard resolve_shard(const RenderArguments& args) {
         if (args.shard == "auto") {
             std::optional<int> count;
             if (args.shard_count_option->count()) count = args.shard_count;
-            return batch::shard_from_environment([](const char* name) { return std::getenv(name); },
-                                                 count);
+            return batch::shard_from_environment(
+                [](const char* name) { return std::getenv(name); }, count);
         }
         if (args.shard_count_option->count())
             throw UsageError("--shard-count goes with --shard auto (Kubernetes Indexed Jobs)");
@@ -287,7 +289,8 @@ void run_render(const RenderArguments& args) {
         memory_limit = *limit;
     }
     batch::Shard shard{0, 1};
-    if (!args.shard.empty()) shard = resolve_shard(args);
+    if (!args.shard.empty())
+        shard = resolve_shard(args);
     else if (args.shard_count_option->count())
         throw UsageError("--shard-count goes with --shard auto (Kubernetes Indexed Jobs)");
 
@@ -335,8 +338,8 @@ void run_render(const RenderArguments& args) {
         }
     }
     if (shard.count > 1 && settings.progress != ProgressMode::json)
-        std::printf("shard    %d/%d: %zu of %zu frames\n", shard.index, shard.count, jobs.size(),
-                    planned);
+        std::printf("shard    %d/%d: %zu of %zu frames\n", shard.index, shard.count,
+                    jobs.size(), planned);
 
     const int status = run_batch(scenes, jobs, settings);
     if (status != kExitSuccess) throw CommandExit{status};
@@ -350,8 +353,8 @@ CLI::Validator quiet(CLI::Validator validator) { return validator.description(""
 
 void add_render_command(CLI::App& app, CommandRunner& run) {
     auto args = std::make_shared<RenderArguments>();
-    CLI::App* cmd = app.add_subcommand(
-        "render", "Render scenes, stills or animations, to OpenEXR images");
+    CLI::App* cmd =
+        app.add_subcommand("render", "Render scenes, stills or animations, to OpenEXR images");
 
     cmd->add_option("scenes", args->scenes,
                     "Scenes: JSON files or built-ins (whitted, random:N, sphereflake:L, each\n"
@@ -368,11 +371,12 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                     "Frames to render: 5, 1-100, 1-100:2 (every 2nd), lists: 1-10,20,30-40:5\n"
                     "[default: the scene's animation frames 0..frames-1, or 0 for a still]")
         ->type_name("SPEC");
-    cmd->add_option("--shard", args->shard,
-                    "Render only the i-th of n interleaved subsets of the frame list: i/n with\n"
-                    "0 <= i < n, or auto: Slurm's SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT\n"
-                    "(minus SLURM_ARRAY_TASK_MIN), or Kubernetes' JOB_COMPLETION_INDEX with\n"
-                    "--shard-count")
+    cmd->add_option(
+           "--shard", args->shard,
+           "Render only the i-th of n interleaved subsets of the frame list: i/n with\n"
+           "0 <= i < n, or auto: Slurm's SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT\n"
+           "(minus SLURM_ARRAY_TASK_MIN), or Kubernetes' JOB_COMPLETION_INDEX with\n"
+           "--shard-count")
         ->type_name("i/n|auto");
     args->shard_count_option =
         cmd->add_option("--shard-count", args->shard_count,
@@ -391,10 +395,11 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                     "Render only pixels x0..x1-1, y0..y1-1 (row 0 on top) into an EXR whose\n"
                     "data window is that region; `octray assemble` stitches regions together")
         ->type_name("x0,y0,x1,y1");
-    cmd->add_option("--aov", args->aov,
-                    "Extra channels from each pixel's first camera ray: depth (Z), normal\n"
-                    "(N.X N.Y N.Z), albedo (albedo.R albedo.G albedo.B), id (UINT, object index\n"
-                    "+ 1, 0 = background); comma-separated")
+    cmd->add_option(
+           "--aov", args->aov,
+           "Extra channels from each pixel's first camera ray: depth (Z), normal\n"
+           "(N.X N.Y N.Z), albedo (albedo.R albedo.G albedo.B), id (UINT, object index\n"
+           "+ 1, 0 = background); comma-separated")
         ->type_name("LIST");
     cmd->add_option("--progress", args->progress,
                     "auto (bar on a terminal, else lines), bar, lines (one line per frame and\n"
@@ -410,7 +415,8 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                     "[default: this machine's physical memory]")
         ->type_name("SIZE");
     args->width_option =
-        cmd->add_option("--width", args->width, "Image width in pixels, 1..65536 (overrides the scene)")
+        cmd->add_option("--width", args->width,
+                        "Image width in pixels, 1..65536 (overrides the scene)")
             ->type_name("W")
             ->check(quiet(CLI::Range(1, 65536)));
     args->height_option =
@@ -451,35 +457,39 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("PATH")
         ->check(quiet(CLI::IsMember({"scalar", "simd"})))
         ->capture_default_str();
-    cmd->add_option("--isa", args->isa,
-                    "Instruction set of the simd path: auto (the best this CPU has), avx2,\n"
-                    "sse4.1 or sse2 (`octray info` lists them; the image does not depend on it)")
+    cmd->add_option(
+           "--isa", args->isa,
+           "Instruction set of the simd path: auto (the best this CPU has), avx2,\n"
+           "sse4.1 or sse2 (`octray info` lists them; the image does not depend on it)")
         ->type_name("ISA")
         ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
-    cmd->add_option("--accel", args->accel,
-                    "Sphere acceleration of the simd path: auto (a BVH above a measured sphere\n"
-                    "count), bvh or none (brute force); the image does not depend on it")
+    cmd->add_option(
+           "--accel", args->accel,
+           "Sphere acceleration of the simd path: auto (a BVH above a measured sphere\n"
+           "count), bvh or none (brute force); the image does not depend on it")
         ->type_name("MODE")
         ->check(quiet(CLI::IsMember({"auto", "bvh", "none"})))
         ->capture_default_str();
-    cmd->add_option("--png", args->png,
-                    "Also write an 8-bit sRGB PNG preview (clamped to [0,1]); a pattern like -o")
+    cmd->add_option(
+           "--png", args->png,
+           "Also write an 8-bit sRGB PNG preview (clamped to [0,1]); a pattern like -o")
         ->type_name("FILE");
     cmd->add_flag("--float", args->float32, "Write 32-bit float channels instead of half");
     cmd->add_option("--compression", args->compression,
                     "EXR codec: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab\n"
                     "(pxr24 is lossy for --float; b44*, dwa* are lossy)")
         ->type_name("C")
-        ->check(quiet(CLI::IsMember({"none", "rle", "zips", "zip", "piz", "pxr24", "b44",
-                                     "b44a", "dwaa", "dwab"})))
+        ->check(quiet(CLI::IsMember(
+            {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})))
         ->capture_default_str();
     cmd->add_option("--tile", args->tile,
                     "Tile size WxH (or N for NxN) handed to the worker threads; the image\n"
                     "does not depend on it")
         ->type_name("WxH")
         ->check([](const std::string& text) {
-            return parse_tile(text) ? std::string() : "expected WxH with sides 1..4096, e.g. 16x16";
+            return parse_tile(text) ? std::string()
+                                    : "expected WxH with sides 1..4096, e.g. 16x16";
         })
         ->capture_default_str();
     cmd->footer(
@@ -492,7 +502,8 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         "  octray render shot.json --shard auto --placeholders -o out/shot.####.exr\n"
         "  octray render whitted --crop 0,0,640,360 -o part0.exr   # then octray assemble\n\n"
         "Each frame's randomness is hash(seed, frame): a frame rendered alone equals the same\n"
-        "frame of a whole sequence. Files are written to a hidden temporary and renamed, so an\n"
+        "frame of a whole sequence. Files are written to a hidden temporary and renamed, so "
+        "an\n"
         "output is either complete or absent. A frame that fails is reported and the others\n"
         "go on. Ctrl-C (or SIGTERM) stops after abandoning the frame in progress; a second\n"
         "one kills at once.\n\n"

@@ -11,7 +11,7 @@
 namespace octray::tools {
 
 class InterruptGuard {
-public:
+  public:
     InterruptGuard();   // installs the handlers for SIGINT and SIGTERM
     ~InterruptGuard();  // restores the previous ones
     InterruptGuard(const InterruptGuard&) = delete;

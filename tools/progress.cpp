@@ -1,9 +1,8 @@
 #include "tools/progress.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 namespace octray::tools {
 namespace {
@@ -16,20 +15,28 @@ constexpr auto kPercentLineInterval = std::chrono::seconds(2);
 
 const char* outcome_name(FrameOutcome outcome) {
     switch (outcome) {
-        case FrameOutcome::rendered: return "rendered";
-        case FrameOutcome::skipped_existing: return "skipped (exists)";
-        case FrameOutcome::skipped_claimed: return "skipped (claimed by another run)";
-        case FrameOutcome::failed: return "FAILED";
+        case FrameOutcome::rendered:
+            return "rendered";
+        case FrameOutcome::skipped_existing:
+            return "skipped (exists)";
+        case FrameOutcome::skipped_claimed:
+            return "skipped (claimed by another run)";
+        case FrameOutcome::failed:
+            return "FAILED";
     }
     return "?";
 }
 
 const char* outcome_key(FrameOutcome outcome) {
     switch (outcome) {
-        case FrameOutcome::rendered: return "rendered";
-        case FrameOutcome::skipped_existing: return "skipped_existing";
-        case FrameOutcome::skipped_claimed: return "skipped_claimed";
-        case FrameOutcome::failed: return "failed";
+        case FrameOutcome::rendered:
+            return "rendered";
+        case FrameOutcome::skipped_existing:
+            return "skipped_existing";
+        case FrameOutcome::skipped_claimed:
+            return "skipped_claimed";
+        case FrameOutcome::failed:
+            return "failed";
     }
     return "unknown";
 }
@@ -40,7 +47,8 @@ double seconds_since(Clock::time_point t) {
 
 }  // namespace
 
-std::optional<ProgressMode> parse_progress_mode(std::string_view name, bool stderr_is_terminal) {
+std::optional<ProgressMode> parse_progress_mode(std::string_view name,
+                                                bool stderr_is_terminal) {
     if (name == "auto") return stderr_is_terminal ? ProgressMode::bar : ProgressMode::lines;
     if (name == "bar") return ProgressMode::bar;
     if (name == "lines") return ProgressMode::lines;
@@ -67,7 +75,9 @@ std::string format_duration(double seconds) {
 
 ProgressReporter::ProgressReporter(ProgressMode mode, std::size_t frame_count,
                                    std::uint64_t total_work)
-    : mode_(mode), frame_count_(frame_count), total_work_(std::max<std::uint64_t>(total_work, 1)) {
+    : mode_(mode),
+      frame_count_(frame_count),
+      total_work_(std::max<std::uint64_t>(total_work, 1)) {
     if (mode_ == ProgressMode::bar || mode_ == ProgressMode::lines ||
         mode_ == ProgressMode::json)
         thread_ = std::thread([this] { ticker(); });
@@ -86,12 +96,13 @@ double ProgressReporter::fraction_locked() const {
     const std::uint64_t pixels = pixels_done_.load(std::memory_order_relaxed);
     const std::uint64_t current =
         std::min(current_work_, pixels * static_cast<std::uint64_t>(current_spp_));
-    return std::min(1.0, static_cast<double>(work_done_ + current) /
-                             static_cast<double>(total_work_));
+    return std::min(
+        1.0, static_cast<double>(work_done_ + current) / static_cast<double>(total_work_));
 }
 
 double ProgressReporter::mrays_per_second_locked() const {
-    return render_seconds_ > 0.0 ? static_cast<double>(rays_done_) / render_seconds_ / 1e6 : 0.0;
+    return render_seconds_ > 0.0 ? static_cast<double>(rays_done_) / render_seconds_ / 1e6
+                                 : 0.0;
 }
 
 void ProgressReporter::draw_bar_locked(bool final_draw) {
@@ -105,8 +116,10 @@ void ProgressReporter::draw_bar_locked(bool final_draw) {
                           ? format_duration(elapsed * (1.0 - fraction) / fraction)
                           : (fraction >= 1.0 ? "0.0s" : "?");
     char rate[32] = "-";
-    if (render_seconds_ > 0.0) std::snprintf(rate, sizeof rate, "%.1f", mrays_per_second_locked());
-    std::fprintf(stderr, "\r\033[K[%s] %3d%%  frame %zu/%zu  %s  elapsed %s  ETA %s  %s Mrays/s",
+    if (render_seconds_ > 0.0)
+        std::snprintf(rate, sizeof rate, "%.1f", mrays_per_second_locked());
+    std::fprintf(stderr,
+                 "\r\033[K[%s] %3d%%  frame %zu/%zu  %s  elapsed %s  ETA %s  %s Mrays/s",
                  bar.c_str(), static_cast<int>(fraction * 100.0), current_index_, frame_count_,
                  current_label_.c_str(), format_duration(elapsed).c_str(), eta.c_str(), rate);
     if (final_draw) std::fputc('\n', stderr);
@@ -125,7 +138,8 @@ void ProgressReporter::maybe_progress_line_locked(bool force) {
     if (mode_ == ProgressMode::lines) {
         std::printf("Progress: %d%%\n", percent);
     } else {
-        nlohmann::json event = {{"event", "progress"}, {"percent", percent},
+        nlohmann::json event = {{"event", "progress"},
+                                {"percent", percent},
                                 {"elapsed_seconds", seconds_since(start_)}};
         std::printf("%s\n", event.dump().c_str());
     }
@@ -212,7 +226,8 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
             maybe_progress_line_locked(true);
             break;
         }
-        case ProgressMode::none: break;
+        case ProgressMode::none:
+            break;
     }
 }
 
@@ -234,9 +249,8 @@ void ProgressReporter::finish(const BatchSummary& summary) {
 
     std::lock_guard lock(mutex_);
     if (mode_ == ProgressMode::bar && bar_drawn_) draw_bar_locked(true);
-    const double mrays = summary.seconds > 0.0
-                             ? static_cast<double>(summary.rays) / summary.seconds / 1e6
-                             : 0.0;
+    const double mrays =
+        summary.seconds > 0.0 ? static_cast<double>(summary.rays) / summary.seconds / 1e6 : 0.0;
     if (mode_ == ProgressMode::json) {
         nlohmann::json event = {{"event", "summary"},
                                 {"frames", frame_count_},
@@ -252,7 +266,7 @@ void ProgressReporter::finish(const BatchSummary& summary) {
     } else {
         if (mode_ == ProgressMode::lines && !summary.interrupted && summary.failed == 0)
             maybe_progress_line_locked(true);
-        std::printf("%s%zu frame%s: %zu rendered, %zu skipped, %zu failed", 
+        std::printf("%s%zu frame%s: %zu rendered, %zu skipped, %zu failed",
                     summary.interrupted ? "interrupted: " : "done: ", frame_count_,
                     frame_count_ == 1 ? "" : "s", summary.rendered, summary.skipped,
                     summary.failed);

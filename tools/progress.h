@@ -35,9 +35,9 @@ struct FrameReport {
     std::string output;
     std::string preview;  // the PNG, if any
     FrameOutcome outcome = FrameOutcome::rendered;
-    double seconds = 0.0;     // render + write
-    std::uint64_t rays = 0;   // rendered frames
-    std::string message;      // failed frames: the reason
+    double seconds = 0.0;    // render + write
+    std::uint64_t rays = 0;  // rendered frames
+    std::string message;     // failed frames: the reason
 };
 
 struct BatchSummary {
@@ -48,7 +48,7 @@ struct BatchSummary {
 };
 
 class ProgressReporter {
-public:
+  public:
     // `total_work`: pixel samples of every frame of the run.
     ProgressReporter(ProgressMode mode, std::size_t frame_count, std::uint64_t total_work);
     ~ProgressReporter();
@@ -67,7 +67,7 @@ public:
     void note(const std::string& line);
     void finish(const BatchSummary& summary);
 
-private:
+  private:
     void ticker();
     void draw_bar_locked(bool final_draw);
     void maybe_progress_line_locked(bool force);
@@ -83,8 +83,8 @@ private:
     std::mutex mutex_;
     std::condition_variable wake_;
     bool stopping_ = false;
-    std::uint64_t work_done_ = 0;       // of finished (or skipped) frames
-    std::uint64_t current_work_ = 0;    // of the frame being rendered
+    std::uint64_t work_done_ = 0;     // of finished (or skipped) frames
+    std::uint64_t current_work_ = 0;  // of the frame being rendered
     int current_spp_ = 1;
     std::size_t current_index_ = 0;
     std::string current_label_;

@@ -1,12 +1,11 @@
 #include "tools/render_batch.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfIntAttribute.h>
+#include <fcntl.h>
 #include <oneapi/tbb/global_control.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
@@ -47,7 +46,9 @@ struct FrameResult {
     FailureKind failure = FailureKind::none;
 };
 
-std::string_view path_name(RenderPath path) { return path == RenderPath::scalar ? "scalar" : "simd"; }
+std::string_view path_name(RenderPath path) {
+    return path == RenderPath::scalar ? "scalar" : "simd";
+}
 
 RenderResult render_still(const BatchSettings& settings, const Scene& scene,
                           const RenderOptions& options) {
@@ -78,8 +79,8 @@ Existing existing_output(const std::string& path) {
     if (size == 0) return Existing::claim;
     try {
         Imf::InputFile file(path.c_str());
-        const auto* samples = file.header().findTypedAttribute<Imf::IntAttribute>(
-            kSamplesSoFarAttribute);
+        const auto* samples =
+            file.header().findTypedAttribute<Imf::IntAttribute>(kSamplesSoFarAttribute);
         if (samples != nullptr) return Existing::unfinished;
     } catch (const std::exception&) {
         // Not an EXR octray can read (a PNG preview target, or a damaged file): it exists.
@@ -120,14 +121,14 @@ void release_claim(const std::string& path) {
 }
 
 class BatchRunner {
-public:
+  public:
     BatchRunner(const std::vector<BatchScene>& scenes, const BatchSettings& settings,
                 ProgressReporter& progress)
         : scenes_(scenes), settings_(settings), progress_(progress) {}
 
     FrameResult run(std::size_t index, const BatchJob& job);
 
-private:
+  private:
     std::uint64_t frame_work(const BatchScene& scene) const;
     ExrAttributes attributes(const BatchScene& scene, const Scene& posed, int frame,
                              const RenderResult& result, int samples_so_far) const;
@@ -142,8 +143,8 @@ private:
 
 std::uint64_t BatchRunner::frame_work(const BatchScene& scene) const {
     const Scene& s = scene.scene;
-    std::uint64_t pixels = static_cast<std::uint64_t>(s.image.width) *
-                           static_cast<std::uint64_t>(s.image.height);
+    std::uint64_t pixels =
+        static_cast<std::uint64_t>(s.image.width) * static_cast<std::uint64_t>(s.image.height);
     if (scene.crop)
         pixels = static_cast<std::uint64_t>(scene.crop->x1 - scene.crop->x0) *
                  static_cast<std::uint64_t>(scene.crop->y1 - scene.crop->y0);
@@ -154,7 +155,8 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
                                       const RenderResult& result, int samples_so_far) const {
     const auto [date, utc_offset] = capture_date();
     std::string path = std::string(path_name(settings_.path));
-    if (settings_.path == RenderPath::simd) path.append(" (").append(isa_name(settings_.isa)).append(")");
+    if (settings_.path == RenderPath::simd)
+        path.append(" (").append(isa_name(settings_.isa)).append(")");
     ExrAttributes a;
     a.strings = {
         {"software", std::string("octray ") + kVersion},
@@ -171,7 +173,8 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
         {"octray.maxDepth", posed.render.max_depth},
         {"octray.frame", frame},
     };
-    if (samples_so_far < posed.image.spp) a.ints.emplace_back(kSamplesSoFarAttribute, samples_so_far);
+    if (samples_so_far < posed.image.spp)
+        a.ints.emplace_back(kSamplesSoFarAttribute, samples_so_far);
     // Ray counts are 64-bit; a double holds them exactly up to 2^53 (9e15 rays).
     a.doubles = {
         {"renderTimeSeconds", result.seconds},
@@ -188,9 +191,9 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
     return a;
 }
 
-void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job, const Scene& posed,
-                                const RenderResult& result, const AovImages& aovs,
-                                int samples_so_far) const {
+void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job,
+                                const Scene& posed, const RenderResult& result,
+                                const AovImages& aovs, int samples_so_far) const {
     ExrImage exr = make_exr_image(result, settings_.exr,
                                   attributes(scene, posed, job.frame, result, samples_so_far));
     if (aovs.set.any())
@@ -249,14 +252,16 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         options.cancel = &InterruptGuard::flag();
         options.pixels_done = &progress_.pixel_counter();
         if (scene.crop)
-            options.crop = PixelRect{scene.crop->x0, scene.crop->y0, scene.crop->x1, scene.crop->y1};
+            options.crop =
+                PixelRect{scene.crop->x0, scene.crop->y0, scene.crop->x1, scene.crop->y1};
         const AovImages aovs = compute_aovs(posed, options, settings_.aovs);
 
         RenderResult result;
         if (settings_.progressive) {
             result = render_progressive(
                 [&](const RenderOptions& o) { return render_still(settings_, posed, o); },
-                posed.image.spp, options, [&](const RenderResult& pass, int samples_so_far) {
+                posed.image.spp, options,
+                [&](const RenderResult& pass, int samples_so_far) {
                     if (samples_so_far < posed.image.spp)
                         write_outputs(scene, job, posed, pass, aovs, samples_so_far);
                 });
@@ -304,18 +309,19 @@ void print_header(const std::vector<BatchScene>& scenes, const std::vector<Batch
         const Scene& scene = scenes[s].scene;
         std::size_t frames = 0;
         for (const BatchJob& job : jobs) frames += job.scene == s ? 1 : 0;
-        std::printf("scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp, max depth %d, "
-                    "seed %llu, %zu frame%s\n",
-                    scenes[s].spec.c_str(), scene.objects.size(), scene.lights.size(),
-                    scene.animation ? ", animated" : "", scene.image.width, scene.image.height,
-                    scene.image.spp, scene.render.max_depth,
-                    static_cast<unsigned long long>(scene.render.seed), frames,
-                    frames == 1 ? "" : "s");
+        std::printf(
+            "scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp, max depth %d, "
+            "seed %llu, %zu frame%s\n",
+            scenes[s].spec.c_str(), scene.objects.size(), scene.lights.size(),
+            scene.animation ? ", animated" : "", scene.image.width, scene.image.height,
+            scene.image.spp, scene.render.max_depth,
+            static_cast<unsigned long long>(scene.render.seed), frames, frames == 1 ? "" : "s");
     }
     const std::size_t threads =
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
     std::string path(path_name(settings.path));
-    if (settings.path == RenderPath::simd) path.append(" (").append(isa_name(settings.isa)).append(")");
+    if (settings.path == RenderPath::simd)
+        path.append(" (").append(isa_name(settings.isa)).append(")");
     std::printf("render   %s path, %zu threads, %dx%d tiles\n", path.c_str(), threads,
                 settings.options.tile_width, settings.options.tile_height);
     std::fflush(stdout);
@@ -358,11 +364,10 @@ int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>
     for (const BatchJob& job : jobs) {
         const Scene& s = scenes[job.scene].scene;
         const auto& crop = scenes[job.scene].crop;
-        const std::uint64_t pixels =
-            crop ? static_cast<std::uint64_t>(crop->x1 - crop->x0) *
-                       static_cast<std::uint64_t>(crop->y1 - crop->y0)
-                 : static_cast<std::uint64_t>(s.image.width) *
-                       static_cast<std::uint64_t>(s.image.height);
+        const std::uint64_t pixels = crop ? static_cast<std::uint64_t>(crop->x1 - crop->x0) *
+                                                static_cast<std::uint64_t>(crop->y1 - crop->y0)
+                                          : static_cast<std::uint64_t>(s.image.width) *
+                                                static_cast<std::uint64_t>(s.image.height);
         total_work += pixels * static_cast<std::uint64_t>(s.image.spp);
     }
 
@@ -384,7 +389,9 @@ int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>
                 summary.rays += result.report.rays;
                 break;
             case FrameOutcome::skipped_existing:
-            case FrameOutcome::skipped_claimed: ++summary.skipped; break;
+            case FrameOutcome::skipped_claimed:
+                ++summary.skipped;
+                break;
             case FrameOutcome::failed:
                 if (result.failure == FailureKind::interrupted) {
                     summary.not_started = jobs.size() - k;  // this one included: not done

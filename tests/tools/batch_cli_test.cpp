@@ -4,10 +4,6 @@
 // progressive passes, per-frame attributes, failures that let the rest go on, and bad
 // input. Every image comparison is bit for bit.
 
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-#include <unistd.h>
-
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
@@ -15,11 +11,14 @@
 #include <ImfRationalAttribute.h>
 #include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
@@ -61,7 +60,7 @@ bool contains(const std::string& text, const std::string& part) {
 }
 
 class BatchCliTest : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "batch" /
                ::testing::UnitTest::GetInstance()->current_test_info()->name();
@@ -86,7 +85,9 @@ protected:
         return found;
     }
 
-    ChannelImage read(const std::string& name) const { return read_image((dir_ / name).string()); }
+    ChannelImage read(const std::string& name) const {
+        return read_image((dir_ / name).string());
+    }
 
     // Runs a shell command line in the test directory; returns its exit status.
     int shell(const std::string& command) const {
@@ -106,13 +107,12 @@ void expect_same_pixels(const ChannelImage& a, const ChannelImage& b, const std:
 }
 
 TEST_F(BatchCliTest, FrameRenderedAloneEqualsTheSameFrameOfTheSequence) {
-    const auto all = run_octray({"render", "shot.json", "-o", "out/shot.####.exr", "--progress",
-                                 "lines"},
-                                dir_);
+    const auto all = run_octray(
+        {"render", "shot.json", "-o", "out/shot.####.exr", "--progress", "lines"}, dir_);
     ASSERT_EQ(all.status, 0) << all.output;
-    EXPECT_EQ(files_in("out"), (std::set<std::string>{"shot.0000.exr", "shot.0001.exr",
-                                                      "shot.0002.exr", "shot.0003.exr",
-                                                      "shot.0004.exr", "shot.0005.exr"}));
+    EXPECT_EQ(files_in("out"),
+              (std::set<std::string>{"shot.0000.exr", "shot.0001.exr", "shot.0002.exr",
+                                     "shot.0003.exr", "shot.0004.exr", "shot.0005.exr"}));
     const auto alone = run_octray({"render", "shot.json", "--frames", "3", "-o",
                                    "alone.{frame:04d}.exr", "--path", "scalar"},
                                   dir_);
@@ -155,9 +155,11 @@ TEST_F(BatchCliTest, ConcurrentSlurmShardsRenderEachFrameOnceAndMatchOneProcess)
     std::string command;
     for (int task = 1; task <= 3; ++task) {
         command += "SLURM_ARRAY_TASK_ID=" + std::to_string(task) +
-                   " SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_COUNT=3 " + shell_quote(OCTRAY_EXE) +
+                   " SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_COUNT=3 " +
+                   shell_quote(OCTRAY_EXE) +
                    " render shot.json --shard auto --placeholders --progress lines -o "
-                   "out/s.####.exr > log" + std::to_string(task) + ".txt 2>&1 </dev/null & ";
+                   "out/s.####.exr > log" +
+                   std::to_string(task) + ".txt 2>&1 </dev/null & ";
     }
     command += "wait";
     ASSERT_EQ(shell(command), 0);
@@ -181,7 +183,8 @@ TEST_F(BatchCliTest, ConcurrentSlurmShardsRenderEachFrameOnceAndMatchOneProcess)
 }
 
 TEST_F(BatchCliTest, KubernetesIndexNeedsAShardCount) {
-    const auto r = run_octray({"render", "shot.json", "--shard", "auto", "-o", "out/k.#.exr"}, dir_);
+    const auto r =
+        run_octray({"render", "shot.json", "--shard", "auto", "-o", "out/k.#.exr"}, dir_);
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_TRUE(contains(r.output, "SLURM_ARRAY_TASK_ID")) << r.output;
     const int status = shell("JOB_COMPLETION_INDEX=1 " + shell_quote(OCTRAY_EXE) +
@@ -193,20 +196,23 @@ TEST_F(BatchCliTest, KubernetesIndexNeedsAShardCount) {
 
 TEST_F(BatchCliTest, ResumeAfterAKillFinishesTheRestAndLeavesNoTemporaries) {
     // Slow enough frames (scalar path, one thread) that the kill lands mid-sequence.
-    const std::string render = shell_quote(OCTRAY_EXE) +
-                               " render shot.json --width 320 --height 240 --spp 16 --path scalar"
-                               " --threads 1 --progress none -o out/r.##.exr";
-    const int status = shell(render + " >/dev/null 2>&1 </dev/null & pid=$!; "
-                             "i=0; while [ ! -s out/r.00.exr ] && [ $i -lt 6000 ]; do sleep 0.01; i=$((i+1)); done; "
-                             "kill -9 $pid; wait $pid; exit 0");
+    const std::string render =
+        shell_quote(OCTRAY_EXE) +
+        " render shot.json --width 320 --height 240 --spp 16 --path scalar"
+        " --threads 1 --progress none -o out/r.##.exr";
+    const int status = shell(
+        render +
+        " >/dev/null 2>&1 </dev/null & pid=$!; "
+        "i=0; while [ ! -s out/r.00.exr ] && [ $i -lt 6000 ]; do sleep 0.01; i=$((i+1)); done; "
+        "kill -9 $pid; wait $pid; exit 0");
     ASSERT_EQ(status, 0);
     const std::size_t after_kill = files_in("out").size() - temporaries("out").size();
     EXPECT_LT(after_kill, 6u) << "the kill came too late to test a resume";
 
-    const auto resumed = run_octray({"render", "shot.json", "--width", "320", "--height", "240",
-                                     "--spp", "16", "--skip-existing", "-o", "out/r.##.exr",
-                                     "--progress", "lines"},
-                                    dir_);
+    const auto resumed =
+        run_octray({"render", "shot.json", "--width", "320", "--height", "240", "--spp", "16",
+                    "--skip-existing", "-o", "out/r.##.exr", "--progress", "lines"},
+                   dir_);
     ASSERT_EQ(resumed.status, 0) << resumed.output;
     EXPECT_TRUE(contains(resumed.output, "skipped (exists)")) << resumed.output;
     EXPECT_TRUE(temporaries("out").empty());
@@ -220,12 +226,13 @@ TEST_F(BatchCliTest, ResumeAfterAKillFinishesTheRestAndLeavesNoTemporaries) {
 }
 
 TEST_F(BatchCliTest, InterruptStopsCleanlyWithASummary) {
-    const int status = shell(shell_quote(OCTRAY_EXE) +
-                             " render shot.json --width 320 --height 240 --spp 16 --path scalar"
-                             " --threads 1 --progress lines -o out/i.##.exr >log.txt 2>&1 "
-                             "</dev/null & pid=$!; "
-                             "i=0; while [ ! -s out/i.00.exr ] && [ $i -lt 6000 ]; do sleep 0.01; i=$((i+1)); done; "
-                             "kill -INT $pid; wait $pid; echo $? > status.txt; exit 0");
+    const int status = shell(
+        shell_quote(OCTRAY_EXE) +
+        " render shot.json --width 320 --height 240 --spp 16 --path scalar"
+        " --threads 1 --progress lines -o out/i.##.exr >log.txt 2>&1 "
+        "</dev/null & pid=$!; "
+        "i=0; while [ ! -s out/i.00.exr ] && [ $i -lt 6000 ]; do sleep 0.01; i=$((i+1)); done; "
+        "kill -INT $pid; wait $pid; echo $? > status.txt; exit 0");
     ASSERT_EQ(status, 0);
     std::ifstream status_file(dir_ / "status.txt");
     int exit_status = -1;
@@ -266,22 +273,25 @@ TEST_F(BatchCliTest, CropsAssembleIntoTheFullFrameBitForBit) {
 }
 
 TEST_F(BatchCliTest, ProgressiveFinalImageEqualsThePlainRender) {
-    ASSERT_EQ(run_octray({"render", "shot.json", "--frames", "1", "--spp", "5", "-o", "plain.exr"},
-                         dir_)
-                  .status,
-              0);
+    ASSERT_EQ(
+        run_octray({"render", "shot.json", "--frames", "1", "--spp", "5", "-o", "plain.exr"},
+                   dir_)
+            .status,
+        0);
     const auto r = run_octray({"render", "shot.json", "--frames", "1", "--spp", "5",
                                "--progressive", "-o", "passes.exr"},
                               dir_);
     ASSERT_EQ(r.status, 0) << r.output;
     expect_same_pixels(read("passes.exr"), read("plain.exr"), "progressive");
     Imf::InputFile file((dir_ / "passes.exr").c_str());
-    EXPECT_EQ(file.header().findTypedAttribute<Imf::IntAttribute>("octray.samplesSoFar"), nullptr)
+    EXPECT_EQ(file.header().findTypedAttribute<Imf::IntAttribute>("octray.samplesSoFar"),
+              nullptr)
         << "the final image is marked unfinished";
 }
 
 TEST_F(BatchCliTest, EveryFrameCarriesItsAttributes) {
-    ASSERT_EQ(run_octray({"render", "shot.json", "--frames", "4", "-o", "a.exr"}, dir_).status, 0);
+    ASSERT_EQ(run_octray({"render", "shot.json", "--frames", "4", "-o", "a.exr"}, dir_).status,
+              0);
     Imf::InputFile file((dir_ / "a.exr").c_str());
     const Imf::Header& h = file.header();
     ASSERT_NE(h.findTypedAttribute<Imf::IntAttribute>("octray.frame"), nullptr);
@@ -298,9 +308,8 @@ TEST_F(BatchCliTest, EveryFrameCarriesItsAttributes) {
 }
 
 TEST_F(BatchCliTest, SeveralScenesNeedSceneInThePattern) {
-    const auto clash = run_octray({"render", "shot.json", "random:4,width=16,height=12", "-o",
-                                   "out/x.exr"},
-                                  dir_);
+    const auto clash = run_octray(
+        {"render", "shot.json", "random:4,width=16,height=12", "-o", "out/x.exr"}, dir_);
     EXPECT_EQ(clash.status, 2) << clash.output;
     const auto r = run_octray({"render", "shot.json", "random:4,width=16,height=12", "--frames",
                                "0-1", "-o", "out/{scene}.#.exr"},
@@ -313,13 +322,14 @@ TEST_F(BatchCliTest, SeveralScenesNeedSceneInThePattern) {
 TEST_F(BatchCliTest, AFailedFrameIsReportedAndTheRestGoOn) {
     // Frame 3's output path is taken by a directory: an I/O failure, worth retrying.
     fs::create_directories(dir_ / "out/g.3.exr/inside");
-    const auto r = run_octray({"render", "shot.json", "-o", "out/g.#.exr", "--progress", "lines"},
-                              dir_);
+    const auto r =
+        run_octray({"render", "shot.json", "-o", "out/g.#.exr", "--progress", "lines"}, dir_);
     EXPECT_EQ(r.status, 4) << r.output;
     EXPECT_TRUE(contains(r.output, "FAILED")) << r.output;
     EXPECT_TRUE(contains(r.output, "5 rendered")) << r.output;
     EXPECT_TRUE(contains(r.output, "1 failed")) << r.output;
-    for (int f : {0, 1, 2, 4, 5}) EXPECT_TRUE(fs::exists(dir_ / ("out/g." + std::to_string(f) + ".exr")));
+    for (int f : {0, 1, 2, 4, 5})
+        EXPECT_TRUE(fs::exists(dir_ / ("out/g." + std::to_string(f) + ".exr")));
     EXPECT_TRUE(temporaries("out").empty());
 }
 

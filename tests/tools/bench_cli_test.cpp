@@ -4,10 +4,10 @@
 // speed (speed lives in bench/).
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 
@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 using testing::run_octray;
 
 class BenchCliTest : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "bench_cli" /
                ::testing::UnitTest::GetInstance()->current_test_info()->name();
@@ -41,8 +41,8 @@ nlohmann::json read_json(const fs::path& path) {
 }
 
 TEST_F(BenchCliTest, JsonReportHasContextAndValidatedRowsForEveryRayKind) {
-    const auto r = run_octray({"bench", "random:16", "--width", "48", "--height", "32", "--reps",
-                               "2", "--warmup", "1", "--threads", "2", "--rays",
+    const auto r = run_octray({"bench", "random:16", "--width", "48", "--height", "32",
+                               "--reps", "2", "--warmup", "1", "--threads", "2", "--rays",
                                "primary,shadow,secondary,whitted", "--json", "report.json"},
                               dir_);
     ASSERT_EQ(r.status, 0) << r.output;
@@ -50,12 +50,13 @@ TEST_F(BenchCliTest, JsonReportHasContextAndValidatedRowsForEveryRayKind) {
     const nlohmann::json report = read_json(dir_ / "report.json");
     ASSERT_TRUE(report.contains("context")) << report.dump(2);
     for (const char* key : {"cpu", "threads", "isa", "compiler", "date"})
-        EXPECT_TRUE(report["context"].contains(key)) << key << "\n" << report["context"].dump(2);
+        EXPECT_TRUE(report["context"].contains(key)) << key << "\n"
+                                                     << report["context"].dump(2);
     ASSERT_TRUE(report["rows"].is_array());
     std::set<std::string> kinds, systems;
     for (const auto& row : report["rows"]) {
-        for (const char* key : {"scene", "ray_kind", "system", "mode", "threads", "mrays_median",
-                                "mrays_min", "mrays_max", "valid"})
+        for (const char* key : {"scene", "ray_kind", "system", "mode", "threads",
+                                "mrays_median", "mrays_min", "mrays_max", "valid"})
             ASSERT_TRUE(row.contains(key)) << key << "\n" << row.dump(2);
         kinds.insert(row["ray_kind"].get<std::string>());
         systems.insert(row["system"].get<std::string>());
@@ -88,15 +89,14 @@ TEST_F(BenchCliTest, NoEmbreeMeasuresOctrayAlone) {
 }
 
 TEST_F(BenchCliTest, ScalarAndSimdPathsAreBothRowsOfOneRun) {
-    const auto r = run_octray({"bench", "random:16", "--width", "32", "--height", "24", "--reps",
-                               "1", "--rays", "primary", "--path", "scalar,simd", "--no-embree",
-                               "--json", "r.json"},
-                              dir_);
+    const auto r = run_octray(
+        {"bench", "random:16", "--width", "32", "--height", "24", "--reps", "1", "--rays",
+         "primary", "--path", "scalar,simd", "--no-embree", "--json", "r.json"},
+        dir_);
     ASSERT_EQ(r.status, 0) << r.output;
     std::set<std::string> modes;
     const nlohmann::json report = read_json(dir_ / "r.json");
-    for (const auto& row : report["rows"])
-        modes.insert(row["mode"].get<std::string>());
+    for (const auto& row : report["rows"]) modes.insert(row["mode"].get<std::string>());
     EXPECT_GE(modes.size(), 2u) << "one mode per path expected";
 }
 
@@ -107,10 +107,10 @@ TEST_F(BenchCliTest, BadInputExitsWithItsCode) {
     const auto scene = run_octray({"bench", "no-such-scene.json", "--reps", "1"}, dir_);
     EXPECT_EQ(scene.status, 3) << scene.output;
     EXPECT_TRUE(contains(scene.output, "no-such-scene.json")) << scene.output;
-    const auto io = run_octray({"bench", "random:4", "--width", "16", "--height", "16", "--reps",
-                                "1", "--rays", "primary", "--no-embree", "--json",
-                                "missing/dir/r.json"},
-                               dir_);
+    const auto io =
+        run_octray({"bench", "random:4", "--width", "16", "--height", "16", "--reps", "1",
+                    "--rays", "primary", "--no-embree", "--json", "missing/dir/r.json"},
+                   dir_);
     EXPECT_EQ(io.status, 4) << io.output;
     EXPECT_TRUE(contains(io.output, "missing/dir/r.json")) << io.output;
 }
