@@ -5,7 +5,9 @@
 #   2. release preset (g++ 12, -Wall -Wextra -Werror, Embree): build, run the whole suite,
 #   3. asan preset (clang, ASan + UBSan, Embree off so that configuration is built and
 #      tested too): build, run the whole suite again plus every libFuzzer target for
-#      OCTRAY_FUZZ_SECONDS (30) each.
+#      OCTRAY_FUZZ_SECONDS (30) each,
+#   4. ThreadSanitizer over the parallel rendering tests and a batch render, against a
+#      oneTBB built with -fsanitize=thread from Debian's source (tests/tsan/run.sh).
 # Quicker loop while developing: ctest --preset release (after a build).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -20,4 +22,7 @@ echo "tools/test.sh: release done at $((SECONDS - start)) s"
 cmake --preset asan
 cmake --build --preset asan -j2
 ctest --preset asan
+echo "tools/test.sh: asan done at $((SECONDS - start)) s"
+
+tests/tsan/run.sh
 echo "tools/test.sh: passed in $((SECONDS - start)) s"

@@ -3,8 +3,10 @@
 # renderer's bit-identity across thread counts and tile sizes):
 #   1. builds oneTBB with -fsanitize=thread once (tests/tsan/build_tbb.sh says why),
 #   2. checks that TSan reports a planted race (tests/tsan/race_canary.cpp),
-#   3. configures the `tsan` preset against that TBB, builds the two test binaries and
-#      runs their thread tests with halt_on_error=1 and tests/tsan/tsan.supp.
+#   3. configures the `tsan` preset against that TBB, builds the test binaries and runs
+#      their thread tests (both renderers, the parallel BVH build, BVH renders) with
+#      halt_on_error=1 and tests/tsan/tsan.supp,
+#   4. renders a small batch with `octray render` (progress thread, progressive passes).
 # Usage: tests/tsan/run.sh   (root on a fresh machine: step 1 adds a deb-src entry)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -28,5 +30,14 @@ fi
 cmake --preset tsan  # TBB_DIR: build/tsan-tbb/install (the preset)
 cmake --build --preset tsan -j2
 ctest --preset tsan --no-tests=error \
-  -R 'ReferenceRender\.ThreadCountAndTileSizeDoNotChangeASingleBit|PacketRenderer\.BitIdenticalForAnyThreadCountAndTileSize'
+  -R 'ReferenceRender\.ThreadCountAndTileSizeDoNotChangeASingleBit|PacketRenderer\.BitIdenticalForAnyThreadCountAndTileSize|SphereBvh\.DeterministicAcrossThreadCounts|BvhRender\.BuiltinScenesMatchTheReference'
+
+# 4. A batch render: two render threads, the progress ticker thread reading the pixel
+#    counter the tiles advance, a BVH built in parallel, progressive passes.
+export TSAN_OPTIONS="suppressions=$PWD/tests/tsan/tsan.supp halt_on_error=1 second_deadlock_stack=1"
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+build/tsan/tools/octray render random:64,width=96,height=64,spp=4 --frames 0-3 --threads 2 \
+  --progress lines --progressive -o "$out/t.#.exr" > build/tsan/batch_render.log 2>&1 ||
+  { cat build/tsan/batch_render.log; echo "tests/tsan/run.sh: the batch render failed" >&2; exit 1; }
 echo "tests/tsan/run.sh: passed in $((SECONDS - start)) s"
