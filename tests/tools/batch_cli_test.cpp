@@ -144,6 +144,24 @@ TEST_F(BatchCliTest, FrameSpecsPickTheFramesInOrder) {
     EXPECT_EQ(summaries, 1);
 }
 
+TEST_F(BatchCliTest, OnATerminalAutoProgressIsALiveBar) {
+    // `script` gives octray a pseudo-terminal, as a user's shell would.
+    if (shell("command -v script >/dev/null") != 0) GTEST_SKIP() << "no script(1) here";
+    const int status = shell("script -qec " +
+                             shell_quote(shell_quote(OCTRAY_EXE) +
+                                         " render shot.json --frames 0-2 -o 'out/b.#.exr'") +
+                             " /dev/null > tty.txt 2>&1 </dev/null");
+    ASSERT_EQ(status, 0);
+    std::ifstream tty_file(dir_ / "tty.txt", std::ios::binary);
+    const std::string tty((std::istreambuf_iterator<char>(tty_file)), {});
+    EXPECT_TRUE(contains(tty, "\r\033[K[")) << tty;  // redrawn in place
+    EXPECT_TRUE(contains(tty, "] 100%  frame 3/3")) << tty;
+    EXPECT_TRUE(contains(tty, "ETA")) << tty;
+    EXPECT_TRUE(contains(tty, "Mrays/s")) << tty;
+    EXPECT_TRUE(contains(tty, "done: 3 frames: 3 rendered")) << tty;
+    EXPECT_FALSE(contains(tty, "Progress: ")) << "lines mode on a terminal\n" << tty;
+}
+
 TEST_F(BatchCliTest, ConcurrentSlurmShardsRenderEachFrameOnceAndMatchOneProcess) {
     ASSERT_EQ(run_octray({"render", "shot.json", "-o", "single/s.####.exr"}, dir_).status, 4)
         << "the directory does not exist yet: refused";
