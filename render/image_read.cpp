@@ -190,30 +190,43 @@ void check_pixel_data_fits(const std::string& path, const Imf::Header& header, l
                    ")");
 }
 
+// The data window's width and height, after the checks both EXR readers need before they
+// allocate: a non-empty window, channels that exist and are not subsampled, a sample count
+// under max_float_values, and pixel data the file's size can hold.
+std::pair<long long, long long> checked_data_window(const std::string& path,
+                                                    const Imf::Header& header) {
+    const Imath::Box2i window = header.dataWindow();
+    const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
+    const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
+    if (w <= 0 || h <= 0) fail(path, "OpenEXR file has an empty data window");
+    unsigned long long channels = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+            fail(path, std::string("OpenEXR channel '") + it.name() +
+                           "' is subsampled, which octray does not support");
+        ++channels;
+    }
+    if (channels == 0) fail(path, "OpenEXR file has no channels");
+    if (static_cast<unsigned long long>(w) * static_cast<unsigned long long>(h) * channels >
+        max_float_values)
+        fail(path, "image too large");
+    check_pixel_data_fits(path, header, w, h);
+    return {w, h};
+}
+
 ChannelImage read_exr_file(const std::string& path) {
     try {
         Imf::InputFile file(path.c_str());
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
-        const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
-        const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
-        if (w <= 0 || h <= 0) fail(path, "OpenEXR file has an empty data window");
+        const auto [w, h] = checked_data_window(path, header);
 
         std::vector<std::string> names;
         std::set<Imf::PixelType> types;
         for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-            if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
-                fail(path, std::string("OpenEXR channel '") + it.name() +
-                               "' is subsampled, which compare does not support");
             names.emplace_back(it.name());
             types.insert(it.channel().type);
         }
-        if (names.empty()) fail(path, "OpenEXR file has no channels");
-        if (static_cast<unsigned long long>(w) * static_cast<unsigned long long>(h) *
-                names.size() >
-            max_float_values)
-            fail(path, "image too large to compare");
-        check_pixel_data_fits(path, header, w, h);
         std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
             return exr_channel_key(a) < exr_channel_key(b);
         });
@@ -306,28 +319,13 @@ ExrImage read_exr_image_file(const std::string& path) {
         Imf::InputFile file(path.c_str());
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
-        const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
-        const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
-        if (w <= 0 || h <= 0) fail(path, "OpenEXR file has an empty data window");
+        const auto [w, h] = checked_data_window(path, header);
         const Imath::Box2i display = header.displayWindow();
         if (static_cast<long long>(display.max.x) < display.min.x ||
             static_cast<long long>(display.max.y) < display.min.y)
             fail(path, "OpenEXR file has an empty display window");
 
         ExrImage image;
-        std::size_t channels = 0;
-        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-            if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
-                fail(path, std::string("OpenEXR channel '") + it.name() +
-                               "' is subsampled, which is not supported");
-            ++channels;
-        }
-        if (channels == 0) fail(path, "OpenEXR file has no channels");
-        if (static_cast<unsigned long long>(w) * static_cast<unsigned long long>(h) *
-                channels > max_float_values)
-            fail(path, "image too large");
-        check_pixel_data_fits(path, header, w, h);
-
         image.display_window = from_box(display);
         image.data_window = from_box(window);
         image.compression = from_imf(header.compression());

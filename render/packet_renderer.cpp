@@ -164,9 +164,8 @@ struct RenderTarget {
     Image& image;
     PixelRect rect;        // the pixels `image` holds; tiles lie inside it
     SampleRange samples;   // [0, spp) for a plain render
-    bool partial = false;  // a progressive pass: start from start_sums, write sums
     const Image* start_sums = nullptr;  // sums of samples [0, samples.begin) or nullptr
-    Image* sums = nullptr;
+    Image* sums = nullptr;              // a progressive pass: where the new sums go
 };
 
 // Pixel blocks of 4 x 2 inside a tile: eight neighbouring pixels fill one packet at one
@@ -318,8 +317,8 @@ class PacketTracer {
             }
         }
 
-        // The mean of the samples (of the samples so far, for a progressive pass).
-        const auto inv = static_cast<float>(target.partial ? end_sample : spp);
+        // The mean of the samples so far: all spp of them, unless a progressive pass.
+        const auto inv = static_cast<float>(end_sample);
         for (int y = 0; y < tile.height; ++y)
             for (int x = 0; x < tile.width; ++x) {
                 const std::size_t p = static_cast<std::size_t>(y) * tile.width + x;
@@ -342,21 +341,9 @@ class PacketTracer {
 RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options, Isa isa) {
     const auto start = std::chrono::steady_clock::now();
     const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
-    // The spheres' BVH (options.accel), built on the render's threads and timed with it.
-    SphereBvh bvh;
-    const bool use_bvh = accel_uses_bvh(options.accel, scene.spheres.count);
-    if (use_bvh) {
-        const auto build = [&] { bvh = build_sphere_bvh(scene.spheres); };
-        if (options.threads > 0)
-            tbb::task_arena(options.threads).execute(build);
-        else
-            build();
-    }
-    const PacketTracer tracer(scene, table, options.frame, use_bvh ? &bvh : nullptr);
-
     RenderResult result;
-    // The crop and the sample range (render/crop.h). Tiles are laid from the crop's corner;
-    // a pixel's value depends on neither.
+    // The crop and the sample range (render/crop.h), checked before any work. Tiles are
+    // laid from the crop's corner; a pixel's value depends on neither.
     const PixelRect rect = render_rect(options, scene.width, scene.height);
     const SampleRange sample_range = render_sample_range(options, scene.spp, rect);
     result.rect = rect;
@@ -367,7 +354,6 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     RenderTarget target{result.image, rect, sample_range};
     if (options.samples) {
         result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});
-        target.partial = true;
         target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
         target.sums = &result.sample_sums;
     }
@@ -376,7 +362,12 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     tbb::enumerable_thread_specific<TileScratch> scratch;
     std::atomic<bool> cancelled{false};  // a tile was skipped because of options.cancel
 
+    // The spheres' BVH (options.accel), built on the render's threads and timed with it.
+    SphereBvh bvh;
+    const bool use_bvh = accel_uses_bvh(options.accel, scene.spheres.count);
     const auto render_tiles = [&] {
+        if (use_bvh) bvh = build_sphere_bvh(scene.spheres);
+        const PacketTracer tracer(scene, table, options.frame, use_bvh ? &bvh : nullptr);
         tbb::parallel_for(
             tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
             [&](const tbb::blocked_range<int>& range) {

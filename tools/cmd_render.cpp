@@ -306,8 +306,9 @@ void run_render(const RenderArguments& args) {
     for (BatchScene& scene : scenes) {
         if (!args.crop.empty()) {
             try {
-                scene.crop = batch::parse_crop(args.crop, scene.scene.image.width,
-                                               scene.scene.image.height);
+                const batch::CropRect c = batch::parse_crop(args.crop, scene.scene.image.width,
+                                                            scene.scene.image.height);
+                scene.crop = PixelRect{c.x0, c.y0, c.x1, c.y1};
             } catch (const batch::SpecError& e) {
                 throw UsageError("--crop for " + scene.spec + ": " + e.what());
             }

@@ -120,6 +120,13 @@ void release_claim(const std::string& path) {
         fs::remove(path, error);
 }
 
+// A frame's work for the progress bar: the pixel samples it traces.
+std::uint64_t frame_work(const BatchScene& scene) {
+    const ImageSettings& image = scene.scene.image;
+    const PixelRect rect = scene.crop.value_or(PixelRect{0, 0, image.width, image.height});
+    return rect.pixel_count() * static_cast<std::uint64_t>(image.spp);
+}
+
 class BatchRunner {
   public:
     BatchRunner(const std::vector<BatchScene>& scenes, const BatchSettings& settings,
@@ -129,7 +136,6 @@ class BatchRunner {
     FrameResult run(std::size_t index, const BatchJob& job);
 
   private:
-    std::uint64_t frame_work(const BatchScene& scene) const;
     ExrAttributes attributes(const BatchScene& scene, const Scene& posed, int frame,
                              const RenderResult& result, int samples_so_far) const;
     void write_outputs(const BatchScene& scene, const BatchJob& job, const Scene& posed,
@@ -140,16 +146,6 @@ class BatchRunner {
     const BatchSettings& settings_;
     ProgressReporter& progress_;
 };
-
-std::uint64_t BatchRunner::frame_work(const BatchScene& scene) const {
-    const Scene& s = scene.scene;
-    std::uint64_t pixels =
-        static_cast<std::uint64_t>(s.image.width) * static_cast<std::uint64_t>(s.image.height);
-    if (scene.crop)
-        pixels = static_cast<std::uint64_t>(scene.crop->x1 - scene.crop->x0) *
-                 static_cast<std::uint64_t>(scene.crop->y1 - scene.crop->y0);
-    return pixels * static_cast<std::uint64_t>(s.image.spp);
-}
 
 ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
                                       const RenderResult& result, int samples_so_far) const {
@@ -213,35 +209,26 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
     out.report.preview = job.png;
     const std::uint64_t work = frame_work(scene);
 
+    const auto skip = [&](FrameOutcome outcome) {
+        out.report.outcome = outcome;
+        progress_.frame_finished(out.report, work);
+        return out;
+    };
     // Resume and claims.
+    Existing existing = Existing::none;
     if (settings_.skip_existing || settings_.placeholders) {
-        const Existing existing = existing_output(job.output);
-        if (existing == Existing::finished) {
-            out.report.outcome = FrameOutcome::skipped_existing;
-            progress_.frame_finished(out.report, work);
-            return out;
-        }
-        if (existing == Existing::claim) {
-            out.report.outcome = FrameOutcome::skipped_claimed;
-            progress_.frame_finished(out.report, work);
-            return out;
-        }
+        existing = existing_output(job.output);
+        if (existing == Existing::finished) return skip(FrameOutcome::skipped_existing);
+        if (existing == Existing::claim) return skip(FrameOutcome::skipped_claimed);
     }
     bool claimed = false;
     const auto started = Clock::now();
     try {
-        if (settings_.placeholders) {
-            // An unfinished progressive image is ours to replace: claim by truncating it
-            // would race, so only a missing file is claimed; an existing one is rendered
-            // over (it was not a claim).
-            if (!fs::exists(job.output)) {
-                if (!claim(job.output)) {
-                    out.report.outcome = FrameOutcome::skipped_claimed;
-                    progress_.frame_finished(out.report, work);
-                    return out;
-                }
-                claimed = true;
-            }
+        // Only a missing output is claimed (O_EXCL: one run wins). An unfinished
+        // --progressive image is not a claim: it is rendered over.
+        if (settings_.placeholders && existing == Existing::none) {
+            if (!claim(job.output)) return skip(FrameOutcome::skipped_claimed);
+            claimed = true;
         }
         remove_stale_temporaries(job.output);
         progress_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
@@ -251,9 +238,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         options.frame = static_cast<std::uint32_t>(job.frame);
         options.cancel = &InterruptGuard::flag();
         options.pixels_done = &progress_.pixel_counter();
-        if (scene.crop)
-            options.crop =
-                PixelRect{scene.crop->x0, scene.crop->y0, scene.crop->x1, scene.crop->y1};
+        options.crop = scene.crop;
         const AovImages aovs = compute_aovs(posed, options, settings_.aovs);
 
         RenderResult result;
@@ -361,15 +346,7 @@ int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>
         print_header(scenes, jobs, settings);
 
     std::uint64_t total_work = 0;
-    for (const BatchJob& job : jobs) {
-        const Scene& s = scenes[job.scene].scene;
-        const auto& crop = scenes[job.scene].crop;
-        const std::uint64_t pixels = crop ? static_cast<std::uint64_t>(crop->x1 - crop->x0) *
-                                                static_cast<std::uint64_t>(crop->y1 - crop->y0)
-                                          : static_cast<std::uint64_t>(s.image.width) *
-                                                static_cast<std::uint64_t>(s.image.height);
-        total_work += pixels * static_cast<std::uint64_t>(s.image.spp);
-    }
+    for (const BatchJob& job : jobs) total_work += frame_work(scenes[job.scene]);
 
     InterruptGuard interrupt;
     ProgressReporter progress(settings.progress, jobs.size(), total_work);

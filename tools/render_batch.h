@@ -26,7 +26,7 @@ struct BatchScene {
     std::string name;    // {scene} in output patterns
     std::string sha256;  // octray.sceneSha256
     Scene scene;         // loaded, overrides applied, validated
-    std::optional<batch::CropRect> crop;
+    std::optional<PixelRect> crop;  // --crop, checked against the image
 };
 
 struct BatchJob {

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages octray needs to build, test and benchmark. Idempotent:
 # it asks dpkg first and only runs apt-get when something is missing, so it is cheap to
-# call before every build. Uses sudo only when not already root.
+# call before every build. Uses sudo only when not already root. clang and its runtime
+# build the asan preset (ASan, UBSan, libFuzzer); dpkg-dev and xz-utils let
+# tests/tsan/build_tbb.sh fetch and unpack oneTBB's Debian source.
 set -euo pipefail
 
 packages=(
     cmake ninja-build g++ pkg-config
     clang libclang-rt-14-dev
+    dpkg-dev xz-utils
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
     libpng-dev libembree-dev
