@@ -5,7 +5,6 @@
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
 
 #include <array>
 #include <limits>
@@ -13,6 +12,7 @@
 #include <utility>
 
 #include "render/crop.h"
+#include "render/parallel.h"
 #include "render/reference.h"
 
 namespace octray {
@@ -111,12 +111,7 @@ AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet 
                 }
         });
     };
-    if (options.threads > 0) {
-        tbb::task_arena arena(options.threads);
-        arena.execute(compute_rows);
-    } else {
-        compute_rows();
-    }
+    run_with_threads(options.threads, compute_rows);
     return out;
 }
 

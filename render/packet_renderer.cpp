@@ -7,10 +7,8 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/enumerable_thread_specific.h>
 #include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <utility>
@@ -20,6 +18,7 @@
 #include "core/random.h"
 #include "kernels/dispatch.h"
 #include "render/crop.h"
+#include "render/parallel.h"
 #include "scene/bvh.h"
 #include "scene/camera.h"
 
@@ -360,7 +359,7 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
     const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
     tbb::enumerable_thread_specific<TileScratch> scratch;
-    std::atomic<bool> cancelled{false};  // a tile was skipped because of options.cancel
+    TileControl control(options);
 
     // The spheres' BVH (options.accel), built on the render's threads and timed with it.
     SphereBvh bvh;
@@ -373,32 +372,20 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
             [&](const tbb::blocked_range<int>& range) {
                 TileScratch& s = scratch.local();
                 for (int t = range.begin(); t < range.end(); ++t) {
-                    if (options.cancel != nullptr &&
-                        options.cancel->load(std::memory_order_relaxed)) {
-                        cancelled.store(true, std::memory_order_relaxed);
-                        return;
-                    }
+                    if (!control.proceed()) return;
                     const int x0 = rect.x0 + (t % tiles_x) * tw;
                     const int y0 = rect.y0 + (t / tiles_x) * th;
                     const Tile tile{x0, y0, std::min(tw, rect.x1 - x0),
                                     std::min(th, rect.y1 - y0)};
                     tracer.render_tile(tile, s, target);
-                    if (options.pixels_done != nullptr)
-                        options.pixels_done->fetch_add(
-                            static_cast<std::uint64_t>(tile.width) *
-                                static_cast<std::uint64_t>(tile.height),
-                            std::memory_order_relaxed);
+                    control.done(static_cast<std::uint64_t>(tile.width) *
+                                 static_cast<std::uint64_t>(tile.height));
                 }
             },
             tbb::simple_partitioner());
     };
-    if (options.threads > 0) {
-        tbb::task_arena arena(options.threads);
-        arena.execute(render_tiles);
-    } else {
-        render_tiles();
-    }
-    if (cancelled.load()) throw RenderCancelled();
+    run_with_threads(options.threads, render_tiles);
+    control.finish();
     for (const TileScratch& s : scratch) result.rays += s.counts;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -6,16 +6,15 @@
 #include <oneapi/tbb/blocked_range2d.h>
 #include <oneapi/tbb/combinable.h>
 #include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <numbers>
 
 #include "core/random.h"
 #include "render/crop.h"
+#include "render/parallel.h"
 
 namespace octray {
 namespace {
@@ -298,7 +297,7 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
     if (partial_samples)
         result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});
     tbb::combinable<RayCounts> counts;
-    std::atomic<bool> cancelled{false};  // a tile was skipped because of options.cancel
+    TileControl control(options);
 
     const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
     const auto render_tiles = [&] {
@@ -306,10 +305,7 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
         tbb::parallel_for(
             tbb::blocked_range2d<int>(rect.y0, rect.y1, th, rect.x0, rect.x1, tw),
             [&](const tbb::blocked_range2d<int>& tile) {
-                if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
-                    cancelled.store(true, std::memory_order_relaxed);
-                    return;
-                }
+                if (!control.proceed()) return;
                 RayCounts& local = counts.local();
                 for (int j = tile.rows().begin(); j < tile.rows().end(); ++j)
                     for (int i = tile.cols().begin(); i < tile.cols().end(); ++i) {
@@ -326,20 +322,13 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
                         result.sample_sums.at(x, y) = sum;
                         result.image.at(x, y) = sum / static_cast<float>(samples.end);
                     }
-                if (options.pixels_done != nullptr)
-                    options.pixels_done->fetch_add(
-                        static_cast<std::uint64_t>(tile.rows().size()) * tile.cols().size(),
-                        std::memory_order_relaxed);
+                control.done(static_cast<std::uint64_t>(tile.rows().size()) *
+                             tile.cols().size());
             },
             tbb::simple_partitioner());
     };
-    if (options.threads > 0) {
-        tbb::task_arena arena(options.threads);
-        arena.execute(render_tiles);
-    } else {
-        render_tiles();
-    }
-    if (cancelled.load()) throw RenderCancelled();
+    run_with_threads(options.threads, render_tiles);
+    control.finish();
     counts.combine_each([&](const RayCounts& c) { result.rays += c; });
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
