@@ -509,7 +509,8 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         "go on. Ctrl-C (or SIGTERM) stops after abandoning the frame in progress; a second\n"
         "one kills at once.\n\n"
         "The EXR carries software, capDate, utcOffset, samplesPerPixel, framesPerSecond,\n"
-        "worldToCamera, worldToNDC, renderTimeSeconds, and octray.scene, octray.sceneSha256,\n"
+        "worldToCamera, worldToNDC (not for a fisheye), renderTimeSeconds, and octray.scene,\n"
+        "octray.sceneSha256, "
         "octray.frame, octray.time, octray.path, octray.seed, octray.maxDepth,\n"
         "octray.rays.{primary,shadow,reflected,refracted,total}.\n\n" +
         exit_code_help() +
