@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <new>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -13,9 +14,12 @@
 namespace octray {
 
 // std::allocator, except that a value-less construct() leaves the element's bytes alone:
-// a vector of trivially copyable pixels can then be sized without writing them.
+// a vector of trivially copyable pixels can then be sized without writing them. Storage
+// starts on a cache line, so whole rows of pixels can be streamed to memory
+// (render/packet_renderer.cpp).
 template <class T>
 struct UninitializedAllocator : std::allocator<T> {
+    static constexpr std::align_val_t kAlignment{64};
     template <class U>
     struct rebind {
         using other = UninitializedAllocator<U>;
@@ -23,6 +27,14 @@ struct UninitializedAllocator : std::allocator<T> {
     UninitializedAllocator() = default;
     template <class U>
     UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+
+    T* allocate(std::size_t n) {
+        if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+        return static_cast<T*>(::operator new(n * sizeof(T), kAlignment));
+    }
+    void deallocate(T* p, std::size_t n) noexcept {
+        ::operator delete(p, n * sizeof(T), kAlignment);
+    }
 
     template <class U>
     void construct(U*) noexcept {

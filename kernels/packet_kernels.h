@@ -24,6 +24,7 @@
 #include <math.h>
 
 #include <cstdint>
+#include <type_traits>
 #include <xsimd/xsimd.hpp>
 
 #include "kernels/kernel_types.h"
@@ -129,13 +130,25 @@ struct LaneIndex {
     bool uniform;
 };
 
-// base[index[i]] per lane.
+// base[index[i]] per lane, as float (T: float, or a small unsigned count or flag). AVX2
+// gathers in one instruction; SSE builds the register from four scalar loads. Neither
+// writes lanes to memory to load them back as a whole register (a store-forwarding stall).
 template <class F, class T>
 F gather(const T* base, const LaneIndex& ix) {
     if (ix.uniform) return F(static_cast<float>(base[ix.index[0]]));
-    alignas(64) float lanes[F::size];
-    for (std::size_t i = 0; i < F::size; ++i) lanes[i] = static_cast<float>(base[ix.index[i]]);
-    return F::load_aligned(lanes);
+    if constexpr (F::size == 8) {
+        const __m256i index = _mm256_load_si256(reinterpret_cast<const __m256i*>(ix.index));
+        if constexpr (std::is_same_v<T, float>)
+            return _mm256_i32gather_ps(base, index, 4);
+        else
+            return _mm256_cvtepi32_ps(
+                _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), index, 4));
+    } else {
+        static_assert(F::size == 4);
+        return _mm_setr_ps(
+            static_cast<float>(base[ix.index[0]]), static_cast<float>(base[ix.index[1]]),
+            static_cast<float>(base[ix.index[2]]), static_cast<float>(base[ix.index[3]]));
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -159,8 +172,10 @@ alignas(64) inline constexpr CompressTable kCompressTable = make_compress_table(
 
 template <class F>
 struct Compaction {
-    alignas(32) std::int32_t lanes[8];  // the selected lanes first; the rest are 0
-    std::uint32_t count;
+    std::uint32_t bits;   // bit i: lane i is selected
+    std::uint32_t count;  // selected lanes
+    // The selected lanes in order, then zeros (kCompressTable's row for `bits`).
+    const std::uint8_t* lanes() const { return kCompressTable.lanes[bits]; }
 };
 
 // Bit i set when lane i of the mask is (movmskps).
@@ -176,10 +191,16 @@ std::uint32_t mask_bits(const M& m) {
 template <class F, class M>
 Compaction<F> compaction(const M& m) {
     const std::uint32_t bits = mask_bits<F>(m);
-    Compaction<F> c;
-    for (int i = 0; i < 8; ++i) c.lanes[i] = kCompressTable.lanes[bits][i];
-    c.count = static_cast<std::uint32_t>(__builtin_popcount(bits));
-    return c;
+    return {bits, static_cast<std::uint32_t>(__builtin_popcount(bits))};
+}
+
+// The permutation that packs a compaction's lanes to the front, widened from the byte
+// table straight into a register (no store and reload of a lane array in between).
+template <class F>
+__m256i compaction_index(std::uint32_t bits) {
+    static_assert(F::size == 8, "AVX2 only");
+    return _mm256_cvtepu8_epi32(
+        _mm_loadl_epi64(reinterpret_cast<const __m128i*>(kCompressTable.lanes[bits])));
 }
 
 // Writes the selected lanes of v to dst[0, count); with AVX2 also scribbles on
@@ -187,12 +208,12 @@ Compaction<F> compaction(const M& m) {
 template <class F>
 void store_compacted(const Compaction<F>& c, const F& v, float* dst) {
     if constexpr (F::size == 8) {
-        const __m256i index = _mm256_load_si256(reinterpret_cast<const __m256i*>(c.lanes));
-        _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(v, index));
+        _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(v, compaction_index<F>(c.bits)));
     } else {
         alignas(64) float lanes[F::size];
         v.store_aligned(lanes);
-        for (std::uint32_t k = 0; k < c.count; ++k) dst[k] = lanes[c.lanes[k]];
+        const std::uint8_t* selected = c.lanes();
+        for (std::uint32_t k = 0; k < c.count; ++k) dst[k] = lanes[selected[k]];
     }
 }
 template <class F>
@@ -202,12 +223,31 @@ void store_compacted(const Compaction<F>& c, const V3<F>& v, float* x, float* y,
     store_compacted(c, v.y, y + at);
     store_compacted(c, v.z, z + at);
 }
-// base + lane for each selected lane, times `scale`, plus `offset`.
+// base + lane for each selected lane, times `scale`, plus `offset`; with AVX2 also
+// scribbles on dst[count, 8).
 template <class F>
 void store_compacted_slots(const Compaction<F>& c, std::uint32_t base, std::uint32_t scale,
                            std::uint32_t offset, std::uint32_t* dst) {
-    for (std::uint32_t k = 0; k < c.count; ++k)
-        dst[k] = (base + static_cast<std::uint32_t>(c.lanes[k])) * scale + offset;
+    if constexpr (F::size == 8) {
+        const __m256i lane = compaction_index<F>(c.bits);
+        const __m256i slot = _mm256_add_epi32(
+            _mm256_mullo_epi32(_mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(base)), lane),
+                               _mm256_set1_epi32(static_cast<int>(scale))),
+            _mm256_set1_epi32(static_cast<int>(offset)));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst), slot);
+    } else {
+        const std::uint8_t* selected = c.lanes();
+        for (std::uint32_t k = 0; k < c.count; ++k) dst[k] = (base + selected[k]) * scale + offset;
+    }
+}
+// `value` in dst[0, count); with AVX2 also scribbles on dst[count, 8).
+template <class F>
+void store_count(const Compaction<F>& c, float value, float* dst) {
+    if constexpr (F::size == 8) {
+        _mm256_storeu_ps(dst, _mm256_set1_ps(value));
+    } else {
+        for (std::uint32_t k = 0; k < c.count; ++k) dst[k] = value;
+    }
 }
 
 // Parity of floor(x) as 0 or 1 (reference: floor_parity): f - 2 floor(f / 2).
@@ -508,23 +548,21 @@ ShadeCounts shade(const SceneView& s, const ShadeInput& in, const ShadeOutput& o
         const std::uint32_t lanes = in.count - base < W ? in.count - base : W;
         // Lanes that missed (or are dead) read the first hit lane's object: always a valid
         // entry, and a coherent packet stays uniform.
+        using I = xsimd::batch<std::int32_t, Arch>;
+        alignas(64) static constexpr std::int32_t kLane[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+        const auto live = I::load_aligned(kLane) < I(static_cast<std::int32_t>(lanes));
+        const I raw_id = xsimd::select(live, I::load_aligned(in.hits.object + base), I(kNoHit));
+        const M hit = xsimd::to_float(raw_id) >= zero;
+        const std::uint32_t hit_bits = mask_bits<F>(hit);
+        const bool all_hit = hit_bits == (1u << W) - 1;
         LaneIndex ids;
-        alignas(64) float hit_flags[W];
-        std::int32_t first_hit = kNoHit;
-        bool all_hit = true;
-        for (std::uint32_t i = 0; i < W; ++i) {
-            const std::int32_t id = i < lanes ? in.hits.object[base + i] : kNoHit;
-            hit_flags[i] = id >= 0 ? 1.0f : 0.0f;
-            all_hit = all_hit && id >= 0;
-            if (first_hit < 0) first_hit = id;
-            ids.index[i] = id;
+        I id = raw_id;
+        if (hit_bits != 0 && !all_hit) {
+            raw_id.store_aligned(ids.index);
+            id = xsimd::select(raw_id >= I(0), raw_id, I(ids.index[__builtin_ctz(hit_bits)]));
         }
-        ids.uniform = true;
-        for (std::uint32_t i = 0; i < W; ++i) {
-            if (ids.index[i] < 0) ids.index[i] = first_hit < 0 ? 0 : first_hit;
-            ids.uniform = ids.uniform && ids.index[i] == ids.index[0];
-        }
-        const M hit = F::load_aligned(hit_flags) != zero;
+        id.store_aligned(ids.index);
+        ids.uniform = xsimd::all(id == I(ids.index[0]));
         const V3<F> o = load3<F>(rays.ox, rays.oy, rays.oz, base);
         const V3<F> d = load3<F>(rays.dx, rays.dy, rays.dz, base);
         const V3<F> weight = load3<F>(rays.wr, rays.wg, rays.wb, base);
@@ -558,9 +596,9 @@ ShadeCounts shade(const SceneView& s, const ShadeInput& in, const ShadeOutput& o
 
         // Material.
         LaneIndex mats;
-        for (std::uint32_t i = 0; i < W; ++i)
-            mats.index[i] = static_cast<std::int32_t>(s.object_material[ids.index[i]]);
         mats.uniform = ids.uniform;
+        for (std::uint32_t i = 0; i < (ids.uniform ? 1 : W); ++i)
+            mats.index[i] = static_cast<std::int32_t>(s.object_material[ids.index[i]]);
         V3<F> cd{gather<F>(s.mat_cd_r, mats), gather<F>(s.mat_cd_g, mats),
                  gather<F>(s.mat_cd_b, mats)};
         const F kd = gather<F>(s.mat_kd, mats), ks = gather<F>(s.mat_ks, mats);
@@ -620,19 +658,17 @@ ShadeCounts shade(const SceneView& s, const ShadeInput& in, const ShadeOutput& o
             // powf per lane, only where it can be non-zero: lit, ks != 0 and the base above
             // the material's pow_zero_below (where powf itself returns 0; scene/compile.h).
             const M needs_pow = lit && ks != zero && clamped > pow_zero;
-            alignas(64) float highlight[W] = {};
-            if (xsimd::any(needs_pow)) {
-                alignas(64) float pow_flags[W], base_pow[W], exps[W], kss[W];
-                mask_to_flags<F>(needs_pow, pow_flags);
+            F h = zero;
+            if (const std::uint32_t pow_bits = mask_bits<F>(needs_pow); pow_bits != 0) {
+                alignas(64) float highlight[W] = {}, base_pow[W], exps[W], kss[W];
                 clamped.store_aligned(base_pow);
                 shininess.store_aligned(exps);
                 ks.store_aligned(kss);
                 for (std::uint32_t i = 0; i < W; ++i)
-                    if (pow_flags[i] != 0.0f)
-                        highlight[i] = kss[i] * powf(base_pow[i], exps[i]);
+                    if ((pow_bits >> i) & 1u) highlight[i] = kss[i] * powf(base_pow[i], exps[i]);
+                h = F::load_aligned(highlight);
             }
             // radiance * (Cd * (kd * N.l) + highlight)
-            const F h = F::load_aligned(highlight);
             const V3<F> term = hadamard(radiance, add(mul(cd, kd * n_dot_l), V3<F>{h, h, h}));
 
             // Compact the lit lanes into the shadow stream.
@@ -642,24 +678,29 @@ ShadeCounts shade(const SceneView& s, const ShadeInput& in, const ShadeOutput& o
             store_compacted(lit_lanes, shadow_origin, sh.ox, sh.oy, sh.oz, at);
             store_compacted(lit_lanes, shadow_dir, sh.dx, sh.dy, sh.dz, at);
             store_compacted(lit_lanes, term, sh.term_r, sh.term_g, sh.term_b, at);
-            for (std::uint32_t i = 0; i < lit_lanes.count; ++i) sh.t_max[at + i] = shadow_t_max;
+            store_count(lit_lanes, shadow_t_max, sh.t_max + at);
             store_compacted_slots(lit_lanes, base, 1, 0, sh.parent + at);
             counts.shadow += lit_lanes.count;
         }
 
         // Refraction first (Snell with the unflipped normal: entering when V.N < 0); total
         // internal reflection moves kt onto the mirror ray.
+        // Most packets hold no glass: skip the whole block then.
         const M has_refraction = hit && kt > zero;
-        const F cos_i = dot(v_hat, normal);
-        const M entering = cos_i < zero;
-        const F eta = xsimd::select(entering, one / ior, ior);
-        const V3<F> nt = select(entering, normal, neg(normal));
-        const F c = xsimd::select(entering, -cos_i, cos_i);
-        const F k = one - eta * eta * (one - c * c);
-        const M tir = has_refraction && k < zero;
-        kr = select(tir, add(kr, V3<F>{kt, kt, kt}), kr);
-        const M refracts = has_refraction && !(k < zero);
-        const V3<F> refracted = add(mul(v_hat, eta), mul(nt, eta * c - xsimd::sqrt(k)));
+        M refracts = has_refraction;  // all false unless some lane refracts
+        V3<F> refracted{zero, zero, zero};
+        if (xsimd::any(has_refraction)) {
+            const F cos_i = dot(v_hat, normal);
+            const M entering = cos_i < zero;
+            const F eta = xsimd::select(entering, one / ior, ior);
+            const V3<F> nt = select(entering, normal, neg(normal));
+            const F c = xsimd::select(entering, -cos_i, cos_i);
+            const F k = one - eta * eta * (one - c * c);
+            const M tir = has_refraction && k < zero;
+            kr = select(tir, add(kr, V3<F>{kt, kt, kt}), kr);
+            refracts = has_refraction && !(k < zero);
+            refracted = add(mul(v_hat, eta), mul(nt, eta * c - xsimd::sqrt(k)));
+        }
 
         // Mirror ray: R = V - 2(N.V)N with the unflipped normal.
         const M reflects = hit && max_component(kr) > zero;

@@ -14,6 +14,10 @@
 #include <utility>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "core/aligned.h"
 #include "core/random.h"
 #include "kernels/dispatch.h"
@@ -140,17 +144,58 @@ void resolve_into_parents(const kernels::SurfaceColor& c, const kernels::ChildLi
         const float cr = (c.local_r[r] + c.tail_reflect_r[r]) + c.tail_refract_r[r];
         const float cg = (c.local_g[r] + c.tail_reflect_g[r]) + c.tail_refract_g[r];
         const float cb = (c.local_b[r] + c.tail_reflect_b[r]) + c.tail_refract_b[r];
+        // Mirror and refracted children are mixed in a stream: pick the tail by pointer,
+        // not by a branch the CPU would mispredict.
         const std::uint32_t slot = links.parent[r] >> 1;
-        if ((links.parent[r] & 1u) != 0) {
-            up.tail_refract_r[slot] = links.factor_r[r] * cr;
-            up.tail_refract_g[slot] = links.factor_g[r] * cg;
-            up.tail_refract_b[slot] = links.factor_b[r] * cb;
-        } else {
-            up.tail_reflect_r[slot] = links.factor_r[r] * cr;
-            up.tail_reflect_g[slot] = links.factor_g[r] * cg;
-            up.tail_reflect_b[slot] = links.factor_b[r] * cb;
-        }
+        const bool refracted = (links.parent[r] & 1u) != 0;
+        (refracted ? up.tail_refract_r : up.tail_reflect_r)[slot] = links.factor_r[r] * cr;
+        (refracted ? up.tail_refract_g : up.tail_reflect_g)[slot] = links.factor_g[r] * cg;
+        (refracted ? up.tail_refract_b : up.tail_reflect_b)[slot] = links.factor_b[r] * cb;
     }
+}
+
+// Writes n pixels (r, g, b) / *divisor, or as they are when divisor is null (x / 1 == x).
+// A frame's image is far larger than the caches and each pixel is written once: with SSE2
+// the aligned groups of four pixels go straight to memory (non-temporal stores), so the
+// CPU does not first read every line of the image only to overwrite it. Division is
+// IEEE-exact either way: the values equal the scalar r / divisor bit for bit.
+void stream_row(Rgb* out, const float* r, const float* g, const float* b, int n,
+                const float* divisor) {
+    int x = 0;
+#if defined(__SSE2__)
+    const auto scalar_until = [&](int end) {
+        for (; x < end; ++x)
+            out[x] = divisor ? Rgb(r[x], g[x], b[x]) / *divisor : Rgb(r[x], g[x], b[x]);
+    };
+    // Four pixels are 48 bytes: aligned groups start where the address is 16-aligned.
+    while (x < n && (reinterpret_cast<std::uintptr_t>(out + x) & 15u) != 0) scalar_until(x + 1);
+    const __m128 d = _mm_set1_ps(divisor ? *divisor : 1.0f);
+    for (; x + 4 <= n; x += 4) {
+        __m128 vr = _mm_loadu_ps(r + x), vg = _mm_loadu_ps(g + x), vb = _mm_loadu_ps(b + x);
+        if (divisor) vr = _mm_div_ps(vr, d), vg = _mm_div_ps(vg, d), vb = _mm_div_ps(vb, d);
+        // (r0 g0 b0 r1) (g1 b1 r2 g2) (b2 r3 g3 b3)
+        const __m128 rg_lo = _mm_unpacklo_ps(vr, vg), rg_hi = _mm_unpackhi_ps(vr, vg);
+        const __m128 b0r1 = _mm_shuffle_ps(vb, vr, _MM_SHUFFLE(1, 1, 0, 0));
+        const __m128 g1b1 = _mm_shuffle_ps(vg, vb, _MM_SHUFFLE(1, 1, 1, 1));
+        const __m128 b2r3 = _mm_shuffle_ps(vb, vr, _MM_SHUFFLE(3, 3, 2, 2));
+        const __m128 g3b3 = _mm_shuffle_ps(vg, vb, _MM_SHUFFLE(3, 3, 3, 3));
+        float* dst = &out[x].r;
+        _mm_stream_ps(dst, _mm_shuffle_ps(rg_lo, b0r1, _MM_SHUFFLE(2, 0, 1, 0)));
+        _mm_stream_ps(dst + 4, _mm_shuffle_ps(g1b1, rg_hi, _MM_SHUFFLE(1, 0, 2, 0)));
+        _mm_stream_ps(dst + 8, _mm_shuffle_ps(b2r3, g3b3, _MM_SHUFFLE(2, 0, 2, 0)));
+    }
+    scalar_until(n);
+#else
+    for (; x < n; ++x)
+        out[x] = divisor ? Rgb(r[x], g[x], b[x]) / *divisor : Rgb(r[x], g[x], b[x]);
+#endif
+}
+
+// Non-temporal stores are weakly ordered: fence them before the tile counts as written.
+void finish_streaming() {
+#if defined(__SSE2__)
+    _mm_sfence();
+#endif
 }
 
 struct Tile {
@@ -218,20 +263,28 @@ class PacketTracer {
         float *su = s.samples.lens_u.data(), *sv = s.samples.lens_v.data();
         std::uint32_t* spixel = s.samples.pixel.data();
         std::size_t n = 0;
+        const bool centers = spp == 1 && !lens;  // one sample per pixel, at its center
         for (int by = 0; by < tile.height; by += kBlockHeight)
-            for (int bx = 0; bx < tile.width; bx += kBlockWidth)
-                for (int y = by; y < std::min(by + kBlockHeight, tile.height); ++y)
-                    for (int x = bx; x < std::min(bx + kBlockWidth, tile.width); ++x) {
+            for (int bx = 0; bx < tile.width; bx += kBlockWidth) {
+                const int y_end = std::min(by + kBlockHeight, tile.height);
+                const int x_end = std::min(bx + kBlockWidth, tile.width);
+                if (centers) {
+                    for (int y = by; y < y_end; ++y) {
+                        const float fy = center_y_[static_cast<std::size_t>(tile.y0 + y)];
+                        for (int x = bx; x < x_end; ++x, ++n) {
+                            sx[n] = center_x_[static_cast<std::size_t>(tile.x0 + x)];
+                            sy[n] = fy;
+                            su[n] = sv[n] = 0.0f;
+                            spixel[n] = static_cast<std::uint32_t>(y * tile.width + x);
+                        }
+                    }
+                    continue;
+                }
+                for (int y = by; y < y_end; ++y)
+                    for (int x = bx; x < x_end; ++x) {
                         const int i = tile.x0 + x, j = tile.y0 + y;
                         const auto ui = static_cast<std::uint32_t>(i);
                         const auto uj = static_cast<std::uint32_t>(j);
-                        if (spp == 1 && !lens) {
-                            sx[n] = center_x_[static_cast<std::size_t>(i)];
-                            sy[n] = center_y_[static_cast<std::size_t>(j)];
-                            su[n] = sv[n] = 0.0f;
-                            spixel[n++] = static_cast<std::uint32_t>(y * tile.width + x);
-                            continue;
-                        }
                         for (int k = first_sample; k < end_sample; ++k, ++n) {
                             const auto sample = static_cast<std::uint32_t>(k);
                             const PixelOffset o = pixel_sample_offset(
@@ -248,6 +301,7 @@ class PacketTracer {
                             spixel[n] = static_cast<std::uint32_t>(y * tile.width + x);
                         }
                     }
+            }
         // Padding lanes: a harmless film position.
         for (std::size_t k = n; k < s.samples.x.size(); ++k) {
             s.samples.x[k] = s.samples.y[k] = s.samples.lens_u[k] = s.samples.lens_v[k] = 0.0f;
@@ -316,15 +370,21 @@ class PacketTracer {
             }
         }
 
-        // The mean of the samples so far: all spp of them, unless a progressive pass.
+        // The mean of the samples so far: all spp of them, unless a progressive pass. A
+        // sum of one sample is its own mean (x / 1 == x): no division then.
         const auto inv = static_cast<float>(end_sample);
-        for (int y = 0; y < tile.height; ++y)
-            for (int x = 0; x < tile.width; ++x) {
-                const std::size_t p = static_cast<std::size_t>(y) * tile.width + x;
-                const Rgb sum(s.acc_r[p], s.acc_g[p], s.acc_b[p]);
-                if (target.sums != nullptr) target.sums->at(ox + x, oy + y) = sum;
-                target.image.at(ox + x, oy + y) = sum / inv;
+        for (int y = 0; y < tile.height; ++y) {
+            const std::size_t row = static_cast<std::size_t>(y) * tile.width;
+            const float *r = s.acc_r.data() + row, *g = s.acc_g.data() + row,
+                        *b = s.acc_b.data() + row;
+            if (target.sums != nullptr) {
+                Rgb* sums = &target.sums->at(ox, oy + y);
+                for (int x = 0; x < tile.width; ++x) sums[x] = Rgb(r[x], g[x], b[x]);
             }
+            stream_row(&target.image.at(ox, oy + y), r, g, b, tile.width,
+                       end_sample == 1 ? nullptr : &inv);
+        }
+        finish_streaming();
     }
 
   private:
@@ -382,7 +442,7 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
                                  static_cast<std::uint64_t>(tile.height));
                 }
             },
-            tbb::simple_partitioner());
+            tbb::auto_partitioner());
     };
     run_with_threads(options.threads, render_tiles);
     control.finish();
