@@ -105,9 +105,11 @@ std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* 
                      const float* dx, const float* dy, const float* dz, const float* t_far,
                      std::uint32_t base, BvhPacket& p) {
     constexpr std::uint32_t W = F::size;
-    float box_max = 0.0f;
+    float box_max = 0.0f;  // no fmaxf: it is a libm call, not an instruction
     for (int a = 0; a < 3; ++a) {
-        box_max = fmaxf(box_max, fmaxf(fabsf(s.bvh_lo[a]), fabsf(s.bvh_hi[a])));
+        const float lo = fabsf(s.bvh_lo[a]), hi = fabsf(s.bvh_hi[a]);
+        box_max = box_max > lo ? box_max : lo;
+        box_max = box_max > hi ? box_max : hi;
     }
     std::uint32_t finite = 0;
     for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
@@ -327,17 +329,14 @@ bool bvh_occluded_ray(const SceneView& s, const BvhPacket& p, std::uint32_t lane
 // ---------------------------------------------------------------------------------------
 // Packets: the 8 rays against one child box at a time.
 
-// Lanes of `mask` whose widened box of child j meets the ray on [t_near, t_far[lane]];
-// entry of the packet's representative lane `rep` in `key`.
+// Lanes of the packet whose widened box of child j meets the ray on [t_near, t_far[lane]].
 template <class F>
-std::uint32_t packet_child_test(const BvhNode8& n, std::uint32_t j, const BvhPacket& p,
-                                const F& t_near, const float* t_far, std::uint32_t rep,
-                                float& key) {
+std::uint32_t packet_child_lanes(const BvhNode8& n, std::uint32_t j, const BvhPacket& p,
+                                 const F& t_near, const float* t_far) {
     constexpr std::uint32_t W = F::size;
     const F min_x(n.min_x[j]), max_x(n.max_x[j]), min_y(n.min_y[j]), max_y(n.max_y[j]);
     const F min_z(n.min_z[j]), max_z(n.max_z[j]);
     std::uint32_t bits = 0;
-    alignas(64) float entry[kPacketWidth];
     for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
         const F ix = F::load_aligned(p.inv_x + at), iy = F::load_aligned(p.inv_y + at),
                 iz = F::load_aligned(p.inv_z + at);
@@ -353,36 +352,73 @@ std::uint32_t packet_child_test(const BvhNode8& n, std::uint32_t j, const BvhPac
         const F tf = xsimd::min(xsimd::min(xsimd::max(ax, bx), xsimd::max(ay, by)),
                                 xsimd::min(xsimd::max(az, bz), F::load_aligned(t_far + at)));
         bits |= mask_bits<F>(tn <= tf) << at;
-        tn.store_aligned(entry + at);
     }
-    key = entry[rep];
     return bits;
 }
 
+// Where lane `rep` of the packet enters each of the 8 children (children in lanes): the
+// order in which the packet visits them. Only an order: it decides no hit.
+template <class F>
+void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep,
+                       float* key) {
+    constexpr std::uint32_t W = F::size;
+    const F ix(p.inv_x[rep]), iy(p.inv_y[rep]), iz(p.inv_z[rep]);
+    const F lo_x(p.lo_off_x[rep]), lo_y(p.lo_off_y[rep]), lo_z(p.lo_off_z[rep]);
+    const F hi_x(p.hi_off_x[rep]), hi_y(p.hi_off_y[rep]), hi_z(p.hi_off_z[rep]);
+    for (std::uint32_t at = 0; at < kBvhWidth; at += W) {
+        const F ax = xsimd::fms(F::load_aligned(n.min_x + at), ix, lo_x);
+        const F bx = xsimd::fms(F::load_aligned(n.max_x + at), ix, hi_x);
+        const F ay = xsimd::fms(F::load_aligned(n.min_y + at), iy, lo_y);
+        const F by = xsimd::fms(F::load_aligned(n.max_y + at), iy, hi_y);
+        const F az = xsimd::fms(F::load_aligned(n.min_z + at), iz, lo_z);
+        const F bz = xsimd::fms(F::load_aligned(n.max_z + at), iz, hi_z);
+        const F entry =
+            xsimd::max(xsimd::max(xsimd::min(ax, bx), xsimd::min(ay, by)), xsimd::min(az, bz));
+        // Ranks need a total order: a NaN (never expected) sorts as the farthest.
+        xsimd::select(entry == entry, entry, F(kInf)).store_aligned(key + at);
+    }
+}
+
 // Pushes the children of `n` that some lane of `mask` enters, nearest (along the
-// representative lane) on top.
+// representative lane) on top. The eight child tests are independent (no branch between
+// them, so the CPU overlaps them); the entered children are then placed by rank, without
+// a data-dependent branch: child j goes below every entered child nearer than it (ties:
+// the lower index nearer).
 template <class F>
 void push_packet_children(const BvhNode8& n, const BvhPacket& p, std::uint32_t mask,
                           const F& t_near, const float* t_far, BvhStacks& st,
                           std::uint32_t& sp) {
-    const auto rep = static_cast<std::uint32_t>(__builtin_ctz(mask));
-    std::uint32_t ref[kBvhWidth], lanes[kBvhWidth];
-    float key[kBvhWidth];
-    std::uint32_t count = 0;
+    constexpr std::uint32_t W = F::size;
+    std::uint32_t lanes[kBvhWidth] = {}, entered = 0;
     for (std::uint32_t j = 0; j < kBvhWidth && n.child[j] != kBvhEmpty; ++j) {
-        float k;
-        const std::uint32_t bits = packet_child_test(n, j, p, t_near, t_far, rep, k) & mask;
-        if (bits == 0) continue;
-        std::uint32_t at = count++;
-        for (; at > 0 && key[at - 1] < k; --at) {  // descending: the nearest pushed last
-            ref[at] = ref[at - 1], lanes[at] = lanes[at - 1], key[at] = key[at - 1];
+        lanes[j] = packet_child_lanes(n, j, p, t_near, t_far) & mask;
+        entered |= static_cast<std::uint32_t>(lanes[j] != 0) << j;
+    }
+    if (entered == 0) return;
+    const auto count = static_cast<std::uint32_t>(__builtin_popcount(entered));
+    if (count == 1) {
+        const auto j = static_cast<std::uint32_t>(__builtin_ctz(entered));
+        st.packet_node[sp] = n.child[j];
+        st.packet_mask[sp++] = static_cast<std::uint8_t>(lanes[j]);
+        return;
+    }
+    alignas(64) float key[kBvhWidth];
+    packet_child_keys<F>(n, p, static_cast<std::uint32_t>(__builtin_ctz(mask)), key);
+    alignas(64) static constexpr float kIndex[kBvhWidth] = {0, 1, 2, 3, 4, 5, 6, 7};
+    for (std::uint32_t bits = entered; bits != 0; bits &= bits - 1) {
+        const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
+        const F kj(key[j]), index_j(static_cast<float>(j));
+        std::uint32_t nearer = 0;  // entered children that must be pushed after j
+        for (std::uint32_t at = 0; at < kBvhWidth; at += W) {
+            const F k = F::load_aligned(key + at), index = F::load_aligned(kIndex + at);
+            nearer |= mask_bits<F>(k < kj || (k == kj && index < index_j)) << at;
         }
-        ref[at] = n.child[j], lanes[at] = bits, key[at] = k;
+        const std::uint32_t slot =
+            sp + count - 1 - static_cast<std::uint32_t>(__builtin_popcount(nearer & entered));
+        st.packet_node[slot] = n.child[j];
+        st.packet_mask[slot] = static_cast<std::uint8_t>(lanes[j]);
     }
-    for (std::uint32_t k = 0; k < count; ++k) {
-        st.packet_node[sp] = ref[k];
-        st.packet_mask[sp++] = static_cast<std::uint8_t>(lanes[k]);
-    }
+    sp += count;
 }
 
 // Closest hits of the packet `p` (lanes `live`) among the BVH's spheres.
