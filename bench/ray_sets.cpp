@@ -309,6 +309,59 @@ OracleHits oracle_hits(const ReferenceTracer& tracer, const RaySet& rays,
     return out;
 }
 
+OracleHits oracle_hits_double(const Scene& scene, const RaySet& rays, const OracleHits& like) {
+    OracleHits out;
+    out.index = like.index;
+    out.t.assign(out.index.size(), kInfinity);
+    out.object.assign(out.index.size(), kernels::kNoHit);
+    const bool any_hit = rays.kind == RayKind::shadow;
+    struct D3 {
+        double x, y, z;
+    };
+    const auto d3 = [](const Vec3& v) { return D3{v.x, v.y, v.z}; };
+    const auto dot = [](const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, out.index.size(), 64),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t k = r.begin(); k < r.end(); ++k) {
+                const Ray ray = rays.ray(out.index[k]);
+                const D3 o = d3(ray.origin), d = d3(ray.direction);
+                const double a = dot(d, d);
+                double best = ray.t_max;
+                std::int32_t best_object = kernels::kNoHit;
+                const auto live = [&](double t) { return t > ray.t_min && t < best; };
+                for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+                    const Object& obj = scene.objects[i];
+                    double t = kInfinity;
+                    if (obj.type == ObjectType::sphere) {
+                        const D3 c = d3(obj.center);
+                        const D3 oc{o.x - c.x, o.y - c.y, o.z - c.z};
+                        const double b = dot(oc, d);
+                        const double radius = obj.radius;
+                        const double disc = b * b - a * (dot(oc, oc) - radius * radius);
+                        if (disc < 0.0) continue;
+                        const double root = std::sqrt(disc);
+                        t = (-b - root) / a;
+                        if (!live(t)) t = (-b + root) / a;
+                    } else {
+                        const D3 n = d3(obj.normal);
+                        const double denom = dot(d, n);
+                        if (!(std::fabs(denom) >= 1e-12)) continue;
+                        t = (dot(d3(obj.point), n) - dot(o, n)) / denom;
+                    }
+                    if (!live(t)) continue;
+                    best = t;
+                    best_object = static_cast<std::int32_t>(i);
+                    if (any_hit) break;
+                }
+                if (best_object == kernels::kNoHit) continue;
+                out.object[k] = any_hit ? kOccluded : best_object;
+                out.t[k] = any_hit ? kInfinity : static_cast<float>(best);
+            }
+        });
+    return out;
+}
+
 Validation validate_hits(const HitSet& hits, const OracleHits& oracle,
                          const ValidationRule& rule) {
     Validation v;

@@ -114,6 +114,12 @@ struct OracleHits {
 OracleHits oracle_hits(const ReferenceTracer& tracer, const RaySet& rays,
                        std::uint32_t max_rays);
 
+// The same rays as `like` (its index), answered in double precision by brute force with
+// the textbook formulas: the truth another intersector is held to. octray's float
+// quadratic (the scalar oracle) loses digits on small, distant spheres, so Embree, which
+// rounds differently, would otherwise be judged against octray's own rounding.
+OracleHits oracle_hits_double(const Scene& scene, const RaySet& rays, const OracleHits& like);
+
 struct ValidationRule {
     // Exact: t bit for bit and the object id, on every ray (octray's two paths perform the
     // same IEEE operations). Otherwise two fractions must reach their minimum: of the
