@@ -384,7 +384,7 @@ void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep,
 // them, so the CPU overlaps them); the entered children are then placed by rank, without
 // a data-dependent branch: child j goes below every entered child nearer than it (ties:
 // the lower index nearer).
-template <class F>
+template <class F, bool kNearestFirst = true>
 void push_packet_children(const BvhNode8& n, const BvhPacket& p, std::uint32_t mask,
                           const F& t_near, const float* t_far, BvhStacks& st,
                           std::uint32_t& sp) {
@@ -396,10 +396,14 @@ void push_packet_children(const BvhNode8& n, const BvhPacket& p, std::uint32_t m
     }
     if (entered == 0) return;
     const auto count = static_cast<std::uint32_t>(__builtin_popcount(entered));
-    if (count == 1) {
-        const auto j = static_cast<std::uint32_t>(__builtin_ctz(entered));
-        st.packet_node[sp] = n.child[j];
-        st.packet_mask[sp++] = static_cast<std::uint8_t>(lanes[j]);
+    if (count == 1 || !kNearestFirst) {
+        // One child, or any hit (which needs no order): index order, the first on top.
+        for (std::uint32_t bits = entered, slot = sp + count; bits != 0; bits &= bits - 1) {
+            const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
+            st.packet_node[--slot] = n.child[j];
+            st.packet_mask[slot] = static_cast<std::uint8_t>(lanes[j]);
+        }
+        sp += count;
         return;
     }
     alignas(64) float key[kBvhWidth];
@@ -511,7 +515,7 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
             continue;
         }
         if ((node & kBvhLeafBit) == 0) {
-            push_packet_children(s.bvh_nodes[node], p, mask, zero, p.best_t, st, sp);
+            push_packet_children<F, false>(s.bvh_nodes[node], p, mask, zero, p.best_t, st, sp);
             continue;
         }
         V3<F> o[K], d[K];
