@@ -101,9 +101,10 @@ constexpr float kBvhFiniteLimit = 1e37f;
 // Loads a packet's rays into `p`; best_t starts at `t_far` (+inf or t_max), best_id at -1.
 // Returns the lanes whose box tests stay finite (kBvhFiniteLimit).
 template <class F>
-std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* oy, const float* oz,
-                     const float* dx, const float* dy, const float* dz, const float* t_far,
-                     std::uint32_t base, BvhPacket& p) {
+std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* oy,
+                              const float* oz, const float* dx, const float* dy,
+                              const float* dz, const float* t_far, std::uint32_t base,
+                              BvhPacket& p) {
     constexpr std::uint32_t W = F::size;
     float box_max = 0.0f;  // no fmaxf: it is a libm call, not an instruction
     for (int a = 0; a < 3; ++a) {
@@ -123,8 +124,8 @@ std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* 
         const F m = bvh_margin(s, o);
         const F o_max =
             xsimd::max(xsimd::max(xsimd::abs(o.x), xsimd::abs(o.y)), xsimd::abs(o.z));
-        const F inv_max = xsimd::max(xsimd::max(xsimd::abs(inv.x), xsimd::abs(inv.y)),
-                                     xsimd::abs(inv.z));
+        const F inv_max =
+            xsimd::max(xsimd::max(xsimd::abs(inv.x), xsimd::abs(inv.y)), xsimd::abs(inv.z));
         finite |= mask_bits<F>((o_max + m + F(box_max)) * inv_max < F(kBvhFiniteLimit)) << at;
         const V3<F> lo{o.x + m, o.y + m, o.z + m}, hi{o.x - m, o.y - m, o.z - m};
         store3(hadamard(lo, inv), p.lo_off_x, p.lo_off_y, p.lo_off_z, at);
@@ -359,8 +360,7 @@ std::uint32_t packet_child_lanes(const BvhNode8& n, std::uint32_t j, const BvhPa
 // Where lane `rep` of the packet enters each of the 8 children (children in lanes): the
 // order in which the packet visits them. Only an order: it decides no hit.
 template <class F>
-void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep,
-                       float* key) {
+void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep, float* key) {
     constexpr std::uint32_t W = F::size;
     const F ix(p.inv_x[rep]), iy(p.inv_y[rep]), iz(p.inv_z[rep]);
     const F lo_x(p.lo_off_x[rep]), lo_y(p.lo_off_y[rep]), lo_z(p.lo_off_z[rep]);
@@ -573,18 +573,20 @@ void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count,
                                 nullptr, base, p) &
              live) != live) {
             // Box tests would overflow: this packet against every sphere.
-            const RayStream one{rays.ox + base, rays.oy + base, rays.oz + base,
-                                rays.dx + base, rays.dy + base, rays.dz + base,
-                                rays.wr + base, rays.wg + base, rays.wb + base,
+            const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
+                                rays.dx + base,   rays.dy + base, rays.dz + base,
+                                rays.wr + base,   rays.wg + base, rays.wb + base,
                                 rays.pixel + base};
-            closest_hit_all<Arch>(s, one, count - base < kPacketWidth ? count - base : kPacketWidth,
+            closest_hit_all<Arch>(s, one,
+                                  count - base < kPacketWidth ? count - base : kPacketWidth,
                                   t_min, HitStream{hits.t + base, hits.object + base});
             continue;
         }
         bvh_closest_packet<Arch>(s, p, live, t_min, st);
         // Planes stay outside the tree.
         for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
-            F best_t = F::load_aligned(p.best_t + at), best_id = F::load_aligned(p.best_id + at);
+            F best_t = F::load_aligned(p.best_t + at),
+              best_id = F::load_aligned(p.best_id + at);
             closest_planes(s, load3<F>(p.ox, p.oy, p.oz, at), load3<F>(p.dx, p.dy, p.dz, at),
                            tmin, best_t, best_id);
             best_t.store_aligned(hits.t + base + at);

@@ -231,13 +231,15 @@ void store_compacted_slots(const Compaction<F>& c, std::uint32_t base, std::uint
     if constexpr (F::size == 8) {
         const __m256i lane = compaction_index<F>(c.bits);
         const __m256i slot = _mm256_add_epi32(
-            _mm256_mullo_epi32(_mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(base)), lane),
-                               _mm256_set1_epi32(static_cast<int>(scale))),
+            _mm256_mullo_epi32(
+                _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(base)), lane),
+                _mm256_set1_epi32(static_cast<int>(scale))),
             _mm256_set1_epi32(static_cast<int>(offset)));
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst), slot);
     } else {
         const std::uint8_t* selected = c.lanes();
-        for (std::uint32_t k = 0; k < c.count; ++k) dst[k] = (base + selected[k]) * scale + offset;
+        for (std::uint32_t k = 0; k < c.count; ++k)
+            dst[k] = (base + selected[k]) * scale + offset;
     }
 }
 // `value` in dst[0, count); with AVX2 also scribbles on dst[count, 8).
@@ -474,7 +476,7 @@ void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t co
 // stops testing objects once every live lane is occluded. occluded[i] is 1 or 0.
 template <class Arch>
 void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
-             std::uint32_t* occluded) {
+                 std::uint32_t* occluded) {
     using F = xsimd::batch<float, Arch>;
     using M = xsimd::batch_bool<float, Arch>;
     constexpr std::uint32_t W = F::size;
@@ -665,7 +667,8 @@ ShadeCounts shade(const SceneView& s, const ShadeInput& in, const ShadeOutput& o
                 shininess.store_aligned(exps);
                 ks.store_aligned(kss);
                 for (std::uint32_t i = 0; i < W; ++i)
-                    if ((pow_bits >> i) & 1u) highlight[i] = kss[i] * powf(base_pow[i], exps[i]);
+                    if ((pow_bits >> i) & 1u)
+                        highlight[i] = kss[i] * powf(base_pow[i], exps[i]);
                 h = F::load_aligned(highlight);
             }
             // radiance * (Cd * (kd * N.l) + highlight)

@@ -206,8 +206,8 @@ struct Tile {
 // and which samples of each pixel to trace (render/crop.h).
 struct RenderTarget {
     Image& image;
-    PixelRect rect;        // the pixels `image` holds; tiles lie inside it
-    SampleRange samples;   // [0, spp) for a plain render
+    PixelRect rect;                     // the pixels `image` holds; tiles lie inside it
+    SampleRange samples;                // [0, spp) for a plain render
     const Image* start_sums = nullptr;  // sums of samples [0, samples.begin) or nullptr
     Image* sums = nullptr;              // a progressive pass: where the new sums go
 };

@@ -213,5 +213,54 @@ TEST(Validation, OracleSubsetIsAnEvenStride) {
     EXPECT_EQ(oracle.index.back(), 99u * f.primary.count / 100u);  // k * n / 100 for k = 99
 }
 
+// ---- The double-precision oracle (Embree's judge) --------------------------------------
+
+TEST(DoubleOracle, AgreesWithTheFloatOracleOnAnOrdinaryScene) {
+    Fixture f;
+    const OracleHits oracle = oracle_hits(f.tracer, f.primary, 0);
+    const OracleHits truth = oracle_hits_double(f.scene, f.primary, oracle);
+    EXPECT_EQ(truth.index, oracle.index);
+    const Validation v =
+        validate_hits(oracle_as_hits(f.primary, oracle), truth, kToleranceRule);
+    EXPECT_TRUE(v.valid) << v.summary();
+    EXPECT_EQ(v.hit_mismatches, 0u);
+    EXPECT_EQ(v.object_mismatches, 0u);
+    EXPECT_GT(v.both_hit, f.primary.count / 2);
+
+    // Shadow rays: the same occlusion answers.
+    const RaySet shadow =
+        make_shadow_rays(f.scene, f.primary, oracle_as_hits(f.primary, oracle));
+    const OracleHits occluded = oracle_hits(f.tracer, shadow, 0);
+    const OracleHits occluded_truth = oracle_hits_double(f.scene, shadow, occluded);
+    ASSERT_GT(shadow.count, 0u);
+    EXPECT_EQ(occluded_truth.object, occluded.object);
+    EXPECT_NE(std::count(occluded.object.begin(), occluded.object.end(), kOccluded), 0);
+}
+
+// A tiny sphere 1000 units away: the float quadratic's t is off in the fourth digit (it
+// is what made Embree's accurate rows look invalid); the double oracle has t to ~1e-12.
+TEST(DoubleOracle, HasTheAccurateRootOnATinyDistantSphere) {
+    Scene scene = load_scene("random:1,width=8,height=8");
+    scene.objects[0].center = Vec3(0.0f, 0.0f, -1000.0f);
+    scene.objects[0].radius = 0.01f;
+    const ReferenceTracer tracer(scene);
+    RaySet rays;
+    rays.kind = RayKind::primary;
+    rays.resize(1);
+    rays.ox[0] = 0.0f, rays.oy[0] = 0.005f, rays.oz[0] = 0.0f;
+    rays.dx[0] = 0.0f, rays.dy[0] = 0.0f, rays.dz[0] = -1.0f;
+    rays.t_max[0] = kInfinity;
+    const OracleHits oracle = oracle_hits(tracer, rays, 0);
+    const OracleHits truth = oracle_hits_double(scene, rays, oracle);
+    ASSERT_EQ(truth.object[0], 0);
+    // Entry at z = -1000 + sqrt(r^2 - y^2), from the origin along -z.
+    const double r = 0.01f, y = 0.005f;
+    const double exact = 1000.0 - std::sqrt(r * r - y * y);
+    EXPECT_NEAR(truth.t[0], exact, 1e-4);  // float storage of t: 6e-5 at 1000
+    ASSERT_EQ(oracle.object[0], 0);
+    EXPECT_GT(std::fabs(oracle.t[0] - exact), 1e-3)
+        << "the float oracle was expected to lose digits";
+}
+
 }  // namespace
 }  // namespace octray::bench
