@@ -275,6 +275,31 @@ RaySet make_secondary_rays(const Scene& scene, const RaySet& primary, const HitS
 
 // ---- The oracle and validation -------------------------------------------------------
 
+namespace {
+
+// An oracle's answer for one ray: t (closest hit) and the object, kOccluded or kNoHit.
+struct Answer {
+    float t = kInfinity;
+    std::int32_t object = kernels::kNoHit;
+};
+
+// Answers each ray of out.index, in parallel (brute force: a few rays per task).
+template <class AnswerRay>
+void answer_rays(const RaySet& rays, OracleHits& out, const AnswerRay& answer_ray) {
+    out.t.assign(out.index.size(), kInfinity);
+    out.object.assign(out.index.size(), kernels::kNoHit);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.index.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t k = r.begin(); k < r.end(); ++k) {
+                              const Answer answer = answer_ray(rays.ray(out.index[k]));
+                              out.t[k] = answer.t;
+                              out.object[k] = answer.object;
+                          }
+                      });
+}
+
+}  // namespace
+
 OracleHits oracle_hits(const ReferenceTracer& tracer, const RaySet& rays,
                        std::uint32_t max_rays) {
     OracleHits out;
@@ -289,76 +314,55 @@ OracleHits oracle_hits(const ReferenceTracer& tracer, const RaySet& rays,
             out.index[k] =
                 static_cast<std::uint32_t>(static_cast<std::uint64_t>(k) * n / max_rays);
     }
-    out.t.assign(out.index.size(), kInfinity);
-    out.object.assign(out.index.size(), kernels::kNoHit);
     const bool any_hit = rays.kind == RayKind::shadow;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.index.size(), 256),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t k = r.begin(); k < r.end(); ++k) {
-                              const Ray ray = rays.ray(out.index[k]);
-                              if (any_hit) {
-                                  if (tracer.occluded(ray)) out.object[k] = kOccluded;
-                                  continue;
-                              }
-                              if (const auto hit = tracer.intersect(ray)) {
-                                  out.t[k] = hit->t;
-                                  out.object[k] = static_cast<std::int32_t>(hit->object);
-                              }
-                          }
-                      });
+    answer_rays(rays, out, [&](const Ray& ray) {
+        if (any_hit) return tracer.occluded(ray) ? Answer{kInfinity, kOccluded} : Answer{};
+        const auto hit = tracer.intersect(ray);
+        return hit ? Answer{hit->t, static_cast<std::int32_t>(hit->object)} : Answer{};
+    });
     return out;
+}
+
+double exact_root(const Object& object, const Ray& ray) {
+    const double dx = ray.direction.x, dy = ray.direction.y, dz = ray.direction.z;
+    if (object.type == ObjectType::plane) {
+        const Vec3& n = object.normal;
+        const double denom = dx * n.x + dy * n.y + dz * n.z;
+        if (!(std::fabs(denom) >= 1e-12)) return std::nan("");
+        const double num = (static_cast<double>(object.point.x) - ray.origin.x) * n.x +
+                           (static_cast<double>(object.point.y) - ray.origin.y) * n.y +
+                           (static_cast<double>(object.point.z) - ray.origin.z) * n.z;
+        return num / denom;
+    }
+    const double ox = static_cast<double>(ray.origin.x) - object.center.x;
+    const double oy = static_cast<double>(ray.origin.y) - object.center.y;
+    const double oz = static_cast<double>(ray.origin.z) - object.center.z;
+    const double a = dx * dx + dy * dy + dz * dz, b = ox * dx + oy * dy + oz * dz;
+    const double radius = object.radius;
+    const double disc = b * b - a * (ox * ox + oy * oy + oz * oz - radius * radius);
+    if (disc < 0.0) return std::nan("");
+    const double t_near = (-b - std::sqrt(disc)) / a;
+    return t_near > ray.t_min ? t_near : (-b + std::sqrt(disc)) / a;
 }
 
 OracleHits oracle_hits_double(const Scene& scene, const RaySet& rays, const OracleHits& like) {
     OracleHits out;
     out.index = like.index;
-    out.t.assign(out.index.size(), kInfinity);
-    out.object.assign(out.index.size(), kernels::kNoHit);
     const bool any_hit = rays.kind == RayKind::shadow;
-    struct D3 {
-        double x, y, z;
-    };
-    const auto d3 = [](const Vec3& v) { return D3{v.x, v.y, v.z}; };
-    const auto dot = [](const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, out.index.size(), 64),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t k = r.begin(); k < r.end(); ++k) {
-                const Ray ray = rays.ray(out.index[k]);
-                const D3 o = d3(ray.origin), d = d3(ray.direction);
-                const double a = dot(d, d);
-                double best = ray.t_max;
-                std::int32_t best_object = kernels::kNoHit;
-                const auto live = [&](double t) { return t > ray.t_min && t < best; };
-                for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-                    const Object& obj = scene.objects[i];
-                    double t = kInfinity;
-                    if (obj.type == ObjectType::sphere) {
-                        const D3 c = d3(obj.center);
-                        const D3 oc{o.x - c.x, o.y - c.y, o.z - c.z};
-                        const double b = dot(oc, d);
-                        const double radius = obj.radius;
-                        const double disc = b * b - a * (dot(oc, oc) - radius * radius);
-                        if (disc < 0.0) continue;
-                        const double root = std::sqrt(disc);
-                        t = (-b - root) / a;
-                        if (!live(t)) t = (-b + root) / a;
-                    } else {
-                        const D3 n = d3(obj.normal);
-                        const double denom = dot(d, n);
-                        if (!(std::fabs(denom) >= 1e-12)) continue;
-                        t = (dot(d3(obj.point), n) - dot(o, n)) / denom;
-                    }
-                    if (!live(t)) continue;
-                    best = t;
-                    best_object = static_cast<std::int32_t>(i);
-                    if (any_hit) break;
-                }
-                if (best_object == kernels::kNoHit) continue;
-                out.object[k] = any_hit ? kOccluded : best_object;
-                out.t[k] = any_hit ? kInfinity : static_cast<float>(best);
-            }
-        });
+    answer_rays(rays, out, [&](const Ray& ray) {
+        double best = ray.t_max;
+        std::int32_t best_object = kernels::kNoHit;
+        for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+            const double t = exact_root(scene.objects[i], ray);
+            if (!(t > ray.t_min && t < best)) continue;  // NaN too
+            best = t;
+            best_object = static_cast<std::int32_t>(i);
+            if (any_hit) break;
+        }
+        if (best_object == kernels::kNoHit) return Answer{};
+        return any_hit ? Answer{kInfinity, kOccluded}
+                       : Answer{static_cast<float>(best), best_object};
+    });
     return out;
 }
 

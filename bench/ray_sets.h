@@ -120,6 +120,11 @@ OracleHits oracle_hits(const ReferenceTracer& tracer, const RaySet& rays,
 // rounds differently, would otherwise be judged against octray's own rounding.
 OracleHits oracle_hits_double(const Scene& scene, const RaySet& rays, const OracleHits& like);
 
+// The first root of `object` above the ray's t_min in double precision, the textbook
+// formulas (t_max is not checked); NaN when there is none (a sphere missed, a plane
+// parallel to the ray within 1e-12).
+double exact_root(const Object& object, const Ray& ray);
+
 struct ValidationRule {
     // Exact: t bit for bit and the object id, on every ray (octray's two paths perform the
     // same IEEE operations). Otherwise two fractions must reach their minimum: of the

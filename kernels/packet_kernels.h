@@ -547,24 +547,24 @@ ShadeCounts shade(const SceneView& s, const ShadeInput& in, const ShadeOutput& o
     ShadeCounts counts{0, 0, 0, 0};
 
     for (std::uint32_t base = 0; base < in.count; base += W) {
-        const std::uint32_t lanes = in.count - base < W ? in.count - base : W;
         // Lanes that missed (or are dead) read the first hit lane's object: always a valid
-        // entry, and a coherent packet stays uniform.
+        // entry, and a coherent packet stays uniform. Ids travel as exact floats (< 2^24).
         using I = xsimd::batch<std::int32_t, Arch>;
-        alignas(64) static constexpr std::int32_t kLane[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-        const auto live = I::load_aligned(kLane) < I(static_cast<std::int32_t>(lanes));
-        const I raw_id = xsimd::select(live, I::load_aligned(in.hits.object + base), I(kNoHit));
-        const M hit = xsimd::to_float(raw_id) >= zero;
+        const F raw_id = xsimd::select(live_lanes<F>(base, in.count),
+                                       xsimd::to_float(I::load_aligned(in.hits.object + base)),
+                                       F(static_cast<float>(kNoHit)));
+        const M hit = raw_id >= zero;
         const std::uint32_t hit_bits = mask_bits<F>(hit);
         const bool all_hit = hit_bits == (1u << W) - 1;
-        LaneIndex ids;
-        I id = raw_id;
+        F id = raw_id;
         if (hit_bits != 0 && !all_hit) {
-            raw_id.store_aligned(ids.index);
-            id = xsimd::select(raw_id >= I(0), raw_id, I(ids.index[__builtin_ctz(hit_bits)]));
+            alignas(64) float lanes[W];
+            raw_id.store_aligned(lanes);
+            id = xsimd::select(hit, raw_id, F(lanes[__builtin_ctz(hit_bits)]));
         }
-        id.store_aligned(ids.index);
-        ids.uniform = xsimd::all(id == I(ids.index[0]));
+        LaneIndex ids;
+        xsimd::to_int(id).store_aligned(ids.index);
+        ids.uniform = xsimd::all(id == F(static_cast<float>(ids.index[0])));
         const V3<F> o = load3<F>(rays.ox, rays.oy, rays.oz, base);
         const V3<F> d = load3<F>(rays.dx, rays.dy, rays.dz, base);
         const V3<F> weight = load3<F>(rays.wr, rays.wg, rays.wb, base);

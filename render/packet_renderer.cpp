@@ -154,25 +154,27 @@ void resolve_into_parents(const kernels::SurfaceColor& c, const kernels::ChildLi
     }
 }
 
-// Writes n pixels (r, g, b) / *divisor, or as they are when divisor is null (x / 1 == x).
-// A frame's image is far larger than the caches and each pixel is written once: with SSE2
-// the aligned groups of four pixels go straight to memory (non-temporal stores), so the
-// CPU does not first read every line of the image only to overwrite it. Division is
-// IEEE-exact either way: the values equal the scalar r / divisor bit for bit.
+// Writes n pixels (r, g, b) / divisor. A frame's image is far larger than the caches and
+// each pixel is written once: with SSE2 the aligned groups of four pixels go straight to
+// memory (non-temporal stores), so the CPU does not first read every line of the image
+// only to overwrite it. Division is IEEE-exact either way (the same bits as the scalar
+// r / divisor), and skipped for a divisor of 1, where x / 1 == x.
 void stream_row(Rgb* out, const float* r, const float* g, const float* b, int n,
-                const float* divisor) {
+                float divisor) {
+    const bool divide = divisor != 1.0f;
+    const auto pixel = [&](int x) {
+        const Rgb sum(r[x], g[x], b[x]);
+        return divide ? sum / divisor : sum;
+    };
     int x = 0;
 #if defined(__SSE2__)
-    const auto scalar_until = [&](int end) {
-        for (; x < end; ++x)
-            out[x] = divisor ? Rgb(r[x], g[x], b[x]) / *divisor : Rgb(r[x], g[x], b[x]);
-    };
     // Four pixels are 48 bytes: aligned groups start where the address is 16-aligned.
-    while (x < n && (reinterpret_cast<std::uintptr_t>(out + x) & 15u) != 0) scalar_until(x + 1);
-    const __m128 d = _mm_set1_ps(divisor ? *divisor : 1.0f);
+    for (; x < n && (reinterpret_cast<std::uintptr_t>(out + x) & 15u) != 0; ++x)
+        out[x] = pixel(x);
+    const __m128 d = _mm_set1_ps(divisor);
     for (; x + 4 <= n; x += 4) {
         __m128 vr = _mm_loadu_ps(r + x), vg = _mm_loadu_ps(g + x), vb = _mm_loadu_ps(b + x);
-        if (divisor) vr = _mm_div_ps(vr, d), vg = _mm_div_ps(vg, d), vb = _mm_div_ps(vb, d);
+        if (divide) vr = _mm_div_ps(vr, d), vg = _mm_div_ps(vg, d), vb = _mm_div_ps(vb, d);
         // (r0 g0 b0 r1) (g1 b1 r2 g2) (b2 r3 g3 b3)
         const __m128 rg_lo = _mm_unpacklo_ps(vr, vg), rg_hi = _mm_unpackhi_ps(vr, vg);
         const __m128 b0r1 = _mm_shuffle_ps(vb, vr, _MM_SHUFFLE(1, 1, 0, 0));
@@ -184,11 +186,8 @@ void stream_row(Rgb* out, const float* r, const float* g, const float* b, int n,
         _mm_stream_ps(dst + 4, _mm_shuffle_ps(g1b1, rg_hi, _MM_SHUFFLE(1, 0, 2, 0)));
         _mm_stream_ps(dst + 8, _mm_shuffle_ps(b2r3, g3b3, _MM_SHUFFLE(2, 0, 2, 0)));
     }
-    scalar_until(n);
-#else
-    for (; x < n; ++x)
-        out[x] = divisor ? Rgb(r[x], g[x], b[x]) / *divisor : Rgb(r[x], g[x], b[x]);
 #endif
+    for (; x < n; ++x) out[x] = pixel(x);
 }
 
 // Non-temporal stores are weakly ordered: fence them before the tile counts as written.
@@ -370,9 +369,8 @@ class PacketTracer {
             }
         }
 
-        // The mean of the samples so far: all spp of them, unless a progressive pass. A
-        // sum of one sample is its own mean (x / 1 == x): no division then.
-        const auto inv = static_cast<float>(end_sample);
+        // The mean of the samples so far: all spp of them, unless a progressive pass.
+        const auto samples_so_far = static_cast<float>(end_sample);
         for (int y = 0; y < tile.height; ++y) {
             const std::size_t row = static_cast<std::size_t>(y) * tile.width;
             const float *r = s.acc_r.data() + row, *g = s.acc_g.data() + row,
@@ -381,8 +379,7 @@ class PacketTracer {
                 Rgb* sums = &target.sums->at(ox, oy + y);
                 for (int x = 0; x < tile.width; ++x) sums[x] = Rgb(r[x], g[x], b[x]);
             }
-            stream_row(&target.image.at(ox, oy + y), r, g, b, tile.width,
-                       end_sample == 1 ? nullptr : &inv);
+            stream_row(&target.image.at(ox, oy + y), r, g, b, tile.width, samples_so_far);
         }
         finish_streaming();
     }

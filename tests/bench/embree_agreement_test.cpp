@@ -22,27 +22,6 @@ namespace {
 
 #if OCTRAY_HAVE_EMBREE
 constexpr int kWidth = 320, kHeight = 180;
-
-// The nearest root of `object` on (t_min, t_max) in double precision (NaN for a miss).
-double exact_t(const Object& o, const Ray& r) {
-    const double dx = r.direction.x, dy = r.direction.y, dz = r.direction.z;
-    if (o.type == ObjectType::plane) {
-        const double denom = dx * o.normal.x + dy * o.normal.y + dz * o.normal.z;
-        const double num = (static_cast<double>(o.point.x) - r.origin.x) * o.normal.x +
-                           (static_cast<double>(o.point.y) - r.origin.y) * o.normal.y +
-                           (static_cast<double>(o.point.z) - r.origin.z) * o.normal.z;
-        return num / denom;
-    }
-    const double ox = static_cast<double>(r.origin.x) - o.center.x;
-    const double oy = static_cast<double>(r.origin.y) - o.center.y;
-    const double oz = static_cast<double>(r.origin.z) - o.center.z;
-    const double a = dx * dx + dy * dy + dz * dz, b = ox * dx + oy * dy + oz * dz;
-    const double c = ox * ox + oy * oy + oz * oz - static_cast<double>(o.radius) * o.radius;
-    const double disc = b * b - a * c;
-    if (disc < 0.0) return std::nan("");
-    const double t_near = (-b - std::sqrt(disc)) / a;
-    return t_near > r.t_min ? t_near : (-b + std::sqrt(disc)) / a;
-}
 #endif
 
 class EmbreeAgreement : public ::testing::TestWithParam<const char*> {};
@@ -86,7 +65,7 @@ TEST_P(EmbreeAgreement, PrimaryRaysAgreeWithOctray) {
                 std::fabs(static_cast<double>(octray.t[i]) - e.t[i]) / octray.t[i];
             if (rel <= 1e-4) continue;
             const double truth =
-                exact_t(scene.objects[static_cast<std::size_t>(e.object[i])], rays.ray(i));
+                exact_root(scene.objects[static_cast<std::size_t>(e.object[i])], rays.ray(i));
             const bool embree_exact = std::fabs(e.t[i] - truth) <= 1e-5 * truth;
             EXPECT_TRUE(embree_exact)
                 << "ray " << i << ": octray t " << octray.t[i] << " (object "
