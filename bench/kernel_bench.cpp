@@ -1,10 +1,13 @@
 // Microbenchmarks of the packet kernels against the scalar reference, each on 4096 rays
 // (a 64 x 64 block of camera rays): ray-sphere and ray-plane intersection, the camera
 // kernel, stream compaction, shading, and one 16 x 16 tile rendered end to end. Every
-// benchmark checks its packet result against the scalar one before timing and reports
-// rays per second (benchmark::Counter::kIsRate). Figures: bench/README.md.
+// kernel benchmark checks its packet result against the scalar one before timing and
+// reports rays per second (benchmark::Counter::kIsRate). Also the sphere BVH's build on
+// whole scenes, on 1 and 2 threads, in spheres per second. Figures: bench/README.md.
 
 #include <benchmark/benchmark.h>
+
+#include <tbb/task_arena.h>
 
 #include <cstring>
 #include <string>
@@ -17,6 +20,7 @@
 #include "kernels/dispatch.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
+#include "scene/bvh.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 
@@ -263,6 +267,21 @@ void tile_end_to_end(benchmark::State& state, bool simd, Isa isa) {
     set_rate(state, 256, "pixels/s");
 }
 
+// ---- BVH build --------------------------------------------------------------------------
+
+// The sphere BVH of a built-in scene, built on `threads` TBB threads (as `octray bench`
+// times it), in spheres per second.
+void bvh_build(benchmark::State& state, const std::string& spec, int threads) {
+    const CompiledScene compiled = compile_scene(load_scene(spec));
+    tbb::task_arena arena(threads);
+    for (auto _ : state) {
+        SphereBvh bvh;
+        arena.execute([&] { bvh = build_sphere_bvh(compiled.spheres); });
+        benchmark::DoNotOptimize(bvh.nodes.data());
+    }
+    set_rate(state, compiled.spheres.count, "spheres/s");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -310,6 +329,14 @@ int main(int argc, char** argv) {
         reg(std::string("tile16x16/whitted/packet8-") + isa_name(isa),
             [isa](benchmark::State& s) { tile_end_to_end(s, true, isa); })
             ->UseRealTime();
+    for (const char* spec : {"random:65536", "sphereflake:5", "random:1048576"})
+        for (int threads : {1, 2})
+            reg(std::string("bvh_build/") + spec + "/threads:" + std::to_string(threads),
+                [spec = std::string(spec), threads](benchmark::State& s) {
+                    bvh_build(s, spec, threads);
+                })
+                ->UseRealTime()
+                ->Unit(benchmark::kMillisecond);
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
     return 0;

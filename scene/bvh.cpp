@@ -5,7 +5,7 @@
 //
 // Determinism: every decision depends only on the spheres of a subtree and its place in
 // the tree. Binning reduces boxes with min/max and counts with integer sums (both exact,
-// so any TBB split gives the same bins); partitions are std::partition on one range; each
+// so any TBB split gives the same bins); a partition is one serial pass over its range; each
 // binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
 // preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
 // depends on which thread got there first; the 8-wide collapse runs serially in preorder.
@@ -70,7 +70,8 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// Binned SAH: 16 bins per axis (Wald 2007 found 16-32 as good as a full sweep).
+// Binned SAH: 16 bins per axis (Wald 2007 found 16-32 as good as a full sweep), or one
+// per sphere for fewer than 16 spheres.
 constexpr int kBins = 16;
 // A binary subtree becomes a leaf when the SAH prefers it and it holds at most this many
 // spheres (a leaf is one 8-wide test against one ray).
@@ -161,58 +162,79 @@ RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e) 
         });
 }
 
-// Maps a center to its bin along each axis; the partition uses the same function, so it
-// agrees with the bins' counts exactly.
+// The bins of a range: at most kBins per axis, fewer for a small range (its bins are
+// cleared, filled and swept per node, and most nodes are small). Maps a center to its bin
+// along each axis; the partition uses the same function, so it agrees with the bins'
+// counts exactly.
 struct BinMapping {
     __m128 lo;
     __m128 scale;  // 0 on an axis without extent (and in w)
+    int count;     // bins per axis, 2 ... kBins
     int axis_has_extent[3];
-    void bins(__m128 center, std::int32_t out[4]) const {
+
+    BinMapping(const Box& centers, std::uint32_t n) {
+        count = static_cast<int>(std::clamp<std::uint32_t>(n, 2, kBins));
+        alignas(16) float s[4] = {0, 0, 0, 0};
+        for (int a = 0; a < 3; ++a) {
+            const float extent = centers.hi_at(a) - centers.lo_at(a);
+            // Slightly fewer than `count` bins per extent, so the top center maps to the
+            // last bin rather than past it (clamped anyway).
+            s[a] = extent > 0.0f ? (static_cast<float>(count) * 0.99999f) / extent : 0.0f;
+            if (!(s[a] < kInf)) s[a] = 0.0f;  // denormal extent
+            axis_has_extent[a] = s[a] > 0.0f;
+        }
+        lo = centers.lo;
+        scale = _mm_load_ps(s);
+    }
+    __m128i bins(__m128 center) const {
         __m128 k = _mm_mul_ps(_mm_sub_ps(center, lo), scale);
-        k = _mm_min_ps(_mm_max_ps(k, _mm_setzero_ps()), _mm_set1_ps(kBins - 1));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_cvttps_epi32(k));
+        k = _mm_min_ps(_mm_max_ps(k, _mm_setzero_ps()),
+                       _mm_set1_ps(static_cast<float>(count - 1)));
+        return _mm_cvttps_epi32(k);
     }
 };
 
-// Per axis and bin: the spheres' boxes, their centers' box (so that the children's bounds
-// come out of the bins, without another pass) and the count.
+// Per axis and bin: the spheres' boxes and their count (the children's center bounds come
+// out of the partition, which visits every sphere anyway).
 struct Bins {
-    RangeBounds bounds[3][kBins];
-    std::uint32_t count[3][kBins] = {};
+    Box box[3][kBins];
+    std::uint32_t count[3][kBins];
 
+    explicit Bins(int bins) {
+        for (int a = 0; a < 3; ++a)
+            for (int k = 0; k < bins; ++k) box[a][k] = Box{}, count[a][k] = 0;
+    }
     void add(const PrimRef& p, const BinMapping& m) {
-        std::int32_t k[4];
-        const __m128 center = p.center();
-        m.bins(center, k);
+        alignas(16) std::int32_t k[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(k), m.bins(p.center()));
         for (int a = 0; a < 3; ++a) {
-            bounds[a][k[a]].box.grow(p.box);
-            bounds[a][k[a]].centers.grow(center);
+            box[a][k[a]].grow(p.box);
             ++count[a][k[a]];
         }
     }
-    void merge(const Bins& o) {
+    void merge(const Bins& o, int bins) {
         for (int a = 0; a < 3; ++a)
-            for (int k = 0; k < kBins; ++k) {
-                bounds[a][k].grow(o.bounds[a][k]);
+            for (int k = 0; k < bins; ++k) {
+                box[a][k].grow(o.box[a][k]);
                 count[a][k] += o.count[a][k];
             }
     }
 };
 
-Bins bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m) {
+void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+               Bins& bins) {
     if (e - b < kParallelBinning) {
-        Bins bins;
         for (std::uint32_t i = b; i < e; ++i) bins.add(refs[i], m);
-        return bins;
+        return;
     }
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::uint32_t>(b, e, kParallelBinning / 4), Bins{},
-        [&](const tbb::blocked_range<std::uint32_t>& r, Bins bins) {
-            for (std::uint32_t i = r.begin(); i < r.end(); ++i) bins.add(refs[i], m);
-            return bins;
+    bins = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(b, e, kParallelBinning / 4), Bins(m.count),
+        [&](const tbb::blocked_range<std::uint32_t>& r, Bins part) {
+            for (std::uint32_t i = r.begin(); i < r.end(); ++i) part.add(refs[i], m);
+            return part;
         },
-        [](Bins x, const Bins& y) {
-            x.merge(y);
+        [&](Bins x, const Bins& y) {
+            x.merge(y, m.count);
             return x;
         });
 }
@@ -221,29 +243,30 @@ struct Split {
     int axis = -1;
     int bin = 0;  // the left side holds bins [0, bin]
     float cost = kInf;
-    RangeBounds left, right;
+    Box left, right;
 };
 
 // The cheapest SAH split over every axis and bin boundary (ties: the lower axis, then
 // the lower bin).
 Split best_split(const Bins& bins, const BinMapping& m) {
     Split best;
+    const int nb = m.count;
     for (int a = 0; a < 3; ++a) {
         if (!m.axis_has_extent[a]) continue;
         float right_area[kBins];
         std::uint32_t right_count[kBins];
         Box acc;
         std::uint32_t n = 0;
-        for (int k = kBins - 1; k > 0; --k) {
-            acc.grow(bins.bounds[a][k].box);
+        for (int k = nb - 1; k > 0; --k) {
+            acc.grow(bins.box[a][k]);
             n += bins.count[a][k];
             right_area[k] = acc.half_area();
             right_count[k] = n;
         }
         Box left;
         std::uint32_t nl = 0;
-        for (int k = 0; k < kBins - 1; ++k) {
-            left.grow(bins.bounds[a][k].box);
+        for (int k = 0; k < nb - 1; ++k) {
+            left.grow(bins.box[a][k]);
             nl += bins.count[a][k];
             const std::uint32_t nr = right_count[k + 1];
             if (nl == 0 || nr == 0) continue;
@@ -257,9 +280,46 @@ Split best_split(const Bins& bins, const BinMapping& m) {
         }
     }
     if (best.axis >= 0)
-        for (int k = 0; k < kBins; ++k)
-            (k <= best.bin ? best.left : best.right).grow(bins.bounds[best.axis][k]);
+        for (int k = 0; k < nb; ++k)
+            (k <= best.bin ? best.left : best.right).grow(bins.box[best.axis][k]);
     return best;
+}
+
+// Moves the spheres whose center lies in bins [0, split.bin] of `axis` to the front of
+// [b, e) (Hoare's partition: each misplaced pair swapped once) and returns where the rest
+// begin; the two sides' center bounds come out on the way.
+std::uint32_t partition(PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+                        int axis, int bin, Box& left_centers, Box& right_centers) {
+    const auto goes_left = [&](__m128 center) {
+        alignas(16) std::int32_t k[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(k), m.bins(center));
+        return k[axis] <= bin;
+    };
+    PrimRef* l = refs + b;
+    PrimRef* r = refs + e;
+    Box lc, rc;
+    for (;;) {
+        for (; l < r; ++l) {
+            const __m128 c = l->center();
+            if (!goes_left(c)) break;
+            lc.grow(c);
+        }
+        for (; l < r; --r) {
+            const __m128 c = (r - 1)->center();
+            if (goes_left(c)) break;
+            rc.grow(c);
+        }
+        if (l == r) break;
+        // *l goes right, *(r - 1) left.
+        --r;
+        std::swap(*l, *r);
+        lc.grow(l->center());
+        rc.grow(r->center());
+        ++l;
+    }
+    left_centers = lc;
+    right_centers = rc;
+    return static_cast<std::uint32_t>(l - refs);
 }
 
 class Builder {
@@ -278,19 +338,10 @@ class Builder {
         std::uint32_t mid = 0;
         RangeBounds left, right;
         if (depth < kMaxSahDepth) {
-            BinMapping m{};
-            alignas(16) float scale[4] = {0, 0, 0, 0};
-            for (int a = 0; a < 3; ++a) {
-                const float extent = rb.centers.hi_at(a) - rb.centers.lo_at(a);
-                // Slightly fewer than kBins per extent, so the top center maps to the
-                // last bin rather than past it (clamped anyway).
-                scale[a] = extent > 0.0f ? (static_cast<float>(kBins) * 0.99999f) / extent : 0.0f;
-                if (!(scale[a] < kInf)) scale[a] = 0.0f;  // denormal extent
-                m.axis_has_extent[a] = scale[a] > 0.0f;
-            }
-            m.lo = rb.centers.lo;
-            m.scale = _mm_load_ps(scale);
-            const Split split = best_split(bin_range(refs_, b, e, m), m);
+            const BinMapping m(rb.centers, n);
+            Bins bins(m.count);
+            bin_range(refs_, b, e, m, bins);
+            const Split split = best_split(bins, m);
             const float area = rb.box.half_area();
             const float leaf_cost = kIntersectionCost * static_cast<float>(n);
             const float split_cost =
@@ -299,15 +350,10 @@ class Builder {
                                : kTraversalCost + kIntersectionCost * static_cast<float>(n);
             if (n <= kMaxLeafSize && leaf_cost <= split_cost) return;
             if (split.axis >= 0) {
-                const PrimRef* cut =
-                    std::partition(refs_ + b, refs_ + e, [&](const PrimRef& p) {
-                        std::int32_t k[4];
-                        m.bins(p.center(), k);
-                        return k[split.axis] <= split.bin;
-                    });
-                mid = static_cast<std::uint32_t>(cut - refs_);
-                left = split.left;
-                right = split.right;
+                mid = partition(refs_, b, e, m, split.axis, split.bin, left.centers,
+                                right.centers);
+                left.box = split.left;
+                right.box = split.right;
             }
         } else if (n <= kMaxLeafSize) {
             return;
