@@ -9,41 +9,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/aligned.h"
 #include "core/color.h"
 
 namespace octray {
-
-// std::allocator, except that a value-less construct() leaves the element's bytes alone:
-// a vector of trivially copyable pixels can then be sized without writing them. Storage
-// starts on a cache line, so whole rows of pixels can be streamed to memory
-// (render/packet_renderer.cpp).
-template <class T>
-struct UninitializedAllocator : std::allocator<T> {
-    static constexpr std::align_val_t kAlignment{64};
-    template <class U>
-    struct rebind {
-        using other = UninitializedAllocator<U>;
-    };
-    UninitializedAllocator() = default;
-    template <class U>
-    UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
-
-    T* allocate(std::size_t n) {
-        if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
-        return static_cast<T*>(::operator new(n * sizeof(T), kAlignment));
-    }
-    // The unsized form: clang declares sized deallocation only with -fsized-deallocation.
-    void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, kAlignment); }
-
-    template <class U>
-    void construct(U*) noexcept {
-        static_assert(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>);
-    }
-    template <class U, class... Args>
-    void construct(U* p, Args&&... args) {
-        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-    }
-};
 
 class Image {
   public:

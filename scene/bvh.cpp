@@ -170,7 +170,7 @@ struct BinMapping {
     __m128 lo;
     __m128 scale;  // 0 on an axis without extent (and in w)
     int count;     // bins per axis, 2 ... kBins
-    int axis_has_extent[3];
+    __m128 extent_mask;  // all ones in the lanes of axes with extent
 
     BinMapping(const Box& centers, std::uint32_t n) {
         count = static_cast<int>(std::clamp<std::uint32_t>(n, 2, kBins));
@@ -181,10 +181,10 @@ struct BinMapping {
             // last bin rather than past it (clamped anyway).
             s[a] = extent > 0.0f ? (static_cast<float>(count) * 0.99999f) / extent : 0.0f;
             if (!(s[a] < kInf)) s[a] = 0.0f;  // denormal extent
-            axis_has_extent[a] = s[a] > 0.0f;
         }
         lo = centers.lo;
         scale = _mm_load_ps(s);
+        extent_mask = _mm_cmpgt_ps(scale, _mm_setzero_ps());
     }
     __m128i bins(__m128 center) const {
         __m128 k = _mm_mul_ps(_mm_sub_ps(center, lo), scale);
@@ -194,30 +194,41 @@ struct BinMapping {
     }
 };
 
+// Lanes of `a` where `mask` is set, else lanes of `b`.
+__m128 select(__m128 mask, __m128 a, __m128 b) {
+    return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+
 // Per axis and bin: the spheres' boxes and their count (the children's center bounds come
-// out of the partition, which visits every sphere anyway).
+// out of the partition, which visits every sphere anyway). Counts are kept per bin with
+// the three axes in lanes, as the sweep reads them.
 struct Bins {
     Box box[3][kBins];
-    std::uint32_t count[3][kBins];
+    alignas(16) std::int32_t count[kBins][4];
 
     explicit Bins(int bins) {
-        for (int a = 0; a < 3; ++a)
-            for (int k = 0; k < bins; ++k) box[a][k] = Box{}, count[a][k] = 0;
+        for (int k = 0; k < bins; ++k) {
+            for (int a = 0; a < 3; ++a) box[a][k] = Box{};
+            _mm_store_si128(counts_at(k), _mm_setzero_si128());
+        }
+    }
+    __m128i* counts_at(int k) { return reinterpret_cast<__m128i*>(count[k]); }
+    __m128i counts(int k) const {
+        return _mm_load_si128(reinterpret_cast<const __m128i*>(count[k]));
     }
     void add(const PrimRef& p, const BinMapping& m) {
         alignas(16) std::int32_t k[4];
         _mm_store_si128(reinterpret_cast<__m128i*>(k), m.bins(p.center()));
         for (int a = 0; a < 3; ++a) {
             box[a][k[a]].grow(p.box);
-            ++count[a][k[a]];
+            ++count[k[a]][a];
         }
     }
     void merge(const Bins& o, int bins) {
-        for (int a = 0; a < 3; ++a)
-            for (int k = 0; k < bins; ++k) {
-                box[a][k].grow(o.box[a][k]);
-                count[a][k] += o.count[a][k];
-            }
+        for (int k = 0; k < bins; ++k) {
+            for (int a = 0; a < 3; ++a) box[a][k].grow(o.box[a][k]);
+            _mm_store_si128(counts_at(k), _mm_add_epi32(counts(k), o.counts(k)));
+        }
     }
 };
 
@@ -239,6 +250,15 @@ void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinM
         });
 }
 
+// Half the surface areas of three boxes, one per lane (w: 0). Empty boxes come out
+// infinite (never used: a split with an empty side is skipped).
+__m128 half_areas(const Box (&boxes)[3]) {
+    __m128 x = _mm_sub_ps(boxes[0].hi, boxes[0].lo), y = _mm_sub_ps(boxes[1].hi, boxes[1].lo);
+    __m128 z = _mm_sub_ps(boxes[2].hi, boxes[2].lo), w = _mm_setzero_ps();
+    _MM_TRANSPOSE4_PS(x, y, z, w);  // now x holds the three boxes' x extents, and so on
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+}
+
 struct Split {
     int axis = -1;
     int bin = 0;  // the left side holds bins [0, bin]
@@ -247,100 +267,119 @@ struct Split {
 };
 
 // The cheapest SAH split over every axis and bin boundary (ties: the lower axis, then
-// the lower bin).
+// the lower bin). The three axes are swept at once, one per lane.
 Split best_split(const Bins& bins, const BinMapping& m) {
-    Split best;
     const int nb = m.count;
-    for (int a = 0; a < 3; ++a) {
-        if (!m.axis_has_extent[a]) continue;
-        float right_area[kBins];
-        std::uint32_t right_count[kBins];
-        Box acc;
-        std::uint32_t n = 0;
-        for (int k = nb - 1; k > 0; --k) {
-            acc.grow(bins.box[a][k]);
-            n += bins.count[a][k];
-            right_area[k] = acc.half_area();
-            right_count[k] = n;
-        }
-        Box left;
-        std::uint32_t nl = 0;
-        for (int k = 0; k < nb - 1; ++k) {
-            left.grow(bins.box[a][k]);
-            nl += bins.count[a][k];
-            const std::uint32_t nr = right_count[k + 1];
-            if (nl == 0 || nr == 0) continue;
-            const float cost = left.half_area() * static_cast<float>(nl) +
-                               right_area[k + 1] * static_cast<float>(nr);
-            if (cost < best.cost) {
-                best.axis = a;
-                best.bin = k;
-                best.cost = cost;
-            }
-        }
+    // Bins [k, nb): their boxes' areas and their counts.
+    alignas(16) float right_area[kBins][4];
+    alignas(16) std::int32_t right_count[kBins][4];
+    Box acc[3];
+    __m128i n = _mm_setzero_si128();
+    for (int k = nb - 1; k > 0; --k) {
+        for (int a = 0; a < 3; ++a) acc[a].grow(bins.box[a][k]);
+        n = _mm_add_epi32(n, bins.counts(k));
+        _mm_store_ps(right_area[k], half_areas(acc));
+        _mm_store_si128(reinterpret_cast<__m128i*>(right_count[k]), n);
     }
+    // Bins [0, k] against bins [k + 1, nb): the cheapest k per axis.
+    Box left[3];
+    __m128i nl = _mm_setzero_si128();
+    __m128 best_cost = _mm_set1_ps(kInf);
+    __m128i best_bin = _mm_setzero_si128();
+    const __m128i zero = _mm_setzero_si128();
+    for (int k = 0; k < nb - 1; ++k) {
+        for (int a = 0; a < 3; ++a) left[a].grow(bins.box[a][k]);
+        nl = _mm_add_epi32(nl, bins.counts(k));
+        const __m128i nr =
+            _mm_load_si128(reinterpret_cast<const __m128i*>(right_count[k + 1]));
+        const __m128 cost =
+            _mm_add_ps(_mm_mul_ps(half_areas(left), _mm_cvtepi32_ps(nl)),
+                       _mm_mul_ps(_mm_load_ps(right_area[k + 1]), _mm_cvtepi32_ps(nr)));
+        const __m128 empty_side = _mm_castsi128_ps(
+            _mm_or_si128(_mm_cmpeq_epi32(nl, zero), _mm_cmpeq_epi32(nr, zero)));
+        const __m128 better =
+            _mm_andnot_ps(empty_side, _mm_and_ps(m.extent_mask, _mm_cmplt_ps(cost, best_cost)));
+        best_cost = select(better, cost, best_cost);
+        best_bin = _mm_or_si128(_mm_and_si128(_mm_castps_si128(better), _mm_set1_epi32(k)),
+                                _mm_andnot_si128(_mm_castps_si128(better), best_bin));
+    }
+    alignas(16) float costs[4];
+    alignas(16) std::int32_t bins_at[4];
+    _mm_store_ps(costs, best_cost);
+    _mm_store_si128(reinterpret_cast<__m128i*>(bins_at), best_bin);
+    Split best;
+    for (int a = 0; a < 3; ++a)
+        if (costs[a] < best.cost) best.axis = a, best.bin = bins_at[a], best.cost = costs[a];
     if (best.axis >= 0)
         for (int k = 0; k < nb; ++k)
             (k <= best.bin ? best.left : best.right).grow(bins.box[best.axis][k]);
     return best;
 }
 
-// Moves the spheres whose center lies in bins [0, split.bin] of `axis` to the front of
-// [b, e) (Hoare's partition: each misplaced pair swapped once) and returns where the rest
-// begin; the two sides' center bounds come out on the way.
-std::uint32_t partition(PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
-                        int axis, int bin, Box& left_centers, Box& right_centers) {
-    const auto goes_left = [&](__m128 center) {
-        alignas(16) std::int32_t k[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(k), m.bins(center));
-        return k[axis] <= bin;
-    };
-    PrimRef* l = refs + b;
-    PrimRef* r = refs + e;
+// Copies the spheres of [b, e) from `src` to `dst`, those whose center lies in bins
+// [0, bin] of `axis` first, and returns where the rest begin; the two sides' center
+// bounds come out on the way. Branch-free (which side a sphere goes to is a coin toss
+// the CPU cannot predict): each sphere goes to the next free slot at the front or at the
+// back of [b, e) (the right side comes out reversed).
+std::uint32_t partition(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
+                        const BinMapping& m, int axis, int bin, Box& left_centers,
+                        Box& right_centers) {
+    const __m128i last_left = _mm_set1_epi32(bin);
+    const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
     Box lc, rc;
-    for (;;) {
-        for (; l < r; ++l) {
-            const __m128 c = l->center();
-            if (!goes_left(c)) break;
-            lc.grow(c);
-        }
-        for (; l < r; --r) {
-            const __m128 c = (r - 1)->center();
-            if (goes_left(c)) break;
-            rc.grow(c);
-        }
-        if (l == r) break;
-        // *l goes right, *(r - 1) left.
-        --r;
-        std::swap(*l, *r);
-        lc.grow(l->center());
-        rc.grow(r->center());
-        ++l;
+    PrimRef* front = dst + b;
+    PrimRef* back = dst + e;
+    for (std::uint32_t i = b; i < e; ++i) {
+        const PrimRef p = src[i];
+        const __m128 c = p.center();
+        alignas(16) std::int32_t right_lanes[4];  // -1 where the bin lies right of `bin`
+        _mm_store_si128(reinterpret_cast<__m128i*>(right_lanes),
+                        _mm_cmpgt_epi32(m.bins(c), last_left));
+        const std::int32_t right = right_lanes[axis];
+        *(right ? back - 1 : front) = p;
+        front += 1 + right;
+        back += right;
+        // The side's bounds grow by the center, the other side's by an empty box.
+        const __m128 to_right = _mm_castsi128_ps(_mm_set1_epi32(right));
+        lc.grow(Box{select(to_right, inf, c), select(to_right, minus_inf, c)});
+        rc.grow(Box{select(to_right, c, inf), select(to_right, c, minus_inf)});
     }
     left_centers = lc;
     right_centers = rc;
-    return static_cast<std::uint32_t>(l - refs);
+    return static_cast<std::uint32_t>(front - dst);
 }
 
 class Builder {
   public:
-    Builder(PrimRef* refs, BinaryNode* nodes) : refs_(refs), nodes_(nodes) {}
+    // The spheres start in `refs` and end there in leaf order; the partitions move them
+    // back and forth between `refs` and `scratch` (as many spheres), level by level.
+    Builder(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes)
+        : refs_(refs), scratch_(scratch), nodes_(nodes) {}
 
-    // Builds the subtree of primitives [b, e) into slots [slot, slot + 2(e - b) - 1).
+    void build(const RangeBounds& rb, std::uint32_t n) { build(0, 0, n, rb, 0, refs_); }
+
+  private:
+    // Builds the subtree of spheres [b, e), which lie in `src` (refs_ or scratch_), into
+    // slots [slot, slot + 2(e - b) - 1).
     void build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
-               std::uint32_t depth) {
+               std::uint32_t depth, PrimRef* src) {
         BinaryNode& node = nodes_[slot];
         for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
         node.mid = 0;
         const std::uint32_t n = e - b;
-        if (n == 1) return;
+        const auto leaf = [&] {
+            if (src != refs_) std::copy(src + b, src + e, refs_ + b);
+        };
+        if (n == 1) return leaf();
 
+        PrimRef* const other = src == refs_ ? scratch_ : refs_;
+        PrimRef* children_src = src;
         std::uint32_t mid = 0;
         RangeBounds left, right;
         if (depth < kMaxSahDepth) {
             const BinMapping m(rb.centers, n);
             Bins bins(m.count);
-            bin_range(refs_, b, e, m, bins);
+            bin_range(src, b, e, m, bins);
             const Split split = best_split(bins, m);
             const float area = rb.box.half_area();
             const float leaf_cost = kIntersectionCost * static_cast<float>(n);
@@ -348,35 +387,37 @@ class Builder {
                 split.axis < 0 ? kInf
                 : area > 0.0f  ? kTraversalCost + kIntersectionCost * split.cost / area
                                : kTraversalCost + kIntersectionCost * static_cast<float>(n);
-            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return;
+            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return leaf();
             if (split.axis >= 0) {
-                mid = partition(refs_, b, e, m, split.axis, split.bin, left.centers,
+                mid = partition(src, other, b, e, m, split.axis, split.bin, left.centers,
                                 right.centers);
+                children_src = other;
                 left.box = split.left;
                 right.box = split.right;
             }
         } else if (n <= kMaxLeafSize) {
-            return;
+            return leaf();
         }
         // Every center in one bin (coincident spheres) or too deep: the middle index.
         if (mid <= b || mid >= e) {
             mid = b + n / 2;
-            left = range_bounds(refs_, b, mid);
-            right = range_bounds(refs_, mid, e);
+            left = range_bounds(src, b, mid);
+            right = range_bounds(src, mid, e);
         }
         node.mid = mid;
         const std::uint32_t left_slot = slot + 1, right_slot = slot + 2 * (mid - b);
         if (n >= kParallelSubtree) {
-            tbb::parallel_invoke([&] { build(left_slot, b, mid, left, depth + 1); },
-                                 [&] { build(right_slot, mid, e, right, depth + 1); });
+            tbb::parallel_invoke(
+                [&] { build(left_slot, b, mid, left, depth + 1, children_src); },
+                [&] { build(right_slot, mid, e, right, depth + 1, children_src); });
         } else {
-            build(left_slot, b, mid, left, depth + 1);
-            build(right_slot, mid, e, right, depth + 1);
+            build(left_slot, b, mid, left, depth + 1, children_src);
+            build(right_slot, mid, e, right, depth + 1, children_src);
         }
     }
 
-  private:
     PrimRef* refs_;
+    PrimRef* scratch_;
     BinaryNode* nodes_;
 };
 
@@ -475,7 +516,8 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
 
     // Each sphere's box c ± sqrt(r2), computed in double and rounded outwards: it holds
     // every point of the sphere the kernels intersect (which knows only r2).
-    std::unique_ptr<PrimRef[]> refs(new PrimRef[n]);
+    using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef>>;
+    PrimRefs refs(n);
     tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
                       [&](const tbb::blocked_range<std::uint32_t>& r) {
                           // c -+ r rounded outwards in float: sqrtf is exact to half an
@@ -509,7 +551,11 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
 
     // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
     std::unique_ptr<BinaryNode[]> binary(new BinaryNode[2 * static_cast<std::size_t>(n) - 1]);
-    Builder(refs.get(), binary.get()).build(0, 0, n, range_bounds(refs.get(), 0, n), 0);
+    {
+        PrimRefs scratch(n);
+        Builder(refs.data(), scratch.data(), binary.get())
+            .build(range_bounds(refs.data(), 0, n), n);
+    }
     const Box root{_mm_setr_ps(binary[0].lo[0], binary[0].lo[1], binary[0].lo[2], 0.0f),
                    _mm_setr_ps(binary[0].hi[0], binary[0].hi[1], binary[0].hi[2], 0.0f)};
 
