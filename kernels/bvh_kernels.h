@@ -331,9 +331,14 @@ bool bvh_occluded_ray(const SceneView& s, const BvhPacket& p, std::uint32_t lane
 // Packets: the 8 rays against one child box at a time.
 
 // Lanes of the packet whose widened box of child j meets the ray on [t_near, t_far[lane]].
+// Always inlined: a node runs it for each of its 8 children, and as a call (which GCC
+// chose) each one also paid for the call and a vzeroupper.
 template <class F>
-std::uint32_t packet_child_lanes(const BvhNode8& n, std::uint32_t j, const BvhPacket& p,
-                                 const F& t_near, const float* t_far) {
+[[gnu::always_inline]] inline std::uint32_t packet_child_lanes(const BvhNode8& n,
+                                                               std::uint32_t j,
+                                                               const BvhPacket& p,
+                                                               const F& t_near,
+                                                               const float* t_far) {
     constexpr std::uint32_t W = F::size;
     const F min_x(n.min_x[j]), max_x(n.max_x[j]), min_y(n.min_y[j]), max_y(n.max_y[j]);
     const F min_z(n.min_z[j]), max_z(n.max_z[j]);

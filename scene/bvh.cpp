@@ -168,8 +168,8 @@ RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e) 
 // counts exactly.
 struct BinMapping {
     __m128 lo;
-    __m128 scale;  // 0 on an axis without extent (and in w)
-    int count;     // bins per axis, 2 ... kBins
+    __m128 scale;        // 0 on an axis without extent (and in w)
+    int count;           // bins per axis, 2 ... kBins
     __m128 extent_mask;  // all ones in the lanes of axes with extent
 
     BinMapping(const Box& centers, std::uint32_t n) {
@@ -290,8 +290,7 @@ Split best_split(const Bins& bins, const BinMapping& m) {
     for (int k = 0; k < nb - 1; ++k) {
         for (int a = 0; a < 3; ++a) left[a].grow(bins.box[a][k]);
         nl = _mm_add_epi32(nl, bins.counts(k));
-        const __m128i nr =
-            _mm_load_si128(reinterpret_cast<const __m128i*>(right_count[k + 1]));
+        const __m128i nr = _mm_load_si128(reinterpret_cast<const __m128i*>(right_count[k + 1]));
         const __m128 cost =
             _mm_add_ps(_mm_mul_ps(half_areas(left), _mm_cvtepi32_ps(nl)),
                        _mm_mul_ps(_mm_load_ps(right_area[k + 1]), _mm_cvtepi32_ps(nr)));
