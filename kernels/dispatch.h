@@ -49,8 +49,8 @@ const kernels::KernelTable& kernel_table(Isa isa);
 kernels::SceneView make_scene_view(const CompiledScene& scene);
 
 // Packets with fewer live lanes than this continue ray by ray in the BVH (measured:
-// kernels/README.md, "The BVH").
-inline constexpr std::uint32_t kBvhPacketMinLanes = 3;
+// bench/README.md, "The packet → single-ray switch").
+inline constexpr std::uint32_t kBvhPacketMinLanes = 2;
 
 // The same with the spheres' BVH built from `scene` (scene/bvh.h); both must outlive the
 // view. An empty BVH (no spheres) leaves the view brute force.
