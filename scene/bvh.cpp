@@ -18,8 +18,8 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
-#include <memory>
 #include <stdexcept>
+#include <vector>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -549,10 +549,11 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
                       });
 
     // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
-    std::unique_ptr<BinaryNode[]> binary(new BinaryNode[2 * static_cast<std::size_t>(n) - 1]);
+    std::vector<BinaryNode, UninitializedAllocator<BinaryNode>> binary(
+        2 * static_cast<std::size_t>(n) - 1);
     {
         PrimRefs scratch(n);
-        Builder(refs.data(), scratch.data(), binary.get())
+        Builder(refs.data(), scratch.data(), binary.data())
             .build(range_bounds(refs.data(), 0, n), n);
     }
     const Box root{_mm_setr_ps(binary[0].lo[0], binary[0].lo[1], binary[0].lo[2], 0.0f),
@@ -560,8 +561,8 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
 
     // 8-wide nodes, preorder.
     bvh.nodes.reserve(n / 4 + 1);
-    Collapser(binary.get(), bvh).emit(0, 0, n, 1);
-    binary.reset();
+    Collapser(binary.data(), bvh).emit(0, 0, n, 1);
+    binary = {};
 
     // The spheres in leaf order, padded with a packet of never-hit entries.
     const std::uint32_t padded = n + kBvhWidth;

@@ -33,5 +33,24 @@ TEST(AlignedVector, StorageIsSixtyFourByteAligned) {
     }
 }
 
+// From 4 MiB on, storage starts on a huge page (2 MiB); both allocators free what they
+// allocated with the alignment they allocated it with (ASan checks the pairing).
+TEST(AlignedVector, LargeStorageStartsOnAHugePage) {
+    const std::size_t large = kHugePageMinBytes / sizeof(float);
+    for (std::size_t n : {large - 1, large, 3 * large + 5}) {
+        AlignedVector<float> v(n, 1.0f);
+        const auto at = reinterpret_cast<std::uintptr_t>(v.data());
+        EXPECT_EQ(at % (n >= large ? kHugePageBytes : kSimdAlignment), 0u) << n;
+        EXPECT_EQ(v[n - 1], 1.0f);
+        std::vector<float, UninitializedAllocator<float>> u(n);
+        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(u.data()) %
+                      (n >= large ? kHugePageBytes : kSimdAlignment),
+                  0u)
+            << n;
+        u[n - 1] = 2.0f;
+        EXPECT_EQ(u[n - 1], 2.0f);
+    }
+}
+
 }  // namespace
 }  // namespace octray
