@@ -8,7 +8,8 @@
 // so any TBB split gives the same bins); a partition is one serial pass over its range; each
 // binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
 // preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
-// depends on which thread got there first; the 8-wide collapse runs serially in preorder.
+// depends on which thread got there first; the 8-wide collapse hands large subtrees to
+// tasks and appends their nodes in child order, whichever task finishes first.
 
 #include "scene/bvh.h"
 
@@ -82,6 +83,8 @@ constexpr float kIntersectionCost = 0.25f;
 // Below this many spheres a subtree (or a binning pass) runs in one task.
 constexpr std::uint32_t kParallelSubtree = 4096;
 constexpr std::uint32_t kParallelBinning = 1u << 15;
+// The 8-wide collapse hands subtrees of this many spheres or more to tasks of their own.
+constexpr std::uint32_t kParallelCollapse = 1024;
 // Beyond this binary depth, subtrees are split at the middle index: the depth (and so the
 // kernels' traversal stack) stays bounded whatever the spheres' layout.
 constexpr std::uint32_t kMaxSahDepth = 48;
@@ -420,13 +423,56 @@ class Builder {
     BinaryNode* nodes_;
 };
 
+// The 8-wide nodes of a subtree: its root first, inner child references relative to its
+// own first node.
+struct Collapsed {
+    AlignedVector<BvhNode8> nodes;
+    std::uint32_t leaf_count = 0;
+    std::uint32_t depth = 0;
+};
+
 class Collapser {
   public:
-    Collapser(const BinaryNode* binary, SphereBvh& out) : binary_(binary), out_(out) {}
+    explicit Collapser(const BinaryNode* binary) : binary_(binary) {}
+
+    // Collapses the binary subtree at `slot` (spheres [b, e), at 8-wide level `depth`) into
+    // `out`, its root at out.nodes[0]. Subtrees of kParallelCollapse spheres or more are
+    // collapsed by tasks of their own and appended after the rest, in child order: the
+    // nodes come out the same for any number of threads.
+    void collapse(std::uint32_t slot, std::uint32_t b, std::uint32_t e, std::uint32_t depth,
+                  Collapsed& out) const {
+        std::vector<Deferred> deferred;
+        emit(slot, b, e, depth, out, deferred);
+        if (deferred.empty()) return;
+        std::vector<Collapsed> parts(deferred.size());
+        tbb::parallel_for(std::size_t{0}, deferred.size(), [&](std::size_t i) {
+            const Deferred& d = deferred[i];
+            collapse(d.slot, d.b, d.e, d.depth, parts[i]);
+        });
+        for (std::size_t i = 0; i < parts.size(); ++i) {
+            const auto offset = static_cast<std::uint32_t>(out.nodes.size());
+            for (BvhNode8 node : parts[i].nodes) {
+                for (std::uint32_t& child : node.child)
+                    if ((child & kBvhLeafBit) == 0) child += offset;  // kBvhEmpty has the bit
+                out.nodes.push_back(node);
+            }
+            out.nodes[deferred[i].parent].child[deferred[i].child] = offset;
+            out.leaf_count += parts[i].leaf_count;
+            out.depth = std::max(out.depth, parts[i].depth);
+        }
+    }
+
+  private:
+    // A subtree left for its own task, and the child slot that will point at it.
+    struct Deferred {
+        std::uint32_t slot, b, e, depth;
+        std::uint32_t parent, child;
+    };
 
     std::uint32_t emit(std::uint32_t slot, std::uint32_t b, std::uint32_t e,
-                       std::uint32_t depth) {
-        out_.depth = std::max(out_.depth, depth);
+                       std::uint32_t depth, Collapsed& out,
+                       std::vector<Deferred>& deferred) const {
+        out.depth = std::max(out.depth, depth);
         struct Child {
             std::uint32_t slot, b, e;
         };
@@ -462,19 +508,22 @@ class Collapser {
             ++count;
         }
 
-        const auto index = static_cast<std::uint32_t>(out_.nodes.size());
-        out_.nodes.emplace_back();
+        const auto index = static_cast<std::uint32_t>(out.nodes.size());
+        out.nodes.emplace_back();
         std::uint32_t refs[kBvhWidth];
         for (std::uint32_t i = 0; i < count; ++i) {
             const Child& c = children[i];
             if (binary_[c.slot].mid == 0) {
-                ++out_.leaf_count;
+                ++out.leaf_count;
                 refs[i] = kBvhLeafBit | (c.b << kBvhLeafCountBits) | (c.e - c.b - 1);
+            } else if (c.e - c.b >= kParallelCollapse) {
+                deferred.push_back({c.slot, c.b, c.e, depth + 1, index, i});
+                refs[i] = kBvhEmpty;  // set when the task's nodes are appended
             } else {
-                refs[i] = emit(c.slot, c.b, c.e, depth + 1);
+                refs[i] = emit(c.slot, c.b, c.e, depth + 1, out, deferred);
             }
         }
-        BvhNode8& node = out_.nodes[index];  // after the recursion: emplace_back moves nodes
+        BvhNode8& node = out.nodes[index];  // after the recursion: emplace_back moves nodes
         for (std::uint32_t i = 0; i < kBvhWidth; ++i) {
             const bool used = i < count;
             const BinaryNode* bn = used ? &binary_[children[i].slot] : nullptr;
@@ -486,7 +535,6 @@ class Collapser {
         return index;
     }
 
-  private:
     float half_area(std::uint32_t slot) const {
         const BinaryNode& b = binary_[slot];
         const float dx = b.hi[0] - b.lo[0], dy = b.hi[1] - b.lo[1], dz = b.hi[2] - b.lo[2];
@@ -494,7 +542,6 @@ class Collapser {
     }
 
     const BinaryNode* binary_;
-    SphereBvh& out_;
 };
 
 }  // namespace
@@ -559,9 +606,12 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
     const Box root{_mm_setr_ps(binary[0].lo[0], binary[0].lo[1], binary[0].lo[2], 0.0f),
                    _mm_setr_ps(binary[0].hi[0], binary[0].hi[1], binary[0].hi[2], 0.0f)};
 
-    // 8-wide nodes, preorder.
-    bvh.nodes.reserve(n / 4 + 1);
-    Collapser(binary.data(), bvh).emit(0, 0, n, 1);
+    // 8-wide nodes: preorder, but for the subtrees collapsed by tasks of their own.
+    Collapsed collapsed;
+    Collapser(binary.data()).collapse(0, 0, n, 1, collapsed);
+    bvh.nodes = std::move(collapsed.nodes);
+    bvh.leaf_count = collapsed.leaf_count;
+    bvh.depth = collapsed.depth;
     binary = {};
 
     // The spheres in leaf order, padded with a packet of never-hit entries.

@@ -178,8 +178,12 @@ DBox check_node(const SphereBvh& bvh, std::uint32_t index, std::vector<int>& see
                     box.hi[a] = std::max(box.hi[a], c[a] + r);
                 }
             }
+        } else if (ref <= index || ref >= bvh.nodes.size()) {
+            // (Not walked: a cycle would recurse forever.)
+            ADD_FAILURE() << "node " << index << " child " << j << " refers to node " << ref
+                          << ": children come after their parent, within the tree";
+            continue;
         } else {
-            EXPECT_GT(ref, index) << "preorder";
             box = check_node(bvh, ref, seen, depth + 1, max_depth);
         }
         EXPECT_TRUE(box_contains(n, j, box.lo, box.hi)) << "node " << index << " child " << j;
@@ -197,7 +201,8 @@ void check_nesting(const SphereBvh& bvh, std::uint32_t index) {
     const BvhNode8& n = bvh.nodes[index];
     for (int j = 0; j < 8; ++j) {
         const std::uint32_t ref = n.child[j];
-        if (ref == kBvhEmpty || (ref & kBvhLeafBit)) continue;
+        if (ref == kBvhEmpty || (ref & kBvhLeafBit) || ref <= index || ref >= bvh.nodes.size())
+            continue;  // (check_node reports a child before its parent)
         const BvhNode8& c = bvh.nodes[ref];
         for (int k = 0; k < 8 && c.child[k] != kBvhEmpty; ++k) {
             const double lo[3] = {c.min_x[k], c.min_y[k], c.min_z[k]};
@@ -208,37 +213,60 @@ void check_nesting(const SphereBvh& bvh, std::uint32_t index) {
     }
 }
 
-TEST(SphereBvh, Invariants) {
-    for (const NamedScene& ns : test_scenes()) {
-        SCOPED_TRACE(ns.name);
-        const CompiledScene c = compile_scene(ns.scene);
-        const SphereBvh bvh = build_sphere_bvh(c.spheres);
-        ASSERT_EQ(bvh.sphere_count, c.spheres.count);
-        ASSERT_FALSE(bvh.nodes.empty());
-        std::vector<int> seen(bvh.sphere_count, 0);
-        std::uint32_t depth = 0;
-        check_node(bvh, 0, seen, 1, depth);
-        check_nesting(bvh, 0);
-        EXPECT_EQ(depth, bvh.depth);
-        for (std::uint32_t i = 0; i < bvh.sphere_count; ++i)
-            EXPECT_EQ(seen[i], 1) << "sphere slot " << i << " in exactly one leaf";
-        // The leaf arrays are a permutation of the scene's spheres, objects once each.
-        std::vector<int> object_seen(c.objects.count, 0);
-        for (std::uint32_t i = 0; i < bvh.sphere_count; ++i) {
-            const std::uint32_t obj = bvh.object[i];
-            ASSERT_LT(obj, c.objects.count);
-            ++object_seen[obj];
-            EXPECT_EQ(c.objects.is_plane[obj], 0u);
-            EXPECT_EQ(bvh.cx[i], c.objects.cx[obj]);
-            EXPECT_EQ(bvh.r2[i], c.objects.radius[obj] * c.objects.radius[obj]);
-        }
-        for (std::uint32_t k = 0; k < c.objects.count; ++k)
-            EXPECT_EQ(object_seen[k], c.objects.is_plane[k] ? 0 : 1) << "object " << k;
-        // Padding: a packet of never-hit entries.
-        ASSERT_EQ(bvh.cx.size(), bvh.sphere_count + 8u);
-        EXPECT_TRUE(std::isnan(bvh.r2[bvh.sphere_count]));
-        EXPECT_GT(bvh.memory_bytes(), 0u);
+// Every sphere in exactly one leaf, boxes that contain their spheres and children, the
+// leaf arrays a permutation of the scene's spheres.
+void check_invariants(const NamedScene& ns) {
+    SCOPED_TRACE(ns.name);
+    const CompiledScene c = compile_scene(ns.scene);
+    const SphereBvh bvh = build_sphere_bvh(c.spheres);
+    ASSERT_EQ(bvh.sphere_count, c.spheres.count);
+    ASSERT_FALSE(bvh.nodes.empty());
+    std::vector<int> seen(bvh.sphere_count, 0);
+    std::uint32_t depth = 0;
+    check_node(bvh, 0, seen, 1, depth);
+    check_nesting(bvh, 0);
+    EXPECT_EQ(depth, bvh.depth);
+    for (std::uint32_t i = 0; i < bvh.sphere_count; ++i)
+        EXPECT_EQ(seen[i], 1) << "sphere slot " << i << " in exactly one leaf";
+    // The leaf arrays are a permutation of the scene's spheres, objects once each.
+    std::vector<int> object_seen(c.objects.count, 0);
+    for (std::uint32_t i = 0; i < bvh.sphere_count; ++i) {
+        const std::uint32_t obj = bvh.object[i];
+        ASSERT_LT(obj, c.objects.count);
+        ++object_seen[obj];
+        EXPECT_EQ(c.objects.is_plane[obj], 0u);
+        EXPECT_EQ(bvh.cx[i], c.objects.cx[obj]);
+        EXPECT_EQ(bvh.r2[i], c.objects.radius[obj] * c.objects.radius[obj]);
     }
+    for (std::uint32_t k = 0; k < c.objects.count; ++k)
+        EXPECT_EQ(object_seen[k], c.objects.is_plane[k] ? 0 : 1) << "object " << k;
+    // Padding: a packet of never-hit entries.
+    ASSERT_EQ(bvh.cx.size(), bvh.sphere_count + 8u);
+    EXPECT_TRUE(std::isnan(bvh.r2[bvh.sphere_count]));
+    EXPECT_GT(bvh.memory_bytes(), 0u);
+}
+
+// Large enough that the builder's tasks collapse subtrees of their own (scene/bvh.cpp:
+// 1024 spheres or more), whose nodes are appended and relocated.
+NamedScene large_scene() {
+    std::mt19937 rng(2026);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), u01(0.0f, 1.0f);
+    std::vector<Object> o;
+    for (int i = 0; i < 20000; ++i)
+        o.push_back(sphere({3 * unit(rng), 3 * unit(rng), 3 * unit(rng)},
+                           0.005f + 0.03f * u01(rng)));
+    return {"20000 spheres", scene_of(o)};
+}
+
+TEST(SphereBvh, Invariants) {
+    for (const NamedScene& ns : test_scenes()) check_invariants(ns);
+}
+
+TEST(SphereBvh, InvariantsOfALargeTree) {
+    const NamedScene ns = large_scene();
+    check_invariants(ns);
+    const SphereBvh bvh = build_sphere_bvh(compile_scene(ns.scene).spheres);
+    EXPECT_GT(bvh.nodes.size(), 256u);
 }
 
 TEST(SphereBvh, NoSpheresNoTree) {
@@ -472,6 +500,11 @@ TYPED_TEST(BvhTraversalTest, PacketsOnly) {
 
 TYPED_TEST(BvhTraversalTest, SingleRaysOnly) {
     for (const NamedScene& ns : test_scenes()) this->check(ns, 9, 600);
+}
+
+TYPED_TEST(BvhTraversalTest, LargeTree) {
+    const NamedScene ns = large_scene();
+    for (std::uint32_t lanes : {0u, 2u, 9u}) this->check(ns, lanes, 400);
 }
 
 }  // namespace
