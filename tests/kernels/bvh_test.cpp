@@ -57,6 +57,17 @@ Scene scene_of(std::vector<Object> objects) {
     return s;
 }
 
+// `count` spheres, centers uniform in [-spread, spread)^3, radii in [r_min, r_min + r_span).
+std::vector<Object> random_spheres(std::mt19937& rng, int count, float spread, float r_min,
+                                   float r_span) {
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), u01(0.0f, 1.0f);
+    std::vector<Object> o;
+    for (int i = 0; i < count; ++i)
+        o.push_back(sphere({spread * unit(rng), spread * unit(rng), spread * unit(rng)},
+                           r_min + r_span * u01(rng)));
+    return o;
+}
+
 // The scenes every test runs on: name and objects.
 struct NamedScene {
     std::string name;
@@ -67,13 +78,7 @@ std::vector<NamedScene> test_scenes() {
     std::vector<NamedScene> out;
     std::mt19937 rng(12345);
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f), u01(0.0f, 1.0f);
-    {
-        std::vector<Object> o;
-        for (int i = 0; i < 700; ++i)
-            o.push_back(sphere({2 * unit(rng), 2 * unit(rng), 2 * unit(rng)},
-                               0.02f + 0.2f * u01(rng)));
-        out.push_back({"random", scene_of(o)});
-    }
+    out.push_back({"random", scene_of(random_spheres(rng, 700, 2.0f, 0.02f, 0.2f))});
     out.push_back({"one sphere", scene_of({sphere({0.3f, -0.2f, 0.1f}, 0.7f)})});
     {
         std::vector<Object> o;
@@ -250,12 +255,7 @@ void check_invariants(const NamedScene& ns) {
 // 1024 spheres or more), whose nodes are appended and relocated.
 NamedScene large_scene() {
     std::mt19937 rng(2026);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), u01(0.0f, 1.0f);
-    std::vector<Object> o;
-    for (int i = 0; i < 20000; ++i)
-        o.push_back(sphere({3 * unit(rng), 3 * unit(rng), 3 * unit(rng)},
-                           0.005f + 0.03f * u01(rng)));
-    return {"20000 spheres", scene_of(o)};
+    return {"20000 spheres", scene_of(random_spheres(rng, 20000, 3.0f, 0.005f, 0.03f))};
 }
 
 TEST(SphereBvh, Invariants) {
