@@ -1,6 +1,6 @@
 #pragma once
 // 64-byte aligned storage for the SoA arrays the kernels stream through (one cache line,
-// and the alignment of a 512-bit register). Large arrays go on transparent huge pages.
+// and the alignment of a 512-bit register); large scratch buffers on huge pages.
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -17,75 +17,84 @@ namespace octray {
 
 inline constexpr std::size_t kSimdAlignment = 64;
 
-// Arrays from 4 MiB on (a big scene's BVH and spheres, the builder's buffers, a frame)
-// start on a 2 MiB boundary and are offered to Linux's transparent huge pages, which
-// Debian's kernel gives only where asked (madvise): a 2 MiB page takes one page fault
-// where 4 KiB pages take 512, and one TLB entry covers it. Building the BVH of
-// random:1048576 took 15 % less time with them.
+// Storage that asks for Pages::huge and holds 4 MiB or more starts on a 2 MiB boundary and
+// is offered to Linux's transparent huge pages, which Debian's kernel gives only where
+// asked (madvise): a 2 MiB page takes one page fault where 4 KiB pages take 512. The BVH
+// and its builder's buffers ask (building random:1048576 took 15 % less time); frames
+// do not: a frame is allocated per render, and rendering whitted and random:64 went 5-20 %
+// slower with its pages huge (the kernel zeroes, and may first compact, 2 MiB at a time).
+enum class Pages { normal, huge };
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 inline constexpr std::size_t kHugePageMinBytes = std::size_t{4} << 20;
 
-inline std::align_val_t storage_alignment(std::size_t bytes) {
-    return std::align_val_t{bytes >= kHugePageMinBytes ? kHugePageBytes : kSimdAlignment};
+inline std::align_val_t storage_alignment(std::size_t bytes, Pages pages) {
+    return std::align_val_t{pages == Pages::huge && bytes >= kHugePageMinBytes ? kHugePageBytes
+                                                                               : kSimdAlignment};
 }
 
-// `bytes` of uninitialised storage aligned as above; release with free_aligned(p, bytes).
-inline void* allocate_aligned(std::size_t bytes) {
-    void* p = ::operator new(bytes, storage_alignment(bytes));
+// `bytes` of uninitialised storage aligned as above; release with free_aligned(p, bytes,
+// pages).
+inline void* allocate_aligned(std::size_t bytes, Pages pages = Pages::normal) {
+    void* p = ::operator new(bytes, storage_alignment(bytes, pages));
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     // Advice only: where the kernel has no huge pages the call fails and nothing changes.
-    if (bytes >= kHugePageMinBytes) (void)madvise(p, bytes, MADV_HUGEPAGE);
+    if (pages == Pages::huge && bytes >= kHugePageMinBytes)
+        (void)madvise(p, bytes, MADV_HUGEPAGE);
 #endif
     return p;
 }
 // The unsized form: clang declares sized deallocation only with -fsized-deallocation.
-inline void free_aligned(void* p, std::size_t bytes) noexcept {
-    ::operator delete(p, storage_alignment(bytes));
+inline void free_aligned(void* p, std::size_t bytes, Pages pages = Pages::normal) noexcept {
+    ::operator delete(p, storage_alignment(bytes, pages));
 }
 
-template <class T>
+template <class T, Pages kPages = Pages::normal>
 struct AlignedAllocator {
     using value_type = T;
+    template <class U>
+    struct rebind {
+        using other = AlignedAllocator<U, kPages>;
+    };
 
     AlignedAllocator() = default;
     template <class U>
-    constexpr AlignedAllocator(const AlignedAllocator<U>&) noexcept {}
+    constexpr AlignedAllocator(const AlignedAllocator<U, kPages>&) noexcept {}
 
     T* allocate(std::size_t n) {
         if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
-        return static_cast<T*>(allocate_aligned(n * sizeof(T)));
+        return static_cast<T*>(allocate_aligned(n * sizeof(T), kPages));
     }
-    void deallocate(T* p, std::size_t n) noexcept { free_aligned(p, n * sizeof(T)); }
+    void deallocate(T* p, std::size_t n) noexcept { free_aligned(p, n * sizeof(T), kPages); }
 
     template <class U>
-    friend bool operator==(const AlignedAllocator&, const AlignedAllocator<U>&) {
+    friend bool operator==(const AlignedAllocator&, const AlignedAllocator<U, kPages>&) {
         return true;
     }
 };
 
-template <class T>
-using AlignedVector = std::vector<T, AlignedAllocator<T>>;
+template <class T, Pages kPages = Pages::normal>
+using AlignedVector = std::vector<T, AlignedAllocator<T, kPages>>;
 
 // std::allocator, except that a value-less construct() leaves the element's bytes alone:
 // a vector of trivially copyable elements (pixels, the BVH builder's sphere references)
 // can then be sized without writing them, and its pages are first touched by the threads
 // that fill them. Storage is aligned as above (at least a cache line), so whole rows of
 // pixels can be streamed to memory (render/packet_renderer.cpp).
-template <class T>
+template <class T, Pages kPages = Pages::normal>
 struct UninitializedAllocator : std::allocator<T> {
     template <class U>
     struct rebind {
-        using other = UninitializedAllocator<U>;
+        using other = UninitializedAllocator<U, kPages>;
     };
     UninitializedAllocator() = default;
     template <class U>
-    UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+    UninitializedAllocator(const UninitializedAllocator<U, kPages>&) noexcept {}
 
     T* allocate(std::size_t n) {
         if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
-        return static_cast<T*>(allocate_aligned(n * sizeof(T)));
+        return static_cast<T*>(allocate_aligned(n * sizeof(T), kPages));
     }
-    void deallocate(T* p, std::size_t n) noexcept { free_aligned(p, n * sizeof(T)); }
+    void deallocate(T* p, std::size_t n) noexcept { free_aligned(p, n * sizeof(T), kPages); }
 
     template <class U>
     void construct(U*) noexcept {

@@ -428,7 +428,7 @@ class Builder {
 // The 8-wide nodes of a subtree: its root first, inner child references relative to its
 // own first node.
 struct Collapsed {
-    AlignedVector<BvhNode8> nodes;
+    AlignedVector<BvhNode8, Pages::huge> nodes;
     std::uint32_t leaf_count = 0;
     std::uint32_t depth = 0;
 };
@@ -564,7 +564,8 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
 
     // Each sphere's box c ± sqrt(r2), computed in double and rounded outwards: it holds
     // every point of the sphere the kernels intersect (which knows only r2).
-    using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef>>;
+    // The builder's buffers (references twice, binary nodes) on huge pages: core/aligned.h.
+    using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef, Pages::huge>>;
     PrimRefs refs(n);
     tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
                       [&](const tbb::blocked_range<std::uint32_t>& r) {
@@ -598,7 +599,7 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
                       });
 
     // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
-    std::vector<BinaryNode, UninitializedAllocator<BinaryNode>> binary(
+    std::vector<BinaryNode, UninitializedAllocator<BinaryNode, Pages::huge>> binary(
         2 * static_cast<std::size_t>(n) - 1);
     {
         PrimRefs scratch(n);

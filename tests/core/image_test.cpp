@@ -33,22 +33,25 @@ TEST(AlignedVector, StorageIsSixtyFourByteAligned) {
     }
 }
 
-// From 4 MiB on, storage starts on a huge page (2 MiB); both allocators free what they
-// allocated with the alignment they allocated it with (ASan checks the pairing).
-TEST(AlignedVector, LargeStorageStartsOnAHugePage) {
+// Storage that asks for huge pages starts on a 2 MiB boundary from 4 MiB on; other storage
+// on a cache line. Each allocator frees with the alignment it allocated with (ASan checks
+// the pairing).
+TEST(AlignedStorage, HugePagesOnlyWhereAskedAndLarge) {
     const std::size_t large = kHugePageMinBytes / sizeof(float);
     for (std::size_t n : {large - 1, large, 3 * large + 5}) {
-        AlignedVector<float> v(n, 1.0f);
-        const auto at = reinterpret_cast<std::uintptr_t>(v.data());
-        EXPECT_EQ(at % (n >= large ? kHugePageBytes : kSimdAlignment), 0u) << n;
-        EXPECT_EQ(v[n - 1], 1.0f);
-        std::vector<float, UninitializedAllocator<float>> u(n);
-        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(u.data()) %
-                      (n >= large ? kHugePageBytes : kSimdAlignment),
-                  0u)
-            << n;
-        u[n - 1] = 2.0f;
-        EXPECT_EQ(u[n - 1], 2.0f);
+        std::vector<float, UninitializedAllocator<float, Pages::huge>> huge(n);
+        const std::size_t want = n >= large ? kHugePageBytes : kSimdAlignment;
+        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(huge.data()) % want, 0u) << n;
+        huge[n - 1] = 2.0f;
+        EXPECT_EQ(huge[n - 1], 2.0f);
+        AlignedVector<float, Pages::huge> huge_aligned(n, 3.0f);
+        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(huge_aligned.data()) % want, 0u) << n;
+        EXPECT_EQ(huge_aligned[n - 1], 3.0f);
+        std::vector<float, UninitializedAllocator<float>> normal(n);
+        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(normal.data()) % kSimdAlignment, 0u) << n;
+        AlignedVector<float> aligned(n, 1.0f);
+        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(aligned.data()) % kSimdAlignment, 0u) << n;
+        EXPECT_EQ(aligned[n - 1], 1.0f);
     }
 }
 
