@@ -28,8 +28,8 @@ inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 inline constexpr std::size_t kHugePageMinBytes = std::size_t{4} << 20;
 
 inline std::align_val_t storage_alignment(std::size_t bytes, Pages pages) {
-    return std::align_val_t{pages == Pages::huge && bytes >= kHugePageMinBytes ? kHugePageBytes
-                                                                               : kSimdAlignment};
+    return std::align_val_t{
+        pages == Pages::huge && bytes >= kHugePageMinBytes ? kHugePageBytes : kSimdAlignment};
 }
 
 // `bytes` of uninitialised storage aligned as above; release with free_aligned(p, bytes,
