@@ -7,7 +7,6 @@
 #endif
 
 #include <cstddef>
-#include <memory>
 #include <new>
 #include <type_traits>
 #include <utility>
@@ -75,13 +74,13 @@ struct AlignedAllocator {
 template <class T, Pages kPages = Pages::normal>
 using AlignedVector = std::vector<T, AlignedAllocator<T, kPages>>;
 
-// std::allocator, except that a value-less construct() leaves the element's bytes alone:
+// AlignedAllocator, except that a value-less construct() leaves the element's bytes alone:
 // a vector of trivially copyable elements (pixels, the BVH builder's sphere references)
 // can then be sized without writing them, and its pages are first touched by the threads
 // that fill them. Storage is aligned as above (at least a cache line), so whole rows of
 // pixels can be streamed to memory (render/packet_renderer.cpp).
 template <class T, Pages kPages = Pages::normal>
-struct UninitializedAllocator : std::allocator<T> {
+struct UninitializedAllocator : AlignedAllocator<T, kPages> {
     template <class U>
     struct rebind {
         using other = UninitializedAllocator<U, kPages>;
@@ -89,12 +88,6 @@ struct UninitializedAllocator : std::allocator<T> {
     UninitializedAllocator() = default;
     template <class U>
     UninitializedAllocator(const UninitializedAllocator<U, kPages>&) noexcept {}
-
-    T* allocate(std::size_t n) {
-        if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
-        return static_cast<T*>(allocate_aligned(n * sizeof(T), kPages));
-    }
-    void deallocate(T* p, std::size_t n) noexcept { free_aligned(p, n * sizeof(T), kPages); }
 
     template <class U>
     void construct(U*) noexcept {

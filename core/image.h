@@ -3,10 +3,6 @@
 // is read; the cameras flip the row index when turning a pixel into a ray.
 
 #include <cstddef>
-#include <memory>
-#include <new>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "core/aligned.h"

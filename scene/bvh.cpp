@@ -201,6 +201,10 @@ struct BinMapping {
 __m128 select(__m128 mask, __m128 a, __m128 b) {
     return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
+__m128i select(__m128 mask, __m128i a, __m128i b) {
+    const __m128i m = _mm_castps_si128(mask);
+    return _mm_or_si128(_mm_and_si128(m, a), _mm_andnot_si128(m, b));
+}
 
 // Per axis and bin: the spheres' boxes and their count (the children's center bounds come
 // out of the partition, which visits every sphere anyway). Counts are kept per bin with
@@ -302,8 +306,7 @@ Split best_split(const Bins& bins, const BinMapping& m) {
         const __m128 better =
             _mm_andnot_ps(empty_side, _mm_and_ps(m.extent_mask, _mm_cmplt_ps(cost, best_cost)));
         best_cost = select(better, cost, best_cost);
-        best_bin = _mm_or_si128(_mm_and_si128(_mm_castps_si128(better), _mm_set1_epi32(k)),
-                                _mm_andnot_si128(_mm_castps_si128(better), best_bin));
+        best_bin = select(better, _mm_set1_epi32(k), best_bin);
     }
     alignas(16) float costs[4];
     alignas(16) std::int32_t bins_at[4];
@@ -451,6 +454,9 @@ class Collapser {
             const Deferred& d = deferred[i];
             collapse(d.slot, d.b, d.e, d.depth, parts[i]);
         });
+        std::size_t total = out.nodes.size();
+        for (const Collapsed& part : parts) total += part.nodes.size();
+        out.nodes.reserve(total);
         for (std::size_t i = 0; i < parts.size(); ++i) {
             const auto offset = static_cast<std::uint32_t>(out.nodes.size());
             for (BvhNode8 node : parts[i].nodes) {
@@ -562,11 +568,11 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
         return bvh;
     }
 
-    // Each sphere's box c ± sqrt(r2), computed in double and rounded outwards: it holds
-    // every point of the sphere the kernels intersect (which knows only r2).
     // The builder's buffers (references twice, binary nodes) on huge pages: core/aligned.h.
     using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef, Pages::huge>>;
     PrimRefs refs(n);
+    // Each sphere's box c ± sqrt(r2), rounded outwards: it holds every point of the sphere
+    // the kernels intersect (which knows only r2).
     tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
                       [&](const tbb::blocked_range<std::uint32_t>& r) {
                           // c -+ r rounded outwards in float: sqrtf is exact to half an
