@@ -6,6 +6,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -53,6 +55,41 @@ void frame(benchmark::State& state, const BenchScene& bs, bool simd, int threads
         static_cast<double>(rays) / 1e6 / static_cast<double>(state.iterations());
 }
 
+// Thread scaling as a ratio taken in one place: each iteration renders the frame on one
+// thread and on two, back to back (which goes first alternates), so a host that speeds up
+// or slows down over the run moves both halves of a pair alike. Counters: the medians of
+// the one- and two-thread frames, the median of the per-pair ratios, and the ratio of the
+// fastest frames (noise on a shared host only ever adds time).
+void scaling(benchmark::State& state, const BenchScene& bs, bool simd) {
+    const auto seconds = [&](int threads) {
+        RenderOptions options;
+        options.threads = threads;
+        const auto start = std::chrono::steady_clock::now();
+        const RenderResult r = simd ? render_packet(bs.compiled, options, Isa::automatic)
+                                    : render_reference(bs.scene, options);
+        benchmark::DoNotOptimize(r.image.data());
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    std::vector<double> one, two, ratio;
+    for (auto _ : state) {
+        const bool one_first = one.size() % 2 == 0;
+        const double a = seconds(one_first ? 1 : 2), b = seconds(one_first ? 2 : 1);
+        one.push_back(one_first ? a : b);
+        two.push_back(one_first ? b : a);
+        ratio.push_back(one.back() / two.back());
+    }
+    const auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        const std::size_t n = v.size();
+        return n == 0 ? 0.0 : n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    };
+    state.counters["1T_ms"] = median(one) * 1e3;
+    state.counters["2T_ms"] = median(two) * 1e3;
+    state.counters["2T/1T"] = median(ratio);
+    state.counters["2T/1T_best"] =
+        *std::min_element(one.begin(), one.end()) / *std::min_element(two.begin(), two.end());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -82,6 +119,13 @@ int main(int argc, char** argv) {
                 ->Unit(benchmark::kMillisecond)
                 ->UseRealTime();
         }
+        for (bool simd : {false, true})
+            benchmark::RegisterBenchmark(
+                ("frame/" + bs.name + (simd ? "/simd" : "/scalar") + "/scaling").c_str(),
+                [&bs, simd](benchmark::State& s) { scaling(s, bs, simd); })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime()
+                ->Iterations(simd ? 41 : 5);
         for (Isa isa : supported_isas())
             benchmark::RegisterBenchmark(
                 ("frame/" + bs.name + "/simd-" + isa_name(isa) + "/threads:1").c_str(),
