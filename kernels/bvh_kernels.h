@@ -5,9 +5,10 @@
 // The tree is scene/bvh.h's: 8-wide nodes with their children's boxes in SoA
 // (scene/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
 // - packet traversal (Wald et al. 2001, "Interactive rendering with coherent ray
-//   tracing", widened to 8-wide nodes): the 8-ray packet is tested against one child box
-//   at a time, lanes whose current closest hit lies before the box are culled, and
-//   children are visited nearest first along the packet's first live ray;
+//   tracing", widened to 8-wide nodes): the packet as a whole (a frustum, where its
+//   directions' signs agree) is tested against all 8 children at once; the 8-ray packet is
+//   then tested against each child box the frustum enters, lanes whose current closest hit
+//   lies before the box are culled, and children are visited nearest first;
 // - single-ray traversal (Wald et al. 2008, "Getting rid of packets"; embree's BVH8): one
 //   ray against all 8 child boxes in one operation, near/far planes picked by the ray's
 //   direction signs (Williams et al. 2005), children visited nearest first.
@@ -384,18 +385,134 @@ void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep,
     }
 }
 
-// Pushes the children of `n` that some lane of `mask` enters, nearest (along the
-// representative lane) on top. The eight child tests are independent (no branch between
-// them, so the CPU overlaps them); the entered children are then placed by rank, without
-// a data-dependent branch: child j goes below every entered child nearer than it (ties:
-// the lower index nearer).
+// ---------------------------------------------------------------------------------------
+// The packet as one bundle (a frustum, after embree's stream traversal): where every live
+// lane's direction has one sign on each axis, all eight children of a node are tested
+// against the bundle in one pass, and only the children it enters get the per-lane tests.
+//
+// Per lane, a child is entered on axis x at fms(near_x, inv, near_off) (near_x: the box's
+// min_x for a positive direction, max_x for a negative one) and left at
+// fms(far_x, inv, far_off). Over the bundle, with inv in [inv_lo, inv_hi] (one sign) and
+// the offsets bounded by the lanes' largest near_off and smallest far_off, the exact value
+// near_x * inv - near_off is at least min(near_x * inv_lo, near_x * inv_hi) - near_off_max,
+// and rounding is monotonic: the bundle's rounded entry is never above any lane's rounded
+// entry, its exit never below. A child some lane enters is entered by the bundle, so the
+// bundle test culls nothing the per-lane tests would keep: the traversal and its hits
+// are the same with it or without it.
+template <class F>
+struct PacketFrustum {
+    using Plane = const float (BvhNode8::*)[kBvhWidth];
+    bool valid = false;  // every axis has one direction sign over the lanes
+    Plane near[3], far[3];
+    F inv_lo[3], inv_hi[3], near_off[3], far_off[3];
+};
+
+template <class F>
+PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
+    using Plane = typename PacketFrustum<F>::Plane;
+    const float* const inv[3] = {p.inv_x, p.inv_y, p.inv_z};
+    const float* const lo_off[3] = {p.lo_off_x, p.lo_off_y, p.lo_off_z};
+    const float* const hi_off[3] = {p.hi_off_x, p.hi_off_y, p.hi_off_z};
+    const Plane mins[3] = {&BvhNode8::min_x, &BvhNode8::min_y, &BvhNode8::min_z};
+    const Plane maxs[3] = {&BvhNode8::max_x, &BvhNode8::max_y, &BvhNode8::max_z};
+    PacketFrustum<F> f;
+    for (int a = 0; a < 3; ++a) {
+        float lo = kInf, hi = -kInf;
+        for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
+            const float v = inv[a][__builtin_ctz(bits)];
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+        const bool positive = lo > 0.0f;
+        if (!positive && !(hi < 0.0f)) return f;  // mixed signs (or NaN): no bundle
+        const float* near_off = positive ? lo_off[a] : hi_off[a];
+        const float* far_off = positive ? hi_off[a] : lo_off[a];
+        float near_max = -kInf, far_min = kInf;
+        for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
+            const auto l = static_cast<std::uint32_t>(__builtin_ctz(bits));
+            near_max = near_off[l] > near_max ? near_off[l] : near_max;
+            far_min = far_off[l] < far_min ? far_off[l] : far_min;
+        }
+        f.near[a] = positive ? mins[a] : maxs[a];
+        f.far[a] = positive ? maxs[a] : mins[a];
+        f.inv_lo[a] = F(lo), f.inv_hi[a] = F(hi);
+        f.near_off[a] = F(near_max), f.far_off[a] = F(far_min);
+    }
+    f.valid = true;
+    return f;
+}
+
+// The largest of v[i] over the lanes i in `bits` (not empty).
+template <class F>
+float masked_max(const float* v, std::uint32_t bits) {
+    if constexpr (F::size == 8) {
+        const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        const __m256i in = _mm256_cmpeq_epi32(
+            _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), lane_bit), lane_bit);
+        const __m256 x =
+            _mm256_blendv_ps(_mm256_set1_ps(-kInf), _mm256_load_ps(v), _mm256_castsi256_ps(in));
+        __m128 m = _mm_max_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1));
+        m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+        return _mm_cvtss_f32(_mm_max_ss(m, _mm_shuffle_ps(m, m, 1)));
+    } else {
+        float m = -kInf;
+        for (; bits != 0; bits &= bits - 1) {
+            const float x = v[__builtin_ctz(bits)];
+            m = x > m ? x : m;
+        }
+        return m;
+    }
+}
+
+// The children of `n` that are not kBvhEmpty, as bits (they come first).
+inline std::uint32_t used_children(const BvhNode8& n) {
+    std::uint32_t count = 0;
+    while (count < kBvhWidth && n.child[count] != kBvhEmpty) ++count;
+    return (1u << count) - 1u;
+}
+
+// Children of `n` the bundle enters on [t_near, t_far]; entry[j]: where it enters child j.
+template <class F>
+[[gnu::always_inline]] inline std::uint32_t frustum_children(const BvhNode8& n,
+                                                             const PacketFrustum<F>& f,
+                                                             const F& t_near, const F& t_far,
+                                                             float* entry) {
+    constexpr std::uint32_t W = F::size;
+    std::uint32_t bits = 0;
+    for (std::uint32_t at = 0; at < kBvhWidth; at += W) {
+        F tn = t_near, tf = t_far;
+        for (int a = 0; a < 3; ++a) {
+            const F near = F::load_aligned((n.*f.near[a]) + at);
+            const F far = F::load_aligned((n.*f.far[a]) + at);
+            tn = xsimd::max(tn, xsimd::min(xsimd::fms(near, f.inv_lo[a], f.near_off[a]),
+                                           xsimd::fms(near, f.inv_hi[a], f.near_off[a])));
+            tf = xsimd::min(tf, xsimd::max(xsimd::fms(far, f.inv_lo[a], f.far_off[a]),
+                                           xsimd::fms(far, f.inv_hi[a], f.far_off[a])));
+        }
+        bits |= mask_bits<F>(tn <= tf) << at;
+        tn.store_aligned(entry + at);
+    }
+    return bits;
+}
+
+// Pushes the children of `n` that some lane of `mask` enters, nearest on top: nearest
+// where the bundle enters them, or, without a bundle, along the representative lane. Only
+// the children the bundle enters get the per-lane tests; these are independent (no branch
+// between them, so the CPU overlaps them), and the entered children are then placed by
+// rank, without a data-dependent branch: child j goes below every entered child nearer
+// than it (ties: the lower index nearer).
 template <class F, bool kNearestFirst = true>
-void push_packet_children(const BvhNode8& n, const BvhPacket& p, std::uint32_t mask,
-                          const F& t_near, const float* t_far, BvhStacks& st,
-                          std::uint32_t& sp) {
+void push_packet_children(const BvhNode8& n, const BvhPacket& p, const PacketFrustum<F>& fr,
+                          std::uint32_t mask, const F& t_near, const float* t_far,
+                          BvhStacks& st, std::uint32_t& sp) {
     constexpr std::uint32_t W = F::size;
     std::uint32_t lanes[kBvhWidth] = {}, entered = 0;
-    for (std::uint32_t j = 0; j < kBvhWidth && n.child[j] != kBvhEmpty; ++j) {
+    alignas(64) float key[kBvhWidth];
+    const std::uint32_t candidates =
+        fr.valid ? frustum_children<F>(n, fr, t_near, F(masked_max<F>(t_far, mask)), key)
+                 : used_children(n);
+    for (std::uint32_t bits = candidates; bits != 0; bits &= bits - 1) {
+        const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
         lanes[j] = packet_child_lanes(n, j, p, t_near, t_far) & mask;
         entered |= static_cast<std::uint32_t>(lanes[j] != 0) << j;
     }
@@ -411,8 +528,8 @@ void push_packet_children(const BvhNode8& n, const BvhPacket& p, std::uint32_t m
         sp += count;
         return;
     }
-    alignas(64) float key[kBvhWidth];
-    packet_child_keys<F>(n, p, static_cast<std::uint32_t>(__builtin_ctz(mask)), key);
+    if (!fr.valid)
+        packet_child_keys<F>(n, p, static_cast<std::uint32_t>(__builtin_ctz(mask)), key);
     alignas(64) static constexpr float kIndex[kBvhWidth] = {0, 1, 2, 3, 4, 5, 6, 7};
     for (std::uint32_t bits = entered; bits != 0; bits &= bits - 1) {
         const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
@@ -438,6 +555,7 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
     constexpr std::uint32_t W = F::size;
     constexpr std::uint32_t K = kPacketWidth / W;
     const F tmin(t_min), zero(0.0f);
+    const PacketFrustum<F> fr = packet_frustum<F>(p, live);
     std::uint32_t sp = 0;
     st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
     while (sp > 0) {
@@ -450,7 +568,7 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
             continue;
         }
         if ((node & kBvhLeafBit) == 0) {
-            push_packet_children(s.bvh_nodes[node], p, mask, tmin, p.best_t, st, sp);
+            push_packet_children(s.bvh_nodes[node], p, fr, mask, tmin, p.best_t, st, sp);
             continue;
         }
         // A leaf: each sphere broadcast against the packet, as the brute-force kernel does,
@@ -506,6 +624,7 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
     constexpr std::uint32_t W = F::size;
     constexpr std::uint32_t K = kPacketWidth / W;
     const F zero(0.0f);
+    const PacketFrustum<F> fr = packet_frustum<F>(p, live);
     std::uint32_t done = 0, sp = 0;
     st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
     while (sp > 0 && done != live) {
@@ -520,7 +639,8 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
             continue;
         }
         if ((node & kBvhLeafBit) == 0) {
-            push_packet_children<F, false>(s.bvh_nodes[node], p, mask, zero, p.best_t, st, sp);
+            push_packet_children<F, false>(s.bvh_nodes[node], p, fr, mask, zero, p.best_t, st,
+                                           sp);
             continue;
         }
         V3<F> o[K], d[K];
