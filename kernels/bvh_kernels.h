@@ -242,6 +242,16 @@ inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const 
     return n.child[order[count - 1]];
 }
 
+// Children of `n` in `bits` in the node's order (the builder's: largest box first, the
+// likeliest to occlude): the first is returned, the rest pushed last first.
+inline std::uint32_t push_children_in_order(const BvhNode8& n, std::uint32_t bits,
+                                            std::uint32_t* stack, std::uint32_t& sp) {
+    const auto first = static_cast<std::uint32_t>(__builtin_ctz(bits));
+    for (bits &= bits - 1; bits != 0; bits &= ~(1u << (31 - __builtin_clz(bits))))
+        stack[sp++] = n.child[31 - __builtin_clz(bits)];
+    return n.child[first];
+}
+
 // Closest hit of lane `lane` of `p` in the subtree `start`, on (t_min, best_t].
 template <class Arch>
 void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::uint32_t start,
@@ -306,7 +316,7 @@ bool bvh_occluded_ray(const SceneView& s, const BvhPacket& p, std::uint32_t lane
             const BvhNode8& n = s.bvh_nodes[node];
             const std::uint32_t bits = ray.test(n, zero, t_max, entry);
             if (bits != 0) {
-                node = push_children(n, bits, entry, stack, sp);
+                node = push_children_in_order(n, bits, stack, sp);
                 continue;
             }
         } else {
@@ -519,7 +529,8 @@ void push_packet_children(const BvhNode8& n, const BvhPacket& p, const PacketFru
     if (entered == 0) return;
     const auto count = static_cast<std::uint32_t>(__builtin_popcount(entered));
     if (count == 1 || !kNearestFirst) {
-        // One child, or any hit (which needs no order): index order, the first on top.
+        // One child, or any hit (which needs no order): node order (largest box first, the
+        // likeliest occluder), the first on top.
         for (std::uint32_t bits = entered, slot = sp + count; bits != 0; bits &= bits - 1) {
             const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
             st.packet_node[--slot] = n.child[j];

@@ -516,6 +516,12 @@ class Collapser {
             ++count;
         }
 
+        // Largest box first: the any-hit traversals take children in node order, and a ray
+        // that meets a node meets its larger children more often (the SAH's odds), so an
+        // occluder tends to be found sooner. Closest-hit orders children by distance.
+        std::stable_sort(children, children + count, [&](const Child& x, const Child& y) {
+            return half_area(x.slot) > half_area(y.slot);
+        });
         const auto index = static_cast<std::uint32_t>(out.nodes.size());
         out.nodes.emplace_back();
         std::uint32_t refs[kBvhWidth];

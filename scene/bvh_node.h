@@ -13,8 +13,8 @@ inline constexpr std::uint32_t kBvhWidth = 8;
 // A child reference: an inner node's index, or a leaf
 //   kBvhLeafBit | first << kBvhLeafCountBits | (count - 1)
 // whose spheres are [first, first + count) of the BVH's sphere arrays (count 1 ... 8).
-// Unused child slots come last and hold kBvhEmpty with an empty box (min = +inf,
-// max = -inf), which no ray enters.
+// Used children come in order of decreasing box surface area; unused child slots come
+// last and hold kBvhEmpty with an empty box (min = +inf, max = -inf), which no ray enters.
 inline constexpr std::uint32_t kBvhLeafBit = 0x80000000u;
 inline constexpr std::uint32_t kBvhLeafCountBits = 3;
 inline constexpr std::uint32_t kBvhEmpty = 0xFFFFFFFFu;

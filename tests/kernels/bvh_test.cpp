@@ -158,6 +158,7 @@ DBox check_node(const SphereBvh& bvh, std::uint32_t index, std::vector<int>& see
     const BvhNode8& n = bvh.nodes.at(index);
     DBox all;
     bool empty_seen = false;
+    double previous_area = INFINITY;
     for (int j = 0; j < 8; ++j) {
         const std::uint32_t ref = n.child[j];
         if (ref == kBvhEmpty) {
@@ -169,6 +170,12 @@ DBox check_node(const SphereBvh& bvh, std::uint32_t index, std::vector<int>& see
             continue;
         }
         EXPECT_FALSE(empty_seen) << "empty slots come last";
+        // Largest box first (the any-hit traversals visit children in node order).
+        const double dx = n.max_x[j] - n.min_x[j], dy = n.max_y[j] - n.min_y[j],
+                     dz = n.max_z[j] - n.min_z[j];
+        const double area = dx * dy + dy * dz + dz * dx;
+        EXPECT_LE(area, previous_area * (1.0 + 1e-6)) << "node " << index << " child " << j;
+        previous_area = area;
         DBox box;
         if (ref & kBvhLeafBit) {
             const std::uint32_t first = (ref & ~kBvhLeafBit) >> kBvhLeafCountBits;
