@@ -239,16 +239,38 @@ struct Bins {
     }
 };
 
+// Ranges from this many spheres on are binned into two sets of bins, even and odd
+// spheres apart, merged at the end.
+constexpr std::uint32_t kTwoWayBinning = 64;
+
+// Bins spheres [b, e) one after the other. Neighbouring spheres tend to fall into the same
+// bins (sphereflakes are generated child by child), and then each update waits for the
+// previous one's store; two sets of bins, merged at the end (exactly: min, max and integer
+// sums), make two independent chains.
+void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+                Bins& bins) {
+    std::uint32_t i = b;
+    if (e - b >= kTwoWayBinning) {
+        Bins odd(m.count);
+        for (; i + 1 < e; i += 2) {
+            bins.add(refs[i], m);
+            odd.add(refs[i + 1], m);
+        }
+        bins.merge(odd, m.count);
+    }
+    for (; i < e; ++i) bins.add(refs[i], m);
+}
+
 void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                Bins& bins) {
     if (e - b < kParallelBinning) {
-        for (std::uint32_t i = b; i < e; ++i) bins.add(refs[i], m);
+        bin_serial(refs, b, e, m, bins);
         return;
     }
     bins = tbb::parallel_reduce(
         tbb::blocked_range<std::uint32_t>(b, e, kParallelBinning / 4), Bins(m.count),
         [&](const tbb::blocked_range<std::uint32_t>& r, Bins part) {
-            for (std::uint32_t i = r.begin(); i < r.end(); ++i) part.add(refs[i], m);
+            bin_serial(refs, r.begin(), r.end(), m, part);
             return part;
         },
         [&](Bins x, const Bins& y) {
