@@ -99,4 +99,8 @@ struct UninitializedAllocator : AlignedAllocator<T, kPages> {
     }
 };
 
+// A vector whose resize() leaves the new elements' bytes to be written by the caller.
+template <class T, Pages kPages = Pages::normal>
+using UninitializedVector = std::vector<T, UninitializedAllocator<T, kPages>>;
+
 }  // namespace octray

@@ -450,12 +450,47 @@ class Builder {
     BinaryNode* nodes_;
 };
 
-// The 8-wide nodes of a subtree: its root first, inner child references relative to its
-// own first node.
+// The 8-wide nodes of a subtree, its root first, inner child references relative to its
+// own first node; the subtrees collapsed by tasks of their own (`parts`) are not in
+// `nodes`, and the child slots that will point at them (`links`) hold kBvhEmpty.
 struct Collapsed {
-    AlignedVector<BvhNode8, Pages::huge> nodes;
+    struct Link {
+        std::uint32_t node, child;
+    };
+    UninitializedVector<BvhNode8, Pages::huge> nodes;  // emit() writes every field
+    std::vector<Collapsed> parts;
+    std::vector<Link> links;  // where parts[i]'s root goes
+    std::size_t total = 0;    // nodes with all the parts'
     std::uint32_t leaf_count = 0;
     std::uint32_t depth = 0;
+
+    // Writes the subtree's nodes to dst[offset, offset + total): its own nodes, then each
+    // part's after them, in order (so the same bytes for any number of threads), with
+    // their references made absolute. Each node is copied once.
+    void flatten(BvhNode8* dst, std::uint32_t offset) const {
+        std::vector<std::uint32_t> part_offset(parts.size());
+        auto next = static_cast<std::uint32_t>(offset + nodes.size());
+        for (std::size_t i = 0; i < parts.size(); ++i) {
+            part_offset[i] = next;
+            next += static_cast<std::uint32_t>(parts[i].total);
+        }
+        tbb::parallel_invoke(
+            [&] {
+                for (std::size_t k = 0; k < nodes.size(); ++k) {
+                    BvhNode8 node = nodes[k];
+                    for (std::uint32_t& child : node.child)
+                        if ((child & kBvhLeafBit) == 0) child += offset;  // kBvhEmpty: leaf bit
+                    dst[offset + k] = node;
+                }
+                for (std::size_t i = 0; i < parts.size(); ++i)
+                    dst[offset + links[i].node].child[links[i].child] = part_offset[i];
+            },
+            [&] {
+                tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t i) {
+                    parts[i].flatten(dst, part_offset[i]);
+                });
+            });
+    }
 };
 
 class Collapser {
@@ -464,31 +499,24 @@ class Collapser {
 
     // Collapses the binary subtree at `slot` (spheres [b, e), at 8-wide level `depth`) into
     // `out`, its root at out.nodes[0]. Subtrees of kParallelCollapse spheres or more are
-    // collapsed by tasks of their own and appended after the rest, in child order: the
-    // nodes come out the same for any number of threads.
+    // collapsed by tasks of their own into out.parts.
     void collapse(std::uint32_t slot, std::uint32_t b, std::uint32_t e, std::uint32_t depth,
                   Collapsed& out) const {
         std::vector<Deferred> deferred;
         emit(slot, b, e, depth, out, deferred);
+        out.total = out.nodes.size();
         if (deferred.empty()) return;
-        std::vector<Collapsed> parts(deferred.size());
+        out.parts.resize(deferred.size());
         tbb::parallel_for(std::size_t{0}, deferred.size(), [&](std::size_t i) {
             const Deferred& d = deferred[i];
-            collapse(d.slot, d.b, d.e, d.depth, parts[i]);
+            collapse(d.slot, d.b, d.e, d.depth, out.parts[i]);
         });
-        std::size_t total = out.nodes.size();
-        for (const Collapsed& part : parts) total += part.nodes.size();
-        out.nodes.reserve(total);
-        for (std::size_t i = 0; i < parts.size(); ++i) {
-            const auto offset = static_cast<std::uint32_t>(out.nodes.size());
-            for (BvhNode8 node : parts[i].nodes) {
-                for (std::uint32_t& child : node.child)
-                    if ((child & kBvhLeafBit) == 0) child += offset;  // kBvhEmpty has the bit
-                out.nodes.push_back(node);
-            }
-            out.nodes[deferred[i].parent].child[deferred[i].child] = offset;
-            out.leaf_count += parts[i].leaf_count;
-            out.depth = std::max(out.depth, parts[i].depth);
+        for (std::size_t i = 0; i < deferred.size(); ++i) {
+            const Collapsed& part = out.parts[i];
+            out.links.push_back({deferred[i].parent, deferred[i].child});
+            out.total += part.total;
+            out.leaf_count += part.leaf_count;
+            out.depth = std::max(out.depth, part.depth);
         }
     }
 
@@ -646,7 +674,8 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
     // 8-wide nodes: preorder, but for the subtrees collapsed by tasks of their own.
     Collapsed collapsed;
     Collapser(binary.data()).collapse(0, 0, n, 1, collapsed);
-    bvh.nodes = std::move(collapsed.nodes);
+    bvh.nodes.resize(collapsed.total);
+    collapsed.flatten(bvh.nodes.data(), 0);
     bvh.leaf_count = collapsed.leaf_count;
     bvh.depth = collapsed.depth;
     binary = {};
@@ -654,8 +683,10 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
     // The spheres in leaf order, padded with a packet of never-hit entries.
     const std::uint32_t padded = n + kBvhWidth;
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    bvh.cx.assign(padded, nan), bvh.cy.assign(padded, nan), bvh.cz.assign(padded, nan);
-    bvh.r2.assign(padded, nan), bvh.object.assign(padded, 0u);
+    bvh.cx.resize(padded), bvh.cy.resize(padded), bvh.cz.resize(padded);
+    bvh.r2.resize(padded), bvh.object.resize(padded);
+    for (std::uint32_t i = n; i < padded; ++i)
+        bvh.cx[i] = bvh.cy[i] = bvh.cz[i] = bvh.r2[i] = nan, bvh.object[i] = 0u;
     tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
                       [&](const tbb::blocked_range<std::uint32_t>& r) {
                           for (std::uint32_t i = r.begin(); i < r.end(); ++i) {

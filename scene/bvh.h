@@ -22,13 +22,15 @@ namespace octray {
 
 struct SphereBvh {
     // Node 0 is the root; children come after their parent. Empty when the scene has no
-    // spheres. (Large arrays on huge pages: core/aligned.h.)
-    AlignedVector<BvhNode8, Pages::huge> nodes;
+    // spheres. (Large arrays on huge pages, and sized without being written, so that the
+    // build's threads fill them in parallel: core/aligned.h.)
+    UninitializedVector<BvhNode8, Pages::huge> nodes;
     // Spheres in leaf order, padded with kBvhWidth entries that never hit (NaN), so that
     // a kernel may load 8 entries from any leaf's first sphere.
     std::uint32_t sphere_count = 0;
-    AlignedVector<float, Pages::huge> cx, cy, cz, r2;
-    AlignedVector<std::uint32_t, Pages::huge> object;  // the file index, as in CompiledSpheres
+    UninitializedVector<float, Pages::huge> cx, cy, cz, r2;
+    UninitializedVector<std::uint32_t, Pages::huge> object;  // the file index, as in
+                                                             // CompiledSpheres
 
     // The root's box (of the spheres, not their centers) and the extreme squared radii:
     // the kernels derive their rounding margin from them.
