@@ -161,6 +161,7 @@ kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& 
     for (int a = 0; a < 3; ++a) v.bvh_lo[a] = bvh.lo[a], v.bvh_hi[a] = bvh.hi[a];
     v.bvh_min_r2 = bvh.min_r2, v.bvh_max_r2 = bvh.max_r2;
     v.bvh_packet_min_lanes = packet_min_lanes;
+    v.bvh_shadow_sort_min_spheres = kBvhShadowSortMinSpheres;
     return v;
 }
 

@@ -52,6 +52,11 @@ kernels::SceneView make_scene_view(const CompiledScene& scene);
 // bench/README.md, "The packet → single-ray switch").
 inline constexpr std::uint32_t kBvhPacketMinLanes = 2;
 
+// From this many spheres on, the BVH's any-hit regroups shadow rays into packets of
+// neighbouring origins and one direction octant: below, the sort costs more than it saves
+// (measured: bench/README.md, "BVH: millions of spheres against Embree").
+inline constexpr std::uint32_t kBvhShadowSortMinSpheres = 32768;
+
 // The same with the spheres' BVH built from `scene` (scene/bvh.h); both must outlive the
 // view. An empty BVH (no spheres) leaves the view brute force.
 kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& bvh,

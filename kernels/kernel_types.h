@@ -82,6 +82,9 @@ struct SceneView {
     // A packet with fewer live lanes than this goes on ray by ray (single-ray traversal);
     // 0 or 1: packets all the way, 9: single rays only.
     std::uint32_t bvh_packet_min_lanes;
+    // Shadow rays are regrouped by origin and direction before tracing (bvh_kernels.h,
+    // any_hit) in BVHs of at least this many spheres.
+    std::uint32_t bvh_shadow_sort_min_spheres;
 };
 
 // Film positions of camera samples, in [-1, 1]^2 with y up, plus the thin-lens aperture

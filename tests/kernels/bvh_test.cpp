@@ -447,7 +447,10 @@ class BvhTraversalTest : public ::testing::Test {
         SCOPED_TRACE(ns.name + ", packet_min_lanes " + std::to_string(packet_min_lanes));
         const CompiledScene c = compile_scene(ns.scene);
         const SphereBvh bvh = build_sphere_bvh(c.spheres);
-        const kernels::SceneView view = make_scene_view(c, bvh, packet_min_lanes);
+        kernels::SceneView view = make_scene_view(c, bvh, packet_min_lanes);
+        // Shadow rays regrouped whatever the scene's size (the default keeps the order
+        // given below kBvhShadowSortMinSpheres; the loop after any_hit checks that path).
+        view.bvh_shadow_sort_min_spheres = 0;
         ASSERT_NE(view.bvh_nodes, nullptr);
         const kernels::KernelTable& k = kernel_table(Tag::isa);
         const ReferenceTracer ref(ns.scene);
@@ -478,6 +481,15 @@ class BvhTraversalTest : public ::testing::Test {
         }
         AlignedVector<std::uint32_t> occluded(padded(n) + kPacketWidth, 7u);
         k.any_hit(view, soa.shadow(), n, occluded.data());
+        // In the order given (a short stream, or a small scene) as regrouped.
+        for (const std::uint32_t few : {21u, n}) {
+            kernels::SceneView in_order = view;
+            in_order.bvh_shadow_sort_min_spheres = few == n ? ~0u : 0u;
+            AlignedVector<std::uint32_t> got(padded(n) + kPacketWidth, 7u);
+            k.any_hit(in_order, soa.shadow(), few, got.data());
+            for (std::uint32_t i = 0; i < few; ++i)
+                EXPECT_EQ(got[i], occluded[i]) << "ray " << i << " of " << few << " in order";
+        }
         AlignedVector<float> t(padded(n), -7.0f);
         AlignedVector<std::int32_t> id(padded(n), -7);
         k.closest_hit(view, soa.stream(), n, 0.0f, {t.data(), id.data()});
