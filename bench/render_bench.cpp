@@ -39,13 +39,17 @@ bool validate(const std::string& spec) {
     return same;
 }
 
-void frame(benchmark::State& state, const BenchScene& bs, bool simd, int threads, Isa isa) {
+RenderResult render_frame(const BenchScene& bs, bool simd, int threads, Isa isa) {
     RenderOptions options;
     options.threads = threads;
+    return simd ? render_packet(bs.compiled, options, isa)
+                : render_reference(bs.scene, options);
+}
+
+void frame(benchmark::State& state, const BenchScene& bs, bool simd, int threads, Isa isa) {
     std::uint64_t rays = 0;
     for (auto _ : state) {
-        const RenderResult r = simd ? render_packet(bs.compiled, options, isa)
-                                    : render_reference(bs.scene, options);
+        const RenderResult r = render_frame(bs, simd, threads, isa);
         rays += r.rays.total();
         benchmark::DoNotOptimize(r.image.data());
     }
@@ -62,11 +66,8 @@ void frame(benchmark::State& state, const BenchScene& bs, bool simd, int threads
 // fastest frames (noise on a shared host only ever adds time).
 void scaling(benchmark::State& state, const BenchScene& bs, bool simd) {
     const auto seconds = [&](int threads) {
-        RenderOptions options;
-        options.threads = threads;
         const auto start = std::chrono::steady_clock::now();
-        const RenderResult r = simd ? render_packet(bs.compiled, options, Isa::automatic)
-                                    : render_reference(bs.scene, options);
+        const RenderResult r = render_frame(bs, simd, threads, Isa::automatic);
         benchmark::DoNotOptimize(r.image.data());
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };

@@ -180,7 +180,7 @@ struct BvhRay {
     }
 
     // Bit i set when child i's widened box meets the ray on [t_near, t_far]; entry[i] is
-    // where the ray enters it.
+    // where the ray enters it (unless entry is null: any hit needs no order).
     std::uint32_t test(const BvhNode8& n, const F& t_near, const F& t_far, float* entry) const {
         constexpr std::uint32_t W = F::size;
         std::uint32_t bits = 0;
@@ -194,7 +194,7 @@ struct BvhRay {
             const F tn = xsimd::max(xsimd::max(tnx, tny), xsimd::max(tnz, t_near));
             const F tf = xsimd::min(xsimd::min(tfx, tfy), xsimd::min(tfz, t_far));
             bits |= mask_bits<F>(tn <= tf) << at;
-            tn.store_aligned(entry + at);
+            if (entry != nullptr) tn.store_aligned(entry + at);
         }
         return bits;
     }
@@ -309,12 +309,11 @@ bool bvh_occluded_ray(const SceneView& s, const BvhPacket& p, std::uint32_t lane
     constexpr std::uint32_t W = F::size;
     const BvhRay<F> ray(p, lane);
     const F zero(0.0f), t_max(p.best_t[lane]);
-    alignas(64) float entry[kBvhWidth];
     std::uint32_t sp = 0, node = start;
     for (;;) {
         if ((node & kBvhLeafBit) == 0) {
             const BvhNode8& n = s.bvh_nodes[node];
-            const std::uint32_t bits = ray.test(n, zero, t_max, entry);
+            const std::uint32_t bits = ray.test(n, zero, t_max, nullptr);
             if (bits != 0) {
                 node = push_children_in_order(n, bits, stack, sp);
                 continue;

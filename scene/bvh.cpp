@@ -9,7 +9,8 @@
 // binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
 // preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
 // depends on which thread got there first; the 8-wide collapse hands large subtrees to
-// tasks and appends their nodes in child order, whichever task finishes first.
+// tasks, and one pass then writes every node to its place in child order, whichever task
+// finished first.
 
 #include "scene/bvh.h"
 
@@ -511,9 +512,7 @@ class Collapser {
             const Deferred& d = deferred[i];
             collapse(d.slot, d.b, d.e, d.depth, out.parts[i]);
         });
-        for (std::size_t i = 0; i < deferred.size(); ++i) {
-            const Collapsed& part = out.parts[i];
-            out.links.push_back({deferred[i].parent, deferred[i].child});
+        for (const Collapsed& part : out.parts) {
             out.total += part.total;
             out.leaf_count += part.leaf_count;
             out.depth = std::max(out.depth, part.depth);
@@ -521,10 +520,9 @@ class Collapser {
     }
 
   private:
-    // A subtree left for its own task, and the child slot that will point at it.
+    // A subtree left for a task of its own (its child slot: the matching Collapsed::links).
     struct Deferred {
         std::uint32_t slot, b, e, depth;
-        std::uint32_t parent, child;
     };
 
     std::uint32_t emit(std::uint32_t slot, std::uint32_t b, std::uint32_t e,
@@ -581,8 +579,9 @@ class Collapser {
                 ++out.leaf_count;
                 refs[i] = kBvhLeafBit | (c.b << kBvhLeafCountBits) | (c.e - c.b - 1);
             } else if (c.e - c.b >= kParallelCollapse) {
-                deferred.push_back({c.slot, c.b, c.e, depth + 1, index, i});
-                refs[i] = kBvhEmpty;  // set when the task's nodes are appended
+                deferred.push_back({c.slot, c.b, c.e, depth + 1});
+                out.links.push_back({index, i});
+                refs[i] = kBvhEmpty;  // set by Collapsed::flatten()
             } else {
                 refs[i] = emit(c.slot, c.b, c.e, depth + 1, out, deferred);
             }
