@@ -225,12 +225,15 @@ struct Bins {
         return _mm_load_si128(reinterpret_cast<const __m128i*>(count[k]));
     }
     void add(const PrimRef& p, const BinMapping& m) {
-        alignas(16) std::int32_t k[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(k), m.bins(p.center()));
-        for (int a = 0; a < 3; ++a) {
-            box[a][k[a]].grow(p.box);
-            ++count[k[a]][a];
-        }
+        // The three bins out of their lanes by shuffles (a store and three loads would
+        // make each update wait on store forwarding).
+        const __m128i k = m.bins(p.center());
+        const int kx = _mm_cvtsi128_si32(k);
+        const int ky = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0x55));
+        const int kz = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0xaa));
+        box[0][kx].grow(p.box), ++count[kx][0];
+        box[1][ky].grow(p.box), ++count[ky][1];
+        box[2][kz].grow(p.box), ++count[kz][2];
     }
     void merge(const Bins& o, int bins) {
         for (int k = 0; k < bins; ++k) {
@@ -242,7 +245,7 @@ struct Bins {
 
 // Ranges from this many spheres on are binned into two sets of bins, even and odd
 // spheres apart, merged at the end.
-constexpr std::uint32_t kTwoWayBinning = 64;
+constexpr std::uint32_t kTwoWayBinning = 32;
 
 // Bins spheres [b, e) one after the other. Neighbouring spheres tend to fall into the same
 // bins (sphereflakes are generated child by child), and then each update waits for the
@@ -345,13 +348,16 @@ Split best_split(const Bins& bins, const BinMapping& m) {
 }
 
 // Copies the spheres of [b, e) from `src` to `dst`, those whose center lies in bins
-// [0, bin] of `axis` first, and returns where the rest begin; the two sides' center
+// [0, bin] of `Axis` first, and returns where the rest begin; the two sides' center
 // bounds come out on the way. Branch-free (which side a sphere goes to is a coin toss
 // the CPU cannot predict): each sphere goes to the next free slot at the front or at the
-// back of [b, e) (the right side comes out reversed).
-std::uint32_t partition(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
-                        const BinMapping& m, int axis, int bin, Box& left_centers,
-                        Box& right_centers) {
+// back of [b, e) (the right side comes out reversed). The axis is a template argument so
+// that its lane is picked by a shuffle, not by a round trip through memory.
+template <int Axis>
+std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
+                           const BinMapping& m, int bin, Box& left_centers,
+                           Box& right_centers) {
+    constexpr int kBroadcast = Axis * 0x55;  // _MM_SHUFFLE(Axis, Axis, Axis, Axis)
     const __m128i last_left = _mm_set1_epi32(bin);
     const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
     Box lc, rc;
@@ -360,21 +366,34 @@ std::uint32_t partition(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::
     for (std::uint32_t i = b; i < e; ++i) {
         const PrimRef p = src[i];
         const __m128 c = p.center();
-        alignas(16) std::int32_t right_lanes[4];  // -1 where the bin lies right of `bin`
-        _mm_store_si128(reinterpret_cast<__m128i*>(right_lanes),
-                        _mm_cmpgt_epi32(m.bins(c), last_left));
-        const std::int32_t right = right_lanes[axis];
+        // All ones in every lane where the bin on `Axis` lies right of `bin`.
+        const __m128i right_mask =
+            _mm_shuffle_epi32(_mm_cmpgt_epi32(m.bins(c), last_left), kBroadcast);
+        const std::int32_t right = _mm_cvtsi128_si32(right_mask);  // 0 or -1
         *(right ? back - 1 : front) = p;
         front += 1 + right;
         back += right;
         // The side's bounds grow by the center, the other side's by an empty box.
-        const __m128 to_right = _mm_castsi128_ps(_mm_set1_epi32(right));
+        const __m128 to_right = _mm_castsi128_ps(right_mask);
         lc.grow(Box{select(to_right, inf, c), select(to_right, minus_inf, c)});
         rc.grow(Box{select(to_right, c, inf), select(to_right, c, minus_inf)});
     }
     left_centers = lc;
     right_centers = rc;
     return static_cast<std::uint32_t>(front - dst);
+}
+
+std::uint32_t partition(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
+                        const BinMapping& m, int axis, int bin, Box& left_centers,
+                        Box& right_centers) {
+    switch (axis) {
+        case 0:
+            return partition_on<0>(src, dst, b, e, m, bin, left_centers, right_centers);
+        case 1:
+            return partition_on<1>(src, dst, b, e, m, bin, left_centers, right_centers);
+        default:
+            return partition_on<2>(src, dst, b, e, m, bin, left_centers, right_centers);
+    }
 }
 
 class Builder {
@@ -529,31 +548,37 @@ class Collapser {
                        std::uint32_t depth, Collapsed& out,
                        std::vector<Deferred>& deferred) const {
         out.depth = std::max(out.depth, depth);
+        // A binary node to become a child: its spheres, whether it is inner, its area.
         struct Child {
             std::uint32_t slot, b, e;
+            bool inner;
+            float area;
+        };
+        const auto child = [&](std::uint32_t s, std::uint32_t cb, std::uint32_t ce) {
+            const std::uint32_t mid = binary_[s].mid;
+            // An inner node's right child lies past its left subtree, far away in memory
+            // for a large one: fetched now, it is there when the node is opened.
+            if (mid != 0)
+                _mm_prefetch(reinterpret_cast<const char*>(&binary_[s + 2 * (mid - cb)]),
+                             _MM_HINT_T0);
+            return Child{s, cb, ce, mid != 0, half_area(s)};
         };
         Child children[kBvhWidth];
         std::uint32_t count = 0;
         const auto open = [&](const Child& c, Child& first, Child& second) {
             const std::uint32_t mid = binary_[c.slot].mid;
-            first = {c.slot + 1, c.b, mid};
-            second = {c.slot + 2 * (mid - c.b), mid, c.e};
+            first = child(c.slot + 1, c.b, mid);
+            second = child(c.slot + 2 * (mid - c.b), mid, c.e);
         };
-        if (binary_[slot].mid == 0) {
-            children[count++] = {slot, b, e};
-        } else {
-            open({slot, b, e}, children[0], children[1]);
-            count = 2;
-        }
-        // Open the inner child with the largest surface area until there are 8.
+        children[count++] = child(slot, b, e);
+        // Open the inner child with the largest surface area (the root first) until there
+        // are 8.
         while (count < kBvhWidth) {
             int pick = -1;
             float pick_area = -1.0f;
-            for (std::uint32_t i = 0; i < count; ++i) {
-                if (binary_[children[i].slot].mid == 0) continue;
-                const float area = half_area(children[i].slot);
-                if (area > pick_area) pick = static_cast<int>(i), pick_area = area;
-            }
+            for (std::uint32_t i = 0; i < count; ++i)
+                if (children[i].inner && children[i].area > pick_area)
+                    pick = static_cast<int>(i), pick_area = children[i].area;
             if (pick < 0) break;
             Child first, second;
             open(children[pick], first, second);
@@ -567,15 +592,19 @@ class Collapser {
         // Largest box first: the any-hit traversals take children in node order, and a ray
         // that meets a node meets its larger children more often (the SAH's odds), so an
         // occluder tends to be found sooner. Closest-hit orders children by distance.
-        std::stable_sort(children, children + count, [&](const Child& x, const Child& y) {
-            return half_area(x.slot) > half_area(y.slot);
-        });
+        // (A stable insertion sort: at most 8 children.)
+        for (std::uint32_t i = 1; i < count; ++i) {
+            const Child c = children[i];
+            std::uint32_t j = i;
+            for (; j > 0 && children[j - 1].area < c.area; --j) children[j] = children[j - 1];
+            children[j] = c;
+        }
         const auto index = static_cast<std::uint32_t>(out.nodes.size());
         out.nodes.emplace_back();
         std::uint32_t refs[kBvhWidth];
         for (std::uint32_t i = 0; i < count; ++i) {
             const Child& c = children[i];
-            if (binary_[c.slot].mid == 0) {
+            if (!c.inner) {
                 ++out.leaf_count;
                 refs[i] = kBvhLeafBit | (c.b << kBvhLeafCountBits) | (c.e - c.b - 1);
             } else if (c.e - c.b >= kParallelCollapse) {
