@@ -89,8 +89,9 @@ namespace {
 // Rays per task: large enough to amortise scheduling, small enough to balance two cores.
 constexpr std::uint32_t kChunkRays = 4096;
 // Builds of each BVH per scene. One build's time moves by a third from run to run on a VM
-// (the first touch of fresh memory costs the most there); the median of three is steadier.
-constexpr int kBuildReps = 3;
+// (the first touch of fresh memory costs the most there, and the first build of a run
+// pays for it more than the others); the median of five is steadier than of three.
+constexpr int kBuildReps = 5;
 static_assert(kChunkRays % kernels::kPacketWidth == 0);
 
 using Clock = std::chrono::steady_clock;
