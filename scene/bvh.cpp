@@ -359,7 +359,7 @@ std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, st
                            Box& right_centers) {
     constexpr int kBroadcast = Axis * 0x55;  // _MM_SHUFFLE(Axis, Axis, Axis, Axis)
     const __m128i last_left = _mm_set1_epi32(bin);
-    const __m128 inf = _mm_set1_ps(kInf), minus_inf = _mm_set1_ps(-kInf);
+    const __m128 all_ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
     Box lc, rc;
     PrimRef* front = dst + b;
     PrimRef* back = dst + e;
@@ -373,10 +373,14 @@ std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, st
         *(right ? back - 1 : front) = p;
         front += 1 + right;
         back += right;
-        // The side's bounds grow by the center, the other side's by an empty box.
+        // The side's bounds grow by the center, the other side's by NaN, which min and
+        // max pass over: minps and maxps return their second operand where either is
+        // NaN, and all ones (the mask) is a NaN.
         const __m128 to_right = _mm_castsi128_ps(right_mask);
-        lc.grow(Box{select(to_right, inf, c), select(to_right, minus_inf, c)});
-        rc.grow(Box{select(to_right, c, inf), select(to_right, c, minus_inf)});
+        const __m128 left_c = _mm_or_ps(c, to_right);
+        const __m128 right_c = _mm_or_ps(c, _mm_xor_ps(to_right, all_ones));
+        lc.lo = _mm_min_ps(left_c, lc.lo), lc.hi = _mm_max_ps(left_c, lc.hi);
+        rc.lo = _mm_min_ps(right_c, rc.lo), rc.hi = _mm_max_ps(right_c, rc.hi);
     }
     left_centers = lc;
     right_centers = rc;
