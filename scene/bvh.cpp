@@ -552,27 +552,26 @@ class Collapser {
                        std::uint32_t depth, Collapsed& out,
                        std::vector<Deferred>& deferred) const {
         out.depth = std::max(out.depth, depth);
-        // A binary node to become a child: its spheres, whether it is inner, its area.
+        // A binary node to become a child: its spheres, its split (0: a leaf), its area.
         struct Child {
-            std::uint32_t slot, b, e;
-            bool inner;
+            std::uint32_t slot, b, e, mid;
             float area;
+            std::uint32_t right_slot() const { return slot + 2 * (mid - b); }
         };
         const auto child = [&](std::uint32_t s, std::uint32_t cb, std::uint32_t ce) {
-            const std::uint32_t mid = binary_[s].mid;
+            const Child c{s, cb, ce, binary_[s].mid, half_area(s)};
             // An inner node's right child lies past its left subtree, far away in memory
             // for a large one: fetched now, it is there when the node is opened.
-            if (mid != 0)
-                _mm_prefetch(reinterpret_cast<const char*>(&binary_[s + 2 * (mid - cb)]),
+            if (c.mid != 0)
+                _mm_prefetch(reinterpret_cast<const char*>(&binary_[c.right_slot()]),
                              _MM_HINT_T0);
-            return Child{s, cb, ce, mid != 0, half_area(s)};
+            return c;
         };
         Child children[kBvhWidth];
         std::uint32_t count = 0;
         const auto open = [&](const Child& c, Child& first, Child& second) {
-            const std::uint32_t mid = binary_[c.slot].mid;
-            first = child(c.slot + 1, c.b, mid);
-            second = child(c.slot + 2 * (mid - c.b), mid, c.e);
+            first = child(c.slot + 1, c.b, c.mid);
+            second = child(c.right_slot(), c.mid, c.e);
         };
         children[count++] = child(slot, b, e);
         // Open the inner child with the largest surface area (the root first) until there
@@ -581,7 +580,7 @@ class Collapser {
             int pick = -1;
             float pick_area = -1.0f;
             for (std::uint32_t i = 0; i < count; ++i)
-                if (children[i].inner && children[i].area > pick_area)
+                if (children[i].mid != 0 && children[i].area > pick_area)
                     pick = static_cast<int>(i), pick_area = children[i].area;
             if (pick < 0) break;
             Child first, second;
@@ -608,7 +607,7 @@ class Collapser {
         std::uint32_t refs[kBvhWidth];
         for (std::uint32_t i = 0; i < count; ++i) {
             const Child& c = children[i];
-            if (!c.inner) {
+            if (c.mid == 0) {
                 ++out.leaf_count;
                 refs[i] = kBvhLeafBit | (c.b << kBvhLeafCountBits) | (c.e - c.b - 1);
             } else if (c.e - c.b >= kParallelCollapse) {

@@ -152,6 +152,14 @@ bool box_contains(const BvhNode8& n, int j, const double lo[3], const double hi[
            n.max_x[j] >= hi[0] && n.max_y[j] >= hi[1] && n.max_z[j] >= hi[2];
 }
 
+double half_area(double dx, double dy, double dz) { return dx * dy + dy * dz + dz * dx; }
+
+// Half the surface area of child j's box.
+double child_half_area(const BvhNode8& n, int j) {
+    return half_area(n.max_x[j] - n.min_x[j], n.max_y[j] - n.min_y[j],
+                     n.max_z[j] - n.min_z[j]);
+}
+
 // Walks the tree; returns the subtree's exact box and counts each sphere's leaves.
 DBox check_node(const SphereBvh& bvh, std::uint32_t index, std::vector<int>& seen,
                 std::uint32_t depth, std::uint32_t& max_depth) {
@@ -172,9 +180,7 @@ DBox check_node(const SphereBvh& bvh, std::uint32_t index, std::vector<int>& see
         }
         EXPECT_FALSE(empty_seen) << "empty slots come last";
         // Largest box first (the any-hit traversals visit children in node order).
-        const double dx = n.max_x[j] - n.min_x[j], dy = n.max_y[j] - n.min_y[j],
-                     dz = n.max_z[j] - n.min_z[j];
-        const double area = dx * dy + dy * dz + dz * dx;
+        const double area = child_half_area(n, j);
         EXPECT_LE(area, previous_area * (1.0 + 1e-6)) << "node " << index << " child " << j;
         previous_area = area;
         DBox box;
@@ -286,18 +292,14 @@ TEST(SphereBvh, InvariantsOfALargeTree) {
 TEST(SphereBvh, LeavesAreSmallPartsOfTheRoot) {
     const NamedScene ns = large_scene();
     const SphereBvh bvh = build_sphere_bvh(compile_scene(ns.scene).spheres);
-    const auto half_area = [](double dx, double dy, double dz) {
-        return dx * dy + dy * dz + dz * dx;
-    };
     const double root =
         half_area(bvh.hi[0] - bvh.lo[0], bvh.hi[1] - bvh.lo[1], bvh.hi[2] - bvh.lo[2]);
     double leaf_areas = 0.0;
     std::uint32_t leaves = 0;
     for (const BvhNode8& n : bvh.nodes)
-        for (std::uint32_t j = 0; j < kBvhWidth; ++j)
+        for (int j = 0; j < 8; ++j)
             if (n.child[j] != kBvhEmpty && (n.child[j] & kBvhLeafBit) != 0) {
-                leaf_areas += half_area(n.max_x[j] - n.min_x[j], n.max_y[j] - n.min_y[j],
-                                        n.max_z[j] - n.min_z[j]);
+                leaf_areas += child_half_area(n, j);
                 ++leaves;
             }
     ASSERT_EQ(leaves, bvh.leaf_count);
