@@ -444,6 +444,7 @@ PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
     const Plane mins[3] = {&BvhNode8::min_x, &BvhNode8::min_y, &BvhNode8::min_z};
     const Plane maxs[3] = {&BvhNode8::max_x, &BvhNode8::max_y, &BvhNode8::max_z};
     PacketFrustum<F> f;
+    if (live == 0) return f;  // nothing to trace (any hit: planes occluded every lane)
     for (int a = 0; a < 3; ++a) {
         float lo = kInf, hi = -kInf;
         for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
