@@ -435,6 +435,7 @@ struct PacketFrustum {
     F inv_lo[3], inv_hi[3], near_off[3], far_off[3];
 };
 
+// `live`: not empty.
 template <class F>
 PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
     using Plane = typename PacketFrustum<F>::Plane;
@@ -444,7 +445,6 @@ PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
     const Plane mins[3] = {&BvhNode8::min_x, &BvhNode8::min_y, &BvhNode8::min_z};
     const Plane maxs[3] = {&BvhNode8::max_x, &BvhNode8::max_y, &BvhNode8::max_z};
     PacketFrustum<F> f;
-    if (live == 0) return f;  // nothing to trace (any hit: planes occluded every lane)
     for (int a = 0; a < 3; ++a) {
         float lo = kInf, hi = -kInf;
         for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
@@ -795,6 +795,7 @@ std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std:
                                        F::load_aligned(p.best_t + at)))
                 << at;
     done &= live;
+    if (done == live) return done;  // no lane left to trace
     return done | bvh_occluded_packet<Arch>(s, p, live & ~done, st);
 }
 
