@@ -17,8 +17,7 @@ tbb=$PWD/build/tsan-tbb/install
 
 # 2. The canary must be caught.
 mkdir -p build/tsan
-c++ -std=c++20 -g -O1 -fsanitize=thread -I"$tbb/include" tests/tsan/race_canary.cpp \
-  -o build/tsan/race_canary -L"$tbb/lib" -Wl,-rpath,"$tbb/lib" -ltbb
+c++ -std=c++20 -g -O1 -fsanitize=thread tests/tsan/race_canary.cpp -o build/tsan/race_canary
 if TSAN_OPTIONS=halt_on_error=1 build/tsan/race_canary > build/tsan/race_canary.log 2>&1 ||
    ! grep -q "ThreadSanitizer: data race" build/tsan/race_canary.log; then
   cat build/tsan/race_canary.log
