@@ -594,7 +594,8 @@ void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket
     sp += count;
 }
 
-// Closest hits of the packet `p` (lanes `live`) among the BVH's spheres.
+// Closest hits of the packet `p` (lanes `live`, not empty: packet_frustum) among the BVH's
+// spheres.
 template <class Arch>
 void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, float t_min,
                         BvhStacks& st) {
@@ -663,7 +664,8 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
     }
 }
 
-// Sets bit i of the result for each lane of `live` that a sphere occludes on (0, t_max).
+// Sets bit i of the result for each lane of `live` (not empty: packet_frustum) that a sphere
+// occludes on (0, t_max).
 template <class Arch>
 std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::uint32_t live,
                                   BvhStacks& st) {
