@@ -248,8 +248,7 @@ constexpr std::uint64_t kOracleBudget = 1ull << 30;  // ray-object tests per ray
 constexpr std::uint32_t kOracleMinRays = 1024;
 std::uint32_t capped_validation(std::uint32_t asked, std::uint32_t objects) {
     if (asked == 0 || objects == 0) return asked;
-    const std::uint64_t cap =
-        std::max<std::uint64_t>(kOracleMinRays, kOracleBudget / objects);
+    const std::uint64_t cap = std::max<std::uint64_t>(kOracleMinRays, kOracleBudget / objects);
     return static_cast<std::uint32_t>(std::min<std::uint64_t>(asked, cap));
 }
 
@@ -266,11 +265,13 @@ Scene load_bench_scene(const std::string& spec, int width, int height) {
 // image and ray counts.
 std::string validate_render(const std::string& spec, const BenchOptions& o, Isa isa,
                             Accel accel, bool& valid) {
-    int width = std::min(o.width, o.validate_width), height = std::min(o.height, o.validate_height);
+    int width = std::min(o.width, o.validate_width),
+        height = std::min(o.height, o.validate_height);
     // The reference render is brute force: shrink the image on large scenes (same budget
     // as the ray sets' oracle, counting pixels).
     const Scene probe = load_scene(spec);
-    const auto objects = static_cast<std::uint64_t>(std::max<std::size_t>(1, probe.objects.size()));
+    const auto objects =
+        static_cast<std::uint64_t>(std::max<std::size_t>(1, probe.objects.size()));
     while (static_cast<std::uint64_t>(width) * height * objects > kOracleBudget &&
            width * height > 256)
         width = std::max(1, width / 2), height = std::max(1, height / 2);
@@ -299,7 +300,6 @@ struct SimdConfig {
     kernels::SceneView view;
     Accel accel;  // as asked (a whole render resolves it itself)
 };
-
 
 }  // namespace
 
@@ -443,22 +443,22 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
             const std::vector<std::uint32_t> lanes =
                 use_bvh ? o.packet_lanes : std::vector<std::uint32_t>{0};
             for (std::uint32_t l : lanes) {
-                const bool seen = std::any_of(simd_configs.begin(), simd_configs.end(),
-                                              [&](const SimdConfig& c) {
-                                                  return c.bvh == use_bvh && c.lanes == l;
-                                              });
+                const bool seen = std::any_of(
+                    simd_configs.begin(), simd_configs.end(),
+                    [&](const SimdConfig& c) { return c.bvh == use_bvh && c.lanes == l; });
                 if (seen) continue;
                 simd_configs.push_back(
                     {use_bvh, l, use_bvh ? make_scene_view(compiled, bvh, l) : view, accel});
             }
         }
         if (bvh.sphere_count > 0)
-            log_line(log, spec + ": octray BVH built in " + format("%.3f ms", *info.bvh_build_ms) +
-                              ", " + format("%.1f bytes/sphere", *info.bvh_bytes_per_sphere) +
-                              (info.embree_bytes_per_sphere
-                                   ? ", Embree " + format("%.1f bytes/sphere",
-                                                          *info.embree_bytes_per_sphere)
-                                   : std::string()));
+            log_line(log,
+                     spec + ": octray BVH built in " + format("%.3f ms", *info.bvh_build_ms) +
+                         ", " + format("%.1f bytes/sphere", *info.bvh_bytes_per_sphere) +
+                         (info.embree_bytes_per_sphere
+                              ? ", Embree " +
+                                    format("%.1f bytes/sphere", *info.embree_bytes_per_sphere)
+                              : std::string()));
         log_line(log, spec + ": " + std::to_string(info.objects) + " objects, compiled in " +
                           format("%.3f ms", info.compile_ms) +
                           (info.embree_build_ms ? ", Embree BVH built in " +
@@ -584,58 +584,60 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                             configs.push_back(&c);
                     if (path == TracePath::scalar || configs.empty()) configs = {nullptr};
                     for (Isa isa : path_isas)
-                    for (const SimdConfig* config : configs) {
-                        const Accel accel = config ? config->accel : Accel::none;
-                        BenchRow row =
-                            base_row(Workload::whitted, Variant{PixelOrder::tiled, tile});
-                        row.system = "octray";
-                        row.mode = path == TracePath::simd ? "packet8" : "single";
-                        row.isa = path == TracePath::simd ? isa_name(isa) : "scalar";
-                        if (config) row.accel = config->bvh ? "bvh" : "none";
-                        if (path == TracePath::simd) {
-                            const auto key = std::make_pair(isa, config && config->bvh);
-                            auto it = render_validation.find(key);
-                            if (it == render_validation.end()) {
-                                bool ok = false;
-                                std::string text = validate_render(spec, o, isa, accel, ok);
-                                it = render_validation.emplace(key, std::make_pair(ok, text))
-                                         .first;
+                        for (const SimdConfig* config : configs) {
+                            const Accel accel = config ? config->accel : Accel::none;
+                            BenchRow row =
+                                base_row(Workload::whitted, Variant{PixelOrder::tiled, tile});
+                            row.system = "octray";
+                            row.mode = path == TracePath::simd ? "packet8" : "single";
+                            row.isa = path == TracePath::simd ? isa_name(isa) : "scalar";
+                            if (config) row.accel = config->bvh ? "bvh" : "none";
+                            if (path == TracePath::simd) {
+                                const auto key = std::make_pair(isa, config && config->bvh);
+                                auto it = render_validation.find(key);
+                                if (it == render_validation.end()) {
+                                    bool ok = false;
+                                    std::string text = validate_render(spec, o, isa, accel, ok);
+                                    it =
+                                        render_validation.emplace(key, std::make_pair(ok, text))
+                                            .first;
+                                }
+                                row.valid = it->second.first;
+                                row.validation = it->second.second;
+                            } else {
+                                row.valid = true;
+                                row.validation = "the scalar reference is the oracle";
                             }
-                            row.valid = it->second.first;
-                            row.validation = it->second.second;
-                        } else {
-                            row.valid = true;
-                            row.validation = "the scalar reference is the oracle";
+                            RenderOptions ro;
+                            ro.threads = ctx.threads;
+                            ro.tile_width = tile.width;
+                            ro.tile_height = tile.height;
+                            ro.accel = accel;
+                            const auto render = [&] {
+                                return path == TracePath::simd
+                                           ? render_packet(compiled, ro, isa)
+                                           : render_reference(scene, ro);
+                            };
+                            RenderResult last;
+                            for (int i = 0; i < std::max(1, o.warmup); ++i) last = render();
+                            for (int i = 0; i < o.reps; ++i) {
+                                last = render();
+                                row.seconds.push_back(last.seconds);
+                            }
+                            row.counts = last.rays;
+                            row.rays = last.rays.total();
+                            row.hit_fraction = std::nan("");
+                            row.timing = summarize(row.seconds, row.rays);
+                            row.frames_per_second = row.timing.seconds_median > 0.0
+                                                        ? 1.0 / row.timing.seconds_median
+                                                        : 0.0;
+                            log_line(log, "  whitted octray " + row.mode + " " + row.isa + " " +
+                                              row.accel + " tile " + row.tile + ": " +
+                                              format("%.3f frames/s", row.frames_per_second) +
+                                              ", " +
+                                              format("%.2f Mrays/s", row.timing.mrays_median));
+                            report.rows.push_back(std::move(row));
                         }
-                        RenderOptions ro;
-                        ro.threads = ctx.threads;
-                        ro.tile_width = tile.width;
-                        ro.tile_height = tile.height;
-                        ro.accel = accel;
-                        const auto render = [&] {
-                            return path == TracePath::simd ? render_packet(compiled, ro, isa)
-                                                           : render_reference(scene, ro);
-                        };
-                        RenderResult last;
-                        for (int i = 0; i < std::max(1, o.warmup); ++i) last = render();
-                        for (int i = 0; i < o.reps; ++i) {
-                            last = render();
-                            row.seconds.push_back(last.seconds);
-                        }
-                        row.counts = last.rays;
-                        row.rays = last.rays.total();
-                        row.hit_fraction = std::nan("");
-                        row.timing = summarize(row.seconds, row.rays);
-                        row.frames_per_second = row.timing.seconds_median > 0.0
-                                                    ? 1.0 / row.timing.seconds_median
-                                                    : 0.0;
-                        log_line(log, "  whitted octray " + row.mode + " " + row.isa + " " +
-                                          row.accel + " tile " + row.tile + ": " +
-                                          format("%.3f frames/s", row.frames_per_second) +
-                                          ", " +
-                                          format("%.2f Mrays/s", row.timing.mrays_median));
-                        report.rows.push_back(std::move(row));
-                    }
                 }
             }
         }

@@ -14,8 +14,8 @@
 #include "bench/ray_sets.h"
 #include "kernels/dispatch.h"
 #include "kernels/isa.h"
-#include "scene/accel.h"
 #include "render/types.h"
+#include "scene/accel.h"
 
 namespace octray::bench {
 
@@ -98,8 +98,8 @@ struct SceneInfo {
     std::string spec;
     std::uint32_t objects = 0, spheres = 0, planes = 0, lights = 0;
     float epsilon = 0.0f;
-    double compile_ms = 0.0;                                              // compile_scene()
-    std::optional<double> embree_build_ms;                                // rtcCommitScene()
+    double compile_ms = 0.0;                        // compile_scene()
+    std::optional<double> embree_build_ms;          // rtcCommitScene()
     std::optional<double> embree_bytes_per_sphere;  // Embree's device memory after the build
     // octray's sphere BVH (scene/bvh.h): build time, bytes per sphere (nodes and its copy of
     // the spheres), 8-wide nodes, leaves, depth. Absent without spheres.

@@ -6,7 +6,6 @@
 // whole scenes, on 1 and 2 threads, in spheres per second. Figures: bench/README.md.
 
 #include <benchmark/benchmark.h>
-
 #include <tbb/task_arena.h>
 
 #include <cstring>

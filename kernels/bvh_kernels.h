@@ -429,7 +429,7 @@ void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep,
 template <class F>
 struct PacketFrustum {
     using Plane = const float (BvhNode8::*)[kBvhWidth];
-    bool valid = false;  // every axis has one direction sign over the lanes
+    bool valid = false;       // every axis has one direction sign over the lanes
     bool one_origin = false;  // ... and the lanes share their origin
     Plane near[3], far[3];
     F inv_lo[3], inv_hi[3], near_off[3], far_off[3];

@@ -5,6 +5,8 @@
 #define OCTRAY_KERNEL_NAMESPACE avx2_fma
 #include "kernels/kernel_table.h"
 #include "kernels/packet_kernels.h"
+// Uses packet_kernels.h, so it comes after it (its own block keeps clang-format from
+// sorting it first).
 #include "kernels/bvh_kernels.h"
 
 namespace octray::kernels {

@@ -48,9 +48,8 @@ std::optional<AovSet> parse_aov_list(std::string_view list, std::string* error) 
     std::size_t start = 0;
     while (true) {
         const std::size_t comma = list.find(',', start);
-        const std::string_view item =
-            list.substr(start, comma == std::string_view::npos ? std::string_view::npos
-                                                               : comma - start);
+        const std::string_view item = list.substr(
+            start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
         if (item.empty()) {
             std::string why = "empty item in the AOV list '";
             why += list;
@@ -105,7 +104,7 @@ AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet 
                     if (set.depth) out.depth[k] = hit->t;
                     if (set.normal)  // the normal shading uses: facing the incoming ray
                         out.normal[k] = dot(hit->normal, ray->direction) > 0.0f ? -hit->normal
-                                                                                 : hit->normal;
+                                                                                : hit->normal;
                     if (set.albedo) out.albedo[k] = tracer.surface_color(*hit);
                     if (set.id) out.id[k] = hit->object + 1;
                 }
@@ -117,8 +116,8 @@ AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet 
 
 void append_aov_channels(ExrImage& exr, const AovImages& aovs, ExrPixelType color_type) {
     if (!(exr.data_window == aovs.rect))
-        throw std::invalid_argument("append_aov_channels: the AOVs cover " + to_string(aovs.rect) +
-                                    ", the image's data window is " +
+        throw std::invalid_argument("append_aov_channels: the AOVs cover " +
+                                    to_string(aovs.rect) + ", the image's data window is " +
                                     to_string(exr.data_window));
     if (color_type == ExrPixelType::uint32)
         throw std::invalid_argument("append_aov_channels: colors are half or float");

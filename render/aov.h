@@ -36,10 +36,10 @@ std::optional<AovSet> parse_aov_list(std::string_view list, std::string* error =
 struct AovImages {
     AovSet set;
     PixelRect rect;
-    std::vector<float> depth;          // t of the first hit along the unit primary ray; +inf: miss
-    std::vector<Vec3> normal;          // world-space unit normal facing the ray; 0: miss
-    std::vector<Rgb> albedo;           // Cd at the hit (checker included); 0: miss
-    std::vector<std::uint32_t> id;     // Scene::objects index + 1; 0: miss
+    std::vector<float> depth;       // t of the first hit along the unit primary ray; +inf: miss
+    std::vector<Vec3> normal;       // world-space unit normal facing the ray; 0: miss
+    std::vector<Rgb> albedo;        // Cd at the hit (checker included); 0: miss
+    std::vector<std::uint32_t> id;  // Scene::objects index + 1; 0: miss
 };
 
 // Computes `set` for the pixels of options.crop (or the whole image) of frame

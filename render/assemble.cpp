@@ -123,8 +123,8 @@ ExrImage assemble_parts(const std::vector<ExrImage>& parts,
         throw AssembleError("no part covers pixel (" + std::to_string(gap.x0) + ", " +
                             std::to_string(gap.y0) + "): the parts leave " +
                             std::to_string(uncovered) + " of the " + std::to_string(pixels) +
-                            " pixels of " + to_string(display) +
-                            " uncovered, among them " + to_string(gap));
+                            " pixels of " + to_string(display) + " uncovered, among them " +
+                            to_string(gap));
     }
 
     ExrImage out;
@@ -133,8 +133,8 @@ ExrImage assemble_parts(const std::vector<ExrImage>& parts,
     out.compression = first.compression;
     out.attributes = first.attributes;
     for (const ExrChannel& c : first.channels)
-        out.channels.push_back(
-            ExrChannel{c.name, c.type, std::vector<unsigned char>(pixels * sample_size(c.type))});
+        out.channels.push_back(ExrChannel{
+            c.name, c.type, std::vector<unsigned char>(pixels * sample_size(c.type))});
     const std::size_t width = static_cast<std::size_t>(display.width());
     for (const ExrImage& p : parts) {
         const PixelRect& r = p.data_window;
@@ -143,9 +143,9 @@ ExrImage assemble_parts(const std::vector<ExrImage>& parts,
             const std::size_t size = sample_size(c.type);
             const std::size_t row_bytes = static_cast<std::size_t>(r.width()) * size;
             for (int y = r.y0; y < r.y1; ++y) {
-                const std::size_t to =
-                    (static_cast<std::size_t>(y - display.y0) * width +
-                     static_cast<std::size_t>(r.x0 - display.x0)) * size;
+                const std::size_t to = (static_cast<std::size_t>(y - display.y0) * width +
+                                        static_cast<std::size_t>(r.x0 - display.x0)) *
+                                       size;
                 const std::size_t from = static_cast<std::size_t>(y - r.y0) * row_bytes;
                 std::memcpy(c.samples.data() + to, source.samples.data() + from, row_bytes);
             }

@@ -16,7 +16,7 @@ namespace octray {
 // window or the channels, or lie outside the display window. The message names the parts
 // and the pixels concerned.
 class AssembleError : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 
@@ -25,7 +25,8 @@ public:
 // channels with the same pixel types; the data windows must lie inside the display
 // window, must not overlap and must together cover it. The result carries the first
 // part's compression and attributes. Throws AssembleError.
-ExrImage assemble_parts(const std::vector<ExrImage>& parts, const std::vector<std::string>& names);
+ExrImage assemble_parts(const std::vector<ExrImage>& parts,
+                        const std::vector<std::string>& names);
 
 struct AssembleSummary {
     PixelRect display_window;

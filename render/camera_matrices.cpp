@@ -49,7 +49,8 @@ Matrix44 world_to_camera(const Scene& scene) {
 }
 
 std::optional<Matrix44> world_to_ndc(const Scene& scene) {
-    const CameraFrame f = make_camera_frame(scene.camera, scene.image.width, scene.image.height);
+    const CameraFrame f =
+        make_camera_frame(scene.camera, scene.image.width, scene.image.height);
     Matrix44 p{};  // camera space -> NDC
     switch (f.type) {
         case CameraType::pinhole:

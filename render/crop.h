@@ -37,7 +37,8 @@ inline PixelRect render_rect(const RenderOptions& options, int width, int height
         message += std::to_string(width);
         message += "x";
         message += std::to_string(height);
-        message += "; a crop is x0,y0,x1,y1 with 0 <= x0 < x1 <= width, 0 <= y0 < y1 <= height)";
+        message +=
+            "; a crop is x0,y0,x1,y1 with 0 <= x0 < x1 <= width, 0 <= y0 < y1 <= height)";
         throw std::invalid_argument(message);
     }
     return c;
@@ -59,9 +60,9 @@ inline SampleRange render_sample_range(const RenderOptions& options, int spp,
         message += ")";
         throw std::invalid_argument(message);
     }
-    if (r.begin > 0 && (options.sample_sums == nullptr ||
-                        options.sample_sums->width() != rect.width() ||
-                        options.sample_sums->height() != rect.height()))
+    if (r.begin > 0 &&
+        (options.sample_sums == nullptr || options.sample_sums->width() != rect.width() ||
+         options.sample_sums->height() != rect.height()))
         throw std::invalid_argument(
             "a sample range that starts after sample 0 needs the previous pass's sums "
             "(RenderOptions::sample_sums) at the size of the rendered rectangle");

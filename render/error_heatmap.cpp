@@ -67,17 +67,17 @@ constexpr Glyph glyphs[] = {
     {'-', {0, 0, 7, 0, 0}}, {'+', {0, 2, 7, 2, 0}},
 };
 
-constexpr int font_scale = 2;                    // each font pixel is 2x2
+constexpr int font_scale = 2;  // each font pixel is 2x2
 constexpr int glyph_height = 5 * font_scale;
-constexpr int glyph_advance = 4 * font_scale;    // one font pixel between glyphs
-constexpr int min_canvas_width = 256;            // room for three labels under the bar
+constexpr int glyph_advance = 4 * font_scale;  // one font pixel between glyphs
+constexpr int min_canvas_width = 256;          // room for three labels under the bar
 constexpr int margin = 8;
 constexpr int bar_height = 14;
 constexpr std::array<std::uint8_t, 3> background{24, 24, 24};
 constexpr std::array<std::uint8_t, 3> text_color{235, 235, 235};
 
 class Canvas {
-public:
+  public:
     explicit Canvas(Rgb8Image& image) : image_(image) {}
 
     void set(int x, int y, std::array<std::uint8_t, 3> color) {
@@ -104,7 +104,7 @@ public:
         }
     }
 
-private:
+  private:
     Rgb8Image& image_;
 };
 

@@ -30,8 +30,8 @@ struct Rgb8Image {
 
 struct ErrorHeatmap {
     Rgb8Image image;
-    int zoom = 1;             // each source pixel is a zoom x zoom block at the top left
-    double scale_max = 0.0;   // the error that maps to the ramp's top (the max finite error)
+    int zoom = 1;                // each source pixel is a zoom x zoom block at the top left
+    double scale_max = 0.0;      // the error that maps to the ramp's top (the max finite error)
     int bar_x0 = 0, bar_x1 = 0;  // the legend bar's columns [x0, x1) and rows [y0, y1)
     int bar_y0 = 0, bar_y1 = 0;
 };

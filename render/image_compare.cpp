@@ -6,11 +6,10 @@
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "render/image_io.h"
@@ -128,7 +127,8 @@ void judge(CompareResult& result, const CompareOptions& options) {
                         nonfinite_note(all) + "; allowed " + percent(options.fail_percent);
         return;
     }
-    if (all.max_abs_error > options.hard_fail || (infinite_error && options.hard_fail < infinity)) {
+    if (all.max_abs_error > options.hard_fail ||
+        (infinite_error && options.hard_fail < infinity)) {
         result.verdict = Verdict::fail;
         result.reason = infinite_error && !(all.max_abs_error > options.hard_fail)
                             ? "FAIL: " + std::to_string(all.nonfinite_pixels) +
@@ -139,8 +139,7 @@ void judge(CompareResult& result, const CompareOptions& options) {
                                   number(options.hard_fail);
         return;
     }
-    const std::string warn_of_pixels = " of " +
-                                       std::to_string(static_cast<long long>(pixels)) +
+    const std::string warn_of_pixels = " of " + std::to_string(static_cast<long long>(pixels)) +
                                        " pixels (" + percent(all.warn_percent) + ")";
     if (static_cast<double>(all.warn_pixels) > options.warn_percent / 100.0 * pixels) {
         result.verdict = Verdict::warn;
@@ -149,12 +148,14 @@ void judge(CompareResult& result, const CompareOptions& options) {
                         nonfinite_note(all) + "; allowed " + percent(options.warn_percent);
         return;
     }
-    if (all.max_abs_error > options.hard_warn || (infinite_error && options.hard_warn < infinity)) {
+    if (all.max_abs_error > options.hard_warn ||
+        (infinite_error && options.hard_warn < infinity)) {
         result.verdict = Verdict::warn;
         result.reason = infinite_error && !(all.max_abs_error > options.hard_warn)
                             ? "WARN: " + std::to_string(all.nonfinite_pixels) +
                                   " pixels hold NaN or Inf, an error over the hard warning "
-                                  "limit " + number(options.hard_warn)
+                                  "limit " +
+                                  number(options.hard_warn)
                             : "WARN: error " + number(all.max_abs_error) + " at " +
                                   where(all.worst) + " is over the hard warning limit " +
                                   number(options.hard_warn);
@@ -166,8 +167,8 @@ void judge(CompareResult& result, const CompareOptions& options) {
     else
         result.reason = "PASS: max error " + number(all.max_abs_error) + "; " +
                         std::to_string(all.fail_pixels) + of_pixels + " over " +
-                        number(options.fail_threshold) + nonfinite_note(all) +
-                        ", within the " + percent(options.fail_percent) + " allowed";
+                        number(options.fail_threshold) + nonfinite_note(all) + ", within the " +
+                        percent(options.fail_percent) + " allowed";
 }
 
 }  // namespace
@@ -179,10 +180,10 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                             std::to_string(a.height) + ", B is " + std::to_string(b.width) +
                             "x" + std::to_string(b.height));
     if (a.origin_x != b.origin_x || a.origin_y != b.origin_y)
-        throw ImageMismatch("data window mismatch: A starts at (" +
-                            std::to_string(a.origin_x) + ", " + std::to_string(a.origin_y) +
-                            "), B at (" + std::to_string(b.origin_x) + ", " +
-                            std::to_string(b.origin_y) + ")");
+        throw ImageMismatch("data window mismatch: A starts at (" + std::to_string(a.origin_x) +
+                            ", " + std::to_string(a.origin_y) + "), B at (" +
+                            std::to_string(b.origin_x) + ", " + std::to_string(b.origin_y) +
+                            ")");
 
     CompareResult result;
     result.width = a.width;
@@ -230,7 +231,8 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                 ++stats.nonfinite_pixels;
                 ++stats.fail_pixels;
                 ++stats.warn_pixels;
-                if (!stats.first_nonfinite) stats.first_nonfinite = sample_at(i, stats.channel, va, vb);
+                if (!stats.first_nonfinite)
+                    stats.first_nonfinite = sample_at(i, stats.channel, va, vb);
                 if (i < all_first_nonfinite) {
                     all_first_nonfinite = i;
                     all.first_nonfinite = sample_at(i, stats.channel, va, vb);
@@ -260,8 +262,8 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                 flags[i] |= over_warn;
             }
         }
-        stats.worst = sample_at(worst_index, stats.channel, plane_a[worst_index],
-                                plane_b[worst_index]);
+        stats.worst =
+            sample_at(worst_index, stats.channel, plane_a[worst_index], plane_b[worst_index]);
         finish(stats, sums, pixels);
 
         // The overall worst: the largest error; on a tie the earlier pixel, then the
@@ -315,9 +317,9 @@ ChannelImage difference_image(const ChannelImage& a, const ChannelImage& b,
 }
 
 void write_channel_exr(const std::string& path, const ChannelImage& image) {
-    const Imath::Box2i window(Imath::V2i(image.origin_x, image.origin_y),
-                              Imath::V2i(image.origin_x + image.width - 1,
-                                         image.origin_y + image.height - 1));
+    const Imath::Box2i window(
+        Imath::V2i(image.origin_x, image.origin_y),
+        Imath::V2i(image.origin_x + image.width - 1, image.origin_y + image.height - 1));
     write_file_atomically(path, [&](const std::string& tmp_path) {
         Imf::Header header(window, window);
         header.compression() = Imf::ZIP_COMPRESSION;
@@ -354,15 +356,15 @@ std::string format_compare_report(const CompareResult& result, const CompareOpti
     const auto row = [&](const ErrorStats& s) {
         const std::string at =
             "(" + std::to_string(s.worst.x) + ", " + std::to_string(s.worst.y) + ")";
-        std::snprintf(line, sizeof line,
-                      "  %-10s %12s %12s %18s %12s %12s %12s %9s %12s %9llu %9llu\n",
-                      s.channel.c_str(), number(s.mean_abs_error).c_str(),
-                      number(s.max_abs_error).c_str(), at.c_str(), number(s.worst.a).c_str(),
-                      number(s.worst.b).c_str(), number(s.rmse).c_str(),
-                      std::isinf(s.psnr) ? "inf" : number(std::round(s.psnr * 100) / 100).c_str(),
-                      number(s.mean_relative_error).c_str(),
-                      static_cast<unsigned long long>(s.fail_pixels),
-                      static_cast<unsigned long long>(s.warn_pixels));
+        std::snprintf(
+            line, sizeof line, "  %-10s %12s %12s %18s %12s %12s %12s %9s %12s %9llu %9llu\n",
+            s.channel.c_str(), number(s.mean_abs_error).c_str(),
+            number(s.max_abs_error).c_str(), at.c_str(), number(s.worst.a).c_str(),
+            number(s.worst.b).c_str(), number(s.rmse).c_str(),
+            std::isinf(s.psnr) ? "inf" : number(std::round(s.psnr * 100) / 100).c_str(),
+            number(s.mean_relative_error).c_str(),
+            static_cast<unsigned long long>(s.fail_pixels),
+            static_cast<unsigned long long>(s.warn_pixels));
         out << line;
     };
     for (const ErrorStats& s : result.channels) row(s);
@@ -394,7 +396,10 @@ nlohmann::ordered_json value_json(float v) {
 }
 
 nlohmann::ordered_json sample_json(const PixelSample& s) {
-    return {{"x", s.x}, {"y", s.y}, {"channel", s.channel}, {"a", value_json(s.a)},
+    return {{"x", s.x},
+            {"y", s.y},
+            {"channel", s.channel},
+            {"a", value_json(s.a)},
             {"b", value_json(s.b)}};
 }
 
@@ -406,7 +411,8 @@ nlohmann::ordered_json stats_json(const ErrorStats& s) {
         {"max_abs_error", s.max_abs_error},
         {"max_at", sample_json(s.worst)},
         {"rmse", s.rmse},
-        {"psnr_db", std::isinf(s.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.psnr)},
+        {"psnr_db",
+         std::isinf(s.psnr) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.psnr)},
         {"psnr_peak", s.peak},
         {"mean_relative_error", s.mean_relative_error},
         {"fail_pixels", s.fail_pixels},
@@ -418,8 +424,8 @@ nlohmann::ordered_json stats_json(const ErrorStats& s) {
         {"inf_a", s.inf_a},
         {"nan_b", s.nan_b},
         {"inf_b", s.inf_b},
-        {"first_nonfinite", s.first_nonfinite ? sample_json(*s.first_nonfinite)
-                                              : nlohmann::ordered_json(nullptr)},
+        {"first_nonfinite",
+         s.first_nonfinite ? sample_json(*s.first_nonfinite) : nlohmann::ordered_json(nullptr)},
     };
     return j;
 }

@@ -39,7 +39,7 @@ std::string_view to_string(Verdict verdict);  // "PASS", "WARN", "FAIL"
 // The images cannot be compared value by value: different sizes, data windows or channel
 // sets (idiff's "different size" outcome).
 class ImageMismatch : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 
@@ -74,7 +74,7 @@ struct ErrorStats {
     // count as failing and warning pixels too.
     std::uint64_t nonfinite_pixels = 0;
     std::uint64_t nan_a = 0, inf_a = 0, nan_b = 0, inf_b = 0;  // values, not pixels
-    std::optional<PixelSample> first_nonfinite;  // in scan order
+    std::optional<PixelSample> first_nonfinite;                // in scan order
 };
 
 struct CompareResult {

@@ -1,9 +1,5 @@
 #include "render/image_io.h"
 
-#include <fcntl.h>
-#include <png.h>
-#include <unistd.h>
-
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
 #include <ImfFloatAttribute.h>
@@ -18,7 +14,10 @@
 #include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
 #include <ImfVersion.h>
+#include <fcntl.h>
 #include <half.h>
+#include <png.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -81,16 +80,26 @@ std::string create_temporary_file(const fs::path& target) {
 
 Imf::Compression to_imf(ExrCompression compression) {
     switch (compression) {
-        case ExrCompression::none: return Imf::NO_COMPRESSION;
-        case ExrCompression::rle: return Imf::RLE_COMPRESSION;
-        case ExrCompression::zips: return Imf::ZIPS_COMPRESSION;
-        case ExrCompression::zip: return Imf::ZIP_COMPRESSION;
-        case ExrCompression::piz: return Imf::PIZ_COMPRESSION;
-        case ExrCompression::pxr24: return Imf::PXR24_COMPRESSION;
-        case ExrCompression::b44: return Imf::B44_COMPRESSION;
-        case ExrCompression::b44a: return Imf::B44A_COMPRESSION;
-        case ExrCompression::dwaa: return Imf::DWAA_COMPRESSION;
-        case ExrCompression::dwab: return Imf::DWAB_COMPRESSION;
+        case ExrCompression::none:
+            return Imf::NO_COMPRESSION;
+        case ExrCompression::rle:
+            return Imf::RLE_COMPRESSION;
+        case ExrCompression::zips:
+            return Imf::ZIPS_COMPRESSION;
+        case ExrCompression::zip:
+            return Imf::ZIP_COMPRESSION;
+        case ExrCompression::piz:
+            return Imf::PIZ_COMPRESSION;
+        case ExrCompression::pxr24:
+            return Imf::PXR24_COMPRESSION;
+        case ExrCompression::b44:
+            return Imf::B44_COMPRESSION;
+        case ExrCompression::b44a:
+            return Imf::B44A_COMPRESSION;
+        case ExrCompression::dwaa:
+            return Imf::DWAA_COMPRESSION;
+        case ExrCompression::dwab:
+            return Imf::DWAB_COMPRESSION;
     }
     throw std::invalid_argument("unknown EXR compression");
 }
@@ -115,16 +124,19 @@ Imath::Box2i to_box(const PixelRect& r) {
 
 Imf::PixelType to_imf(ExrPixelType type) {
     switch (type) {
-        case ExrPixelType::uint32: return Imf::UINT;
-        case ExrPixelType::half: return Imf::HALF;
-        case ExrPixelType::float32: return Imf::FLOAT;
+        case ExrPixelType::uint32:
+            return Imf::UINT;
+        case ExrPixelType::half:
+            return Imf::HALF;
+        case ExrPixelType::float32:
+            return Imf::FLOAT;
     }
     throw std::invalid_argument("unknown EXR pixel type");
 }
 
 // Attributes the writer derives from the image itself; a caller may not set them.
 constexpr std::array<std::string_view, 11> kStructuralAttributes{
-    "channels", "compression", "dataWindow", "displayWindow", "lineOrder", "tiles",
+    "channels", "compression", "dataWindow", "displayWindow", "lineOrder",         "tiles",
     "type",     "name",        "version",    "chunkCount",    "maxSamplesPerPixel"};
 
 void insert_attribute(Imf::Header& header, std::set<std::string>& seen, const std::string& name,
@@ -248,8 +260,8 @@ void png_warning_handler(png_structp, png_const_charp) {}
 // never skip a C++ destructor. Returns an empty string on success, else the reason.
 std::string write_png_rows(std::FILE* file, int width, int height, png_bytepp rows) {
     PngErrorState error;
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error,
-                                              png_error_handler, png_warning_handler);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_error_handler,
+                                              png_warning_handler);
     if (png == nullptr) return "libpng: cannot create the write structure";
     png_infop info = png_create_info_struct(png);
     if (info == nullptr) {
@@ -340,9 +352,12 @@ std::string_view to_string(ExrCompression compression) {
 
 std::string_view to_string(ExrPixelType type) {
     switch (type) {
-        case ExrPixelType::uint32: return "uint";
-        case ExrPixelType::half: return "half";
-        case ExrPixelType::float32: return "float";
+        case ExrPixelType::uint32:
+            return "uint";
+        case ExrPixelType::half:
+            return "half";
+        case ExrPixelType::float32:
+            return "float";
     }
     return "unknown";
 }

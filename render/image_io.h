@@ -20,7 +20,7 @@ namespace octray {
 
 // Any failure to read or write a file. Its message names the file and the reason.
 class IoError : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 
@@ -58,7 +58,7 @@ ExrRational exr_rational(double value);
 // (read from one file, written to another unchanged: `octray assemble`).
 struct ExrOpaqueAttribute {
     std::string name;
-    std::string type;                // OpenEXR's type name: "v2f", "chromaticities", ...
+    std::string type;                  // OpenEXR's type name: "v2f", "chromaticities", ...
     std::vector<unsigned char> value;  // the attribute's bytes as stored in a file
 };
 
@@ -71,7 +71,7 @@ struct ExrAttributes {
     std::vector<std::pair<std::string, float>> floats;
     std::vector<std::pair<std::string, int>> ints;
     std::vector<std::pair<std::string, double>> doubles;
-    std::vector<std::pair<std::string, Matrix44>> matrices;  // M44f: worldToCamera, ...
+    std::vector<std::pair<std::string, Matrix44>> matrices;      // M44f: worldToCamera, ...
     std::vector<std::pair<std::string, ExrRational>> rationals;  // framesPerSecond
     std::vector<ExrOpaqueAttribute> opaque;
 };
@@ -80,8 +80,8 @@ struct ExrAttributes {
 
 // OpenEXR's pixel types: UINT, HALF, FLOAT.
 enum class ExrPixelType { uint32, half, float32 };
-std::string_view to_string(ExrPixelType type);       // "uint", "half", "float"
-std::size_t sample_size(ExrPixelType type);           // 4, 2, 4 bytes
+std::string_view to_string(ExrPixelType type);  // "uint", "half", "float"
+std::size_t sample_size(ExrPixelType type);     // 4, 2, 4 bytes
 
 // One channel: a sample per pixel of the data window, row by row (top row first), each in
 // the channel's own type and native byte order (half: the 16 bits of an IEEE binary16).

@@ -1,13 +1,11 @@
 #include "render/image_read.h"
 
-#include <png.h>
-
 #include <ImfChannelList.h>
 #include <ImfCompression.h>
-#include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
 #include <ImfDoubleAttribute.h>
 #include <ImfFloatAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfMatrixAttribute.h>
@@ -15,6 +13,7 @@
 #include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
 #include <ImfVersion.h>
+#include <png.h>
 
 #include <algorithm>
 #include <array>
@@ -37,7 +36,9 @@
 namespace octray {
 
 ChannelImage::ChannelImage(int width_, int height_, std::vector<std::string> names)
-    : width(width_), height(height_), channel_names(std::move(names)),
+    : width(width_),
+      height(height_),
+      channel_names(std::move(names)),
       planes(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) *
              channel_names.size()) {}
 
@@ -147,17 +148,24 @@ std::pair<std::string, std::pair<int, std::string>> exr_channel_key(const std::s
 // (64 x 1032). 0 means unknown, for codecs newer than this table: no bound but the cap.
 unsigned long long max_expansion(Imf::Compression compression) {
     switch (compression) {
-        case Imf::NO_COMPRESSION: return 1;
-        case Imf::RLE_COMPRESSION: return 128;
+        case Imf::NO_COMPRESSION:
+            return 1;
+        case Imf::RLE_COMPRESSION:
+            return 128;
         case Imf::ZIPS_COMPRESSION:
         case Imf::ZIP_COMPRESSION:
-        case Imf::PXR24_COMPRESSION: return 2048;
-        case Imf::PIZ_COMPRESSION: return 4096;
+        case Imf::PXR24_COMPRESSION:
+            return 2048;
+        case Imf::PIZ_COMPRESSION:
+            return 4096;
         case Imf::B44_COMPRESSION:
-        case Imf::B44A_COMPRESSION: return 16;
+        case Imf::B44A_COMPRESSION:
+            return 16;
         case Imf::DWAA_COMPRESSION:
-        case Imf::DWAB_COMPRESSION: return 1ull << 17;
-        default: return 0;
+        case Imf::DWAB_COMPRESSION:
+            return 1ull << 17;
+        default:
+            return 0;
     }
 }
 
@@ -175,16 +183,15 @@ void check_pixel_data_fits(const std::string& path, const Imf::Header& header, l
         bytes_per_pixel += it.channel().type == Imf::HALF ? 2 : 4;
     // w, h < 2^31 and at most 2^30 values in all (checked above): no overflow.
     const unsigned long long pixel_bytes = static_cast<unsigned long long>(w) *
-                                           static_cast<unsigned long long>(h) *
-                                           bytes_per_pixel;
+                                           static_cast<unsigned long long>(h) * bytes_per_pixel;
     std::error_code ec;
     const std::uintmax_t file_bytes = fs::file_size(path, ec);
     if (ec) return;  // OpenEXR reports an unreadable file itself
     if (pixel_bytes / ratio <= file_bytes) return;
     fail(path, "truncated or corrupt OpenEXR file (its header claims a " + std::to_string(w) +
-                   " x " + std::to_string(h) + " data window, " +
-                   std::to_string(pixel_bytes) + " bytes of pixel data, which cannot fit in " +
-                   "the file's " + std::to_string(file_bytes) + " bytes" +
+                   " x " + std::to_string(h) + " data window, " + std::to_string(pixel_bytes) +
+                   " bytes of pixel data, which cannot fit in " + "the file's " +
+                   std::to_string(file_bytes) + " bytes" +
                    (ratio == 1 ? std::string(" uncompressed")
                                : " even at " + std::to_string(ratio) + ":1 compression") +
                    ")");
@@ -242,10 +249,10 @@ ChannelImage read_exr_file(const std::string& path) {
         // Every channel is read as FLOAT; OpenEXR converts HALF and UINT on the way.
         Imf::FrameBuffer frame_buffer;
         for (int c = 0; c < image.channel_count(); ++c)
-            frame_buffer.insert(image.channel_names[static_cast<std::size_t>(c)],
-                                Imf::Slice::Make(Imf::FLOAT, image.plane(c), window,
-                                                 sizeof(float),
-                                                 sizeof(float) * static_cast<std::size_t>(w)));
+            frame_buffer.insert(
+                image.channel_names[static_cast<std::size_t>(c)],
+                Imf::Slice::Make(Imf::FLOAT, image.plane(c), window, sizeof(float),
+                                 sizeof(float) * static_cast<std::size_t>(w)));
         file.setFrameBuffer(frame_buffer);
         file.readPixels(window.min.y, window.max.y);
         return image;
@@ -256,17 +263,28 @@ ChannelImage read_exr_file(const std::string& path) {
 
 ExrCompression from_imf(Imf::Compression compression) {
     switch (compression) {
-        case Imf::NO_COMPRESSION: return ExrCompression::none;
-        case Imf::RLE_COMPRESSION: return ExrCompression::rle;
-        case Imf::ZIPS_COMPRESSION: return ExrCompression::zips;
-        case Imf::ZIP_COMPRESSION: return ExrCompression::zip;
-        case Imf::PIZ_COMPRESSION: return ExrCompression::piz;
-        case Imf::PXR24_COMPRESSION: return ExrCompression::pxr24;
-        case Imf::B44_COMPRESSION: return ExrCompression::b44;
-        case Imf::B44A_COMPRESSION: return ExrCompression::b44a;
-        case Imf::DWAA_COMPRESSION: return ExrCompression::dwaa;
-        case Imf::DWAB_COMPRESSION: return ExrCompression::dwab;
-        default: return ExrCompression::zip;  // a codec newer than this list
+        case Imf::NO_COMPRESSION:
+            return ExrCompression::none;
+        case Imf::RLE_COMPRESSION:
+            return ExrCompression::rle;
+        case Imf::ZIPS_COMPRESSION:
+            return ExrCompression::zips;
+        case Imf::ZIP_COMPRESSION:
+            return ExrCompression::zip;
+        case Imf::PIZ_COMPRESSION:
+            return ExrCompression::piz;
+        case Imf::PXR24_COMPRESSION:
+            return ExrCompression::pxr24;
+        case Imf::B44_COMPRESSION:
+            return ExrCompression::b44;
+        case Imf::B44A_COMPRESSION:
+            return ExrCompression::b44a;
+        case Imf::DWAA_COMPRESSION:
+            return ExrCompression::dwaa;
+        case Imf::DWAB_COMPRESSION:
+            return ExrCompression::dwab;
+        default:
+            return ExrCompression::zip;  // a codec newer than this list
     }
 }
 
@@ -277,7 +295,7 @@ PixelRect from_box(const Imath::Box2i& box) {
 // The attributes write_exr() derives from the image itself, and so does not carry.
 bool is_structural(std::string_view name) {
     static constexpr std::array<std::string_view, 11> names{
-        "channels", "compression", "dataWindow", "displayWindow", "lineOrder", "tiles",
+        "channels", "compression", "dataWindow", "displayWindow", "lineOrder",         "tiles",
         "type",     "name",        "version",    "chunkCount",    "maxSamplesPerPixel"};
     return std::find(names.begin(), names.end(), name) != names.end();
 }
@@ -340,10 +358,9 @@ ExrImage read_exr_image_file(const std::string& path) {
             const std::size_t element = sample_size(type);
             image.channels.push_back(
                 ExrChannel{it.name(), type, std::vector<unsigned char>(pixels * element)});
-            frame_buffer.insert(it.name(),
-                                Imf::Slice::Make(t, image.channels.back().samples.data(),
-                                                 window, element,
-                                                 element * static_cast<std::size_t>(w)));
+            frame_buffer.insert(
+                it.name(), Imf::Slice::Make(t, image.channels.back().samples.data(), window,
+                                            element, element * static_cast<std::size_t>(w)));
         }
         file.setFrameBuffer(frame_buffer);
         file.readPixels(window.min.y, window.max.y);
@@ -426,7 +443,7 @@ bool read_png_rows(png_structp png, png_infop info, png_bytepp rows) {
 
 // Owns libpng's two structures for the length of one read.
 class PngReadHandle {
-public:
+  public:
     explicit PngReadHandle(PngSource& source) {
         png_ = png_create_read_struct(PNG_LIBPNG_VER_STRING, &source, on_png_error,
                                       on_png_warning);
@@ -439,7 +456,7 @@ public:
     png_structp png() const { return png_; }
     png_infop info() const { return info_; }
 
-private:
+  private:
     png_structp png_ = nullptr;
     png_infop info_ = nullptr;
 };

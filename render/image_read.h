@@ -44,7 +44,7 @@ struct ChannelImage {
     float& at(int c, int x, int y) { return plane(c)[index(x, y)]; }
     float at(int c, int x, int y) const { return plane(c)[index(x, y)]; }
 
-private:
+  private:
     std::size_t index(int x, int y) const {
         return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
                static_cast<std::size_t>(x);

@@ -60,8 +60,8 @@ void write_png_rgb8(const std::string& path, int width, int height,
         std::FILE* file = std::fopen(tmp_path.c_str(), "wb");
         if (!file) throw IoError(tmp_path + ": " + std::generic_category().message(errno));
         PngSinkError error;
-        png_structp png =
-            png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, on_png_error, on_png_warning);
+        png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, on_png_error,
+                                                  on_png_warning);
         png_infop info = png ? png_create_info_struct(png) : nullptr;
         bool ok = png && info &&
                   write_rgb8_rows(png, info, file, static_cast<png_uint_32>(width),

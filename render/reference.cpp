@@ -75,8 +75,9 @@ ReferenceTracer::ReferenceTracer(const Scene& scene)
 std::optional<Ray> ReferenceTracer::camera_ray(int i, int j, std::uint32_t sample,
                                                std::uint32_t frame) const {
     const auto ui = static_cast<std::uint32_t>(i), uj = static_cast<std::uint32_t>(j);
-    const PixelOffset o = pixel_sample_offset(
-        frame, ui, uj, sample, static_cast<std::uint32_t>(scene_.image.spp), scene_.render.seed);
+    const PixelOffset o =
+        pixel_sample_offset(frame, ui, uj, sample, static_cast<std::uint32_t>(scene_.image.spp),
+                            scene_.render.seed);
     const float x = film_x(i, o.ox, scene_.image.width);
     const float y = film_y(j, o.oy, scene_.image.height);
     const CameraFrame& c = camera_;
@@ -98,8 +99,10 @@ std::optional<Ray> ReferenceTracer::camera_ray(int i, int j, std::uint32_t sampl
             // focus_distance) from a point on the lens disk (polar mapping, r = a sqrt(u)).
             const Vec3 d = normalize(c.ln + c.u * x + c.v * y);
             const Vec3 focus = c.eye + d * (c.focus_distance / dot(d, c.ln));
-            const float lu = sample_uniform(frame, ui, uj, sample, kDimLensU, scene_.render.seed);
-            const float lv = sample_uniform(frame, ui, uj, sample, kDimLensV, scene_.render.seed);
+            const float lu =
+                sample_uniform(frame, ui, uj, sample, kDimLensU, scene_.render.seed);
+            const float lv =
+                sample_uniform(frame, ui, uj, sample, kDimLensV, scene_.render.seed);
             const float r = c.aperture * std::sqrt(lu);
             const float phi = 2.0f * std::numbers::pi_v<float> * lv;
             ray.origin = c.eye + c.u_hat * (r * std::cos(phi)) + c.v_hat * (r * std::sin(phi));
@@ -136,7 +139,8 @@ std::optional<SurfaceHit> ReferenceTracer::intersect(const Ray& ray) const {
     if (!best) return best;
     const Object& o = scene_.objects[best->object];
     best->point = ray.at(best->t);
-    best->normal = o.type == ObjectType::sphere ? (best->point - o.center) / o.radius : o.normal;
+    best->normal =
+        o.type == ObjectType::sphere ? (best->point - o.center) / o.radius : o.normal;
     return best;
 }
 
@@ -246,7 +250,8 @@ Rgb ReferenceTracer::shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb
     const auto secondary = [&](Vec3 origin, Vec3 direction, Rgb factor,
                                std::uint64_t& counter) {
         const Rgb child_weight = weight * factor;
-        if (depth + 1 > scene_.render.max_depth || !(max_component(child_weight) >= kMinRayWeight))
+        if (depth + 1 > scene_.render.max_depth ||
+            !(max_component(child_weight) >= kMinRayWeight))
             return factor * background(direction);
         ++counter;
         const Ray child{origin, direction, 0.0f, kInfinity};
@@ -254,7 +259,8 @@ Rgb ReferenceTracer::shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb
     };
 
     if (max_component(kr) > 0.0f) {
-        const Vec3 reflected = ray.direction - hit.normal * (2.0f * dot(hit.normal, ray.direction));
+        const Vec3 reflected =
+            ray.direction - hit.normal * (2.0f * dot(hit.normal, ray.direction));
         color += secondary(p + n * epsilon_, reflected, kr, counts.reflected);
     }
     if (refracted) {

@@ -22,7 +22,7 @@ struct SurfaceHit {
 };
 
 class ReferenceTracer {
-public:
+  public:
     // The scene must have passed validate_scene().
     explicit ReferenceTracer(const Scene& scene);
 
@@ -56,7 +56,7 @@ public:
     float epsilon() const { return epsilon_; }
     const CameraFrame& camera() const { return camera_; }
 
-private:
+  private:
     Rgb shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb weight,
               RayCounts& counts) const;
     Rgb background(Vec3 direction) const;

@@ -50,8 +50,8 @@ struct PixelRect {
 
 // The pixels two rectangles share (empty() when none).
 inline PixelRect intersection(const PixelRect& a, const PixelRect& b) {
-    PixelRect r{a.x0 > b.x0 ? a.x0 : b.x0, a.y0 > b.y0 ? a.y0 : b.y0,
-                a.x1 < b.x1 ? a.x1 : b.x1, a.y1 < b.y1 ? a.y1 : b.y1};
+    PixelRect r{a.x0 > b.x0 ? a.x0 : b.x0, a.y0 > b.y0 ? a.y0 : b.y0, a.x1 < b.x1 ? a.x1 : b.x1,
+                a.y1 < b.y1 ? a.y1 : b.y1};
     if (r.empty()) r = PixelRect{};
     return r;
 }
@@ -63,8 +63,8 @@ struct SampleRange {
 };
 
 struct RenderOptions {
-    int threads = 0;           // 0: every core TBB sees
-    std::uint32_t frame = 0;   // the frame counter of the random hash
+    int threads = 0;          // 0: every core TBB sees
+    std::uint32_t frame = 0;  // the frame counter of the random hash
     int tile_width = 16;
     int tile_height = 16;
     // Batch rendering (tools/cmd_render.cpp), both optional: the renderers poll *cancel
@@ -90,7 +90,7 @@ struct RenderOptions {
 
 // Thrown by a render stopped through RenderOptions::cancel: no image is returned.
 class RenderCancelled : public std::runtime_error {
-public:
+  public:
     RenderCancelled() : std::runtime_error("render cancelled") {}
 };
 

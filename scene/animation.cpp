@@ -34,7 +34,7 @@ float lerp_value(float a, float b, double t) { return lerp_float(a, b, t); }
 // search, so posing many frames costs O(log keys) each (validate_scene poses every frame).
 template <typename T>
 class PropertyTrack {
-public:
+  public:
     template <typename Key, typename Get>
     PropertyTrack(const std::vector<Key>& keys, Get get) {
         for (const Key& k : keys) {
@@ -58,7 +58,7 @@ public:
         return lerp_value(values_[i - 1], values_[i], t);
     }
 
-private:
+  private:
     std::vector<int> frames_;  // strictly increasing (validate_scene)
     std::vector<T> values_;
 };

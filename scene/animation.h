@@ -41,10 +41,10 @@ struct ObjectTrack {
 };
 
 struct Animation {
-    int frames = 1;     // the sequence is frames 0 .. frames - 1
-    double fps = 24.0;  // frame f shows time f / fps seconds
-    std::vector<CameraKey> camera;        // strictly increasing frames
-    std::vector<ObjectTrack> objects;     // file order; each key list strictly increasing
+    int frames = 1;                    // the sequence is frames 0 .. frames - 1
+    double fps = 24.0;                 // frame f shows time f / fps seconds
+    std::vector<CameraKey> camera;     // strictly increasing frames
+    std::vector<ObjectTrack> objects;  // file order; each key list strictly increasing
 };
 
 // At most this many frames per animation: validate_scene checks the camera of every frame,

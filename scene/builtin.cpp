@@ -50,7 +50,8 @@ template <typename Int>
 std::optional<Int> parse_integer(std::string_view text) {
     Int value{};
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (ec != std::errc{} || end != text.data() + text.size() || text.empty()) return std::nullopt;
+    if (ec != std::errc{} || end != text.data() + text.size() || text.empty())
+        return std::nullopt;
     return value;
 }
 
@@ -76,8 +77,9 @@ BuiltinSpec parse_spec(const std::string& spec) {
         const std::string_view option = rest.substr(0, comma);
         rest.remove_prefix(comma == std::string_view::npos ? rest.size() : comma);
         if (option.empty()) {
-            throw SceneError(spec, "", "empty option between commas; expected key=value with key "
-                                       "one of width, height, spp, seed, max_depth");
+            throw SceneError(spec, "",
+                             "empty option between commas; expected key=value with key "
+                             "one of width, height, spp, seed, max_depth");
         }
         const std::size_t equals = option.find('=');
         const std::string_view key = option.substr(0, equals);
@@ -115,7 +117,8 @@ BuiltinSpec parse_spec(const std::string& spec) {
             if (!v) {
                 throw SceneError(spec, path,
                                  "expected a non-negative integer from 0 to "
-                                 "18446744073709551615, found " + quote_text(value));
+                                 "18446744073709551615, found " +
+                                     quote_text(value));
             }
             out.overrides.seed = *v;
         } else {
@@ -264,7 +267,8 @@ Dir operator*(Dir a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 using Mat3 = std::array<Dir, 3>;  // rows
 
 Dir apply(const Mat3& m, Dir v) {
-    return {m[0].x * v.x + m[0].y * v.y + m[0].z * v.z, m[1].x * v.x + m[1].y * v.y + m[1].z * v.z,
+    return {m[0].x * v.x + m[0].y * v.y + m[0].z * v.z,
+            m[1].x * v.x + m[1].y * v.y + m[1].z * v.z,
             m[2].x * v.x + m[2].y * v.y + m[2].z * v.z};
 }
 
@@ -287,9 +291,10 @@ std::array<Dir, 9> child_directions() {
     const Mat3 tilt = axis_rotation(Dir{h, -h, 0.0}, std::asin(2.0 / std::sqrt(6.0)));
     std::array<Dir, 9> out{};
     for (int set = 0; set < 3; ++set) {
-        const Mat3 turn =
-            axis_rotation(Dir{0.0, 0.0, 1.0}, set * 2.0 * std::numbers::pi / 3.0);
-        for (int v = 0; v < 3; ++v) out[static_cast<std::size_t>(set * 3 + v)] = apply(turn, apply(tilt, trio[static_cast<std::size_t>(v)]));
+        const Mat3 turn = axis_rotation(Dir{0.0, 0.0, 1.0}, set * 2.0 * std::numbers::pi / 3.0);
+        for (int v = 0; v < 3; ++v)
+            out[static_cast<std::size_t>(set * 3 + v)] =
+                apply(turn, apply(tilt, trio[static_cast<std::size_t>(v)]));
     }
     return out;
 }
@@ -385,15 +390,15 @@ Scene make_builtin_scene(const std::string& spec) {
     Scene scene;
     if (parsed.name == "whitted") {
         if (parsed.argument) {
-            throw SceneError(spec, "", "whitted takes no argument; expected \"whitted\", found " +
-                                           quote_text(spec));
+            throw SceneError(
+                spec, "",
+                "whitted takes no argument; expected \"whitted\", found " + quote_text(spec));
         }
         scene = make_whitted();
         if (o.seed) scene.render.seed = *o.seed;
     } else if (parsed.name == "random") {
-        const std::string expectation =
-            "expected random:N with N a sphere count from 1 to " +
-            std::to_string(kMaxGeneratedSpheres);
+        const std::string expectation = "expected random:N with N a sphere count from 1 to " +
+                                        std::to_string(kMaxGeneratedSpheres);
         if (!parsed.argument) throw SceneError(spec, "", expectation + ", found no count");
         const auto n = parse_integer<std::uint64_t>(*parsed.argument);
         if (!n || *n < 1 || *n > kMaxGeneratedSpheres) {
@@ -403,8 +408,9 @@ Scene make_builtin_scene(const std::string& spec) {
         // so random:N and random:N,seed=1 are the same scene.
         scene = make_random(*n, o.seed.value_or(1));
     } else if (parsed.name == "sphereflake") {
-        const std::string expectation = "expected sphereflake:L with L a recursion level from 0 to " +
-                                        std::to_string(kMaxSphereflakeLevel);
+        const std::string expectation =
+            "expected sphereflake:L with L a recursion level from 0 to " +
+            std::to_string(kMaxSphereflakeLevel);
         if (!parsed.argument) throw SceneError(spec, "", expectation + ", found no level");
         const auto level = parse_integer<int>(*parsed.argument);
         if (!level || *level < 0 || *level > kMaxSphereflakeLevel) {
@@ -413,8 +419,9 @@ Scene make_builtin_scene(const std::string& spec) {
         scene = make_sphereflake(*level);
         if (o.seed) scene.render.seed = *o.seed;
     } else {
-        throw SceneError(spec, "", "unknown built-in scene " + quote_text(parsed.name) +
-                                       "; expected whitted, random:N or sphereflake:L");
+        throw SceneError(spec, "",
+                         "unknown built-in scene " + quote_text(parsed.name) +
+                             "; expected whitted, random:N or sphereflake:L");
     }
     if (o.width) scene.image.width = *o.width;
     if (o.height) scene.image.height = *o.height;

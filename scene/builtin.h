@@ -18,12 +18,12 @@ Scene make_builtin_scene(const std::string& spec);
 
 // The splitmix64 generator that random:N is specified with.
 class SplitMix64 {
-public:
+  public:
     explicit SplitMix64(std::uint64_t state) : state_(state) {}
     std::uint64_t next();
     float next_float();  // (next() >> 40) * 2^-24, in [0, 1)
 
-private:
+  private:
     std::uint64_t state_;
 };
 

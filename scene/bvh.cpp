@@ -16,16 +16,16 @@
 
 #include <emmintrin.h>
 #include <math.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <chrono>
 #include <limits>
 #include <stdexcept>
 #include <vector>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
-#include <tbb/parallel_reduce.h>
 
 namespace octray {
 
@@ -660,36 +660,33 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
     PrimRefs refs(n);
     // Each sphere's box c ± sqrt(r2), rounded outwards: it holds every point of the sphere
     // the kernels intersect (which knows only r2).
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
-                      [&](const tbb::blocked_range<std::uint32_t>& r) {
-                          // c -+ r rounded outwards in float: sqrtf is exact to half an
-                          // ulp, the factor and the relative and absolute steps cover
-                          // every rounding after it.
-                          const __m128 grow_r = _mm_set1_ps(1.0f + 0x1.0p-21f);
-                          const __m128 rel = _mm_set1_ps(0x1.0p-21f);
-                          const __m128 abs_mask =
-                              _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-                          const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
-                          for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
-                              const auto index = static_cast<float>(i);
-                              const __m128 c =
-                                  _mm_setr_ps(spheres.cx[i], spheres.cy[i], spheres.cz[i], 0.0f);
-                              const __m128 radius =
-                                  _mm_mul_ps(_mm_set1_ps(sqrtf(spheres.r2[i])), grow_r);
-                              __m128 lo = _mm_sub_ps(c, radius), hi = _mm_add_ps(c, radius);
-                              const auto step = [&](__m128 v) {
-                                  return _mm_add_ps(_mm_mul_ps(_mm_and_ps(v, abs_mask), rel),
-                                                    tiny);
-                              };
-                              lo = _mm_sub_ps(lo, step(lo));
-                              hi = _mm_add_ps(hi, step(hi));
-                              alignas(16) float l[4], h[4];
-                              _mm_store_ps(l, lo);
-                              _mm_store_ps(h, hi);
-                              refs[i].box.lo = _mm_setr_ps(l[0], l[1], l[2], index);
-                              refs[i].box.hi = _mm_setr_ps(h[0], h[1], h[2], index);
-                          }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::uint32_t>(0, n, 4096),
+        [&](const tbb::blocked_range<std::uint32_t>& r) {
+            // c -+ r rounded outwards in float: sqrtf is exact to half an
+            // ulp, the factor and the relative and absolute steps cover
+            // every rounding after it.
+            const __m128 grow_r = _mm_set1_ps(1.0f + 0x1.0p-21f);
+            const __m128 rel = _mm_set1_ps(0x1.0p-21f);
+            const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+            const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
+            for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                const auto index = static_cast<float>(i);
+                const __m128 c = _mm_setr_ps(spheres.cx[i], spheres.cy[i], spheres.cz[i], 0.0f);
+                const __m128 radius = _mm_mul_ps(_mm_set1_ps(sqrtf(spheres.r2[i])), grow_r);
+                __m128 lo = _mm_sub_ps(c, radius), hi = _mm_add_ps(c, radius);
+                const auto step = [&](__m128 v) {
+                    return _mm_add_ps(_mm_mul_ps(_mm_and_ps(v, abs_mask), rel), tiny);
+                };
+                lo = _mm_sub_ps(lo, step(lo));
+                hi = _mm_add_ps(hi, step(hi));
+                alignas(16) float l[4], h[4];
+                _mm_store_ps(l, lo);
+                _mm_store_ps(h, hi);
+                refs[i].box.lo = _mm_setr_ps(l[0], l[1], l[2], index);
+                refs[i].box.hi = _mm_setr_ps(h[0], h[1], h[2], index);
+            }
+        });
 
     // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
     std::vector<BinaryNode, UninitializedAllocator<BinaryNode, Pages::huge>> binary(

@@ -11,11 +11,11 @@ namespace octray {
 struct CameraFrame {
     CameraType type = CameraType::pinhole;
     Vec3 eye;
-    Vec3 ln;      // normalize(lookat - eye)
-    Vec3 u_hat;   // normalize(ln x up)
-    Vec3 v_hat;   // normalize(u_hat x ln)
-    Vec3 u;       // pinhole/thinlens: u_hat * tan(fov/2)
-    Vec3 v;       // pinhole/thinlens: v_hat * tan(fov/2) / aspect
+    Vec3 ln;                        // normalize(lookat - eye)
+    Vec3 u_hat;                     // normalize(ln x up)
+    Vec3 v_hat;                     // normalize(u_hat x ln)
+    Vec3 u;                         // pinhole/thinlens: u_hat * tan(fov/2)
+    Vec3 v;                         // pinhole/thinlens: v_hat * tan(fov/2) / aspect
     float aspect = 1.0f;            // W / H
     float half_width = 1.0f;        // orthographic: width / 2
     float half_height = 1.0f;       // orthographic: width / (2 * aspect)

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -25,8 +26,6 @@
 #include <unordered_set>
 #include <utility>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "scene/builtin.h"
 #include "scene/camera.h"
@@ -116,11 +115,10 @@ std::string describe(const Json& v) {
 
 // A path segment: .key for identifier-like keys, ["odd key"] otherwise.
 std::string child_path(const std::string& path, std::string_view key) {
-    const bool plain =
-        !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
-            return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                   c == '_' || c == '-';
-        });
+    const bool plain = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+               c == '_' || c == '-';
+    });
     if (!plain) return path + "[" + quote_text(key) + "]";
     return path.empty() ? abbreviated(key) : path + "." + abbreviated(key);
 }
@@ -139,8 +137,8 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
     for (std::size_t i = 1; i <= a.size(); ++i) {
         for (std::size_t j = 1; j <= b.size(); ++j) {
             const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            std::size_t best = std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1,
-                                         d[(i - 1) * w + j - 1] + cost});
+            std::size_t best = std::min(
+                {d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + cost});
             if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
                 best = std::min(best, d[(i - 2) * w + j - 2] + 1);
             }
@@ -192,7 +190,7 @@ struct ParseFailure {
 };
 
 class DomBuilder final : public nlohmann::json_sax<Json> {
-public:
+  public:
     explicit DomBuilder(std::string_view text) : text_(text) {}
 
     bool null() override { return add(Json(nullptr)); }
@@ -214,9 +212,9 @@ public:
         Frame& frame = frames_.back();
         frame.key = name;
         if (!frame.keys.insert(name).second) {
-            failure_ = ParseFailure{current_path(),
-                                    "duplicate key " + quote_text(name) +
-                                        " (each key may appear once per object)"};
+            failure_ =
+                ParseFailure{current_path(), "duplicate key " + quote_text(name) +
+                                                 " (each key may appear once per object)"};
             return false;
         }
         return true;
@@ -239,9 +237,9 @@ public:
             "line " + std::to_string(line) + ", column " + std::to_string(column);
         if (ex.id == 406) {
             // nlohmann's "number overflow": a literal such as 1e999 that is no finite double.
-            failure_ = ParseFailure{current_path(true),
-                                    "expected a finite number, found " + last_token + " (at " +
-                                        where + "), which overflows to infinity"};
+            failure_ = ParseFailure{current_path(true), "expected a finite number, found " +
+                                                            last_token + " (at " + where +
+                                                            "), which overflows to infinity"};
             return false;
         }
         // Drop nlohmann's "[json.exception...] parse error at line L, column C: " prefix;
@@ -257,7 +255,7 @@ public:
     Json& root() { return root_; }
     const std::optional<ParseFailure>& failure() const { return failure_; }
 
-private:
+  private:
     struct Frame {
         Json* container;
         bool is_array;
@@ -304,8 +302,9 @@ private:
         for (std::size_t i = 0; i < frames_.size(); ++i) {
             const Frame& f = frames_[i];
             const bool next = pending && i + 1 == frames_.size();
-            path = f.is_array ? index_path(path, next ? f.count : (f.count == 0 ? 0 : f.count - 1))
-                              : child_path(path, f.key);
+            path = f.is_array
+                       ? index_path(path, next ? f.count : (f.count == 0 ? 0 : f.count - 1))
+                       : child_path(path, f.key);
         }
         return path;
     }
@@ -339,7 +338,7 @@ struct ForeignKey {
 };
 
 class Reader {
-public:
+  public:
     explicit Reader(const std::string& file) : file_(file) {}
 
     [[noreturn]] void fail(const std::string& path, const std::string& message) const {
@@ -381,8 +380,8 @@ public:
                             std::string_view expectation) const {
         const auto it = object.find(key);
         if (it == object.end()) {
-            fail(child_path(path, key),
-                 "missing required key " + quote_text(key) + "; expected " + std::string(expectation));
+            fail(child_path(path, key), "missing required key " + quote_text(key) +
+                                            "; expected " + std::string(expectation));
         }
         return *it;
     }
@@ -394,8 +393,10 @@ public:
         // as 3.4028235e+38, just above it); from there on they would round to infinity.
         constexpr double kFloatRoundingLimit = 0x1.ffffffp+127;
         if (!(std::fabs(d) < kFloatRoundingLimit)) {
-            fail(path, "expected a finite number within float range (magnitude at most "
-                       "3.4028235e38), found " + describe(v));
+            fail(path,
+                 "expected a finite number within float range (magnitude at most "
+                 "3.4028235e38), found " +
+                     describe(v));
         }
         return static_cast<float>(d);
     }
@@ -408,7 +409,8 @@ public:
         std::int64_t value = 0;
         if (v.is_number_unsigned()) {
             const std::uint64_t u = v.get<std::uint64_t>();
-            if (u > static_cast<std::uint64_t>(hi)) fail(path, expectation + ", found " + describe(v));
+            if (u > static_cast<std::uint64_t>(hi))
+                fail(path, expectation + ", found " + describe(v));
             value = static_cast<std::int64_t>(u);
         } else if (v.is_number_integer()) {
             value = v.get<std::int64_t>();
@@ -433,8 +435,10 @@ public:
         if (v.is_number_integer() && v.get<std::int64_t>() >= 0) {
             return static_cast<std::uint64_t>(v.get<std::int64_t>());
         }
-        fail(path, "expected a non-negative integer from 0 to 18446744073709551615 written "
-                   "without a fraction or exponent, found " + describe(v));
+        fail(path,
+             "expected a non-negative integer from 0 to 18446744073709551615 written "
+             "without a fraction or exponent, found " +
+                 describe(v));
     }
 
     const std::string& string(const Json& v, const std::string& path) const {
@@ -474,24 +478,28 @@ public:
                 number(v[2], index_path(path, 2))};
     }
 
-private:
+  private:
     const std::string& file_;
 };
 
 // ---------------------------------------------------------------------------------------
 // The sections of a scene file.
 
-constexpr std::array<std::string_view, 9> kTopKeys = {
-    "image", "camera", "background", "ambient", "render",
-    "materials", "objects", "lights", "animation"};
+constexpr std::array<std::string_view, 9> kTopKeys = {"image",   "camera", "background",
+                                                      "ambient", "render", "materials",
+                                                      "objects", "lights", "animation"};
 
 void read_image(const Reader& r, const Json& j, ImageSettings& image) {
     static constexpr std::array<std::string_view, 3> keys = {"width", "height", "spp"};
     r.require_object(j, "image", "width, height, spp");
     r.check_keys(j, "image", keys);
-    if (j.contains("width")) image.width = static_cast<int>(r.integer(j["width"], "image.width", 1, kMaxIntValue));
-    if (j.contains("height")) image.height = static_cast<int>(r.integer(j["height"], "image.height", 1, kMaxIntValue));
-    if (j.contains("spp")) image.spp = static_cast<int>(r.integer(j["spp"], "image.spp", 1, kMaxIntValue));
+    if (j.contains("width"))
+        image.width = static_cast<int>(r.integer(j["width"], "image.width", 1, kMaxIntValue));
+    if (j.contains("height"))
+        image.height =
+            static_cast<int>(r.integer(j["height"], "image.height", 1, kMaxIntValue));
+    if (j.contains("spp"))
+        image.spp = static_cast<int>(r.integer(j["spp"], "image.spp", 1, kMaxIntValue));
 }
 
 void read_camera(const Reader& r, const Json& j, Camera& camera) {
@@ -504,8 +512,7 @@ void read_camera(const Reader& r, const Json& j, Camera& camera) {
     }
     static constexpr std::array<ForeignKey, 4> foreign = {
         ForeignKey{"fov", "pinhole, thinlens and fisheye cameras"},
-        ForeignKey{"width", "orthographic cameras"},
-        ForeignKey{"aperture", "thinlens cameras"},
+        ForeignKey{"width", "orthographic cameras"}, ForeignKey{"aperture", "thinlens cameras"},
         ForeignKey{"focus_distance", "thinlens cameras"}};
     std::vector<std::string_view> allowed = {"type", "eye", "lookat", "up"};
     switch (camera.type) {
@@ -524,15 +531,17 @@ void read_camera(const Reader& r, const Json& j, Camera& camera) {
         "a " + std::string(types[static_cast<std::size_t>(camera.type)]) + " camera";
     r.check_keys(j, path, allowed, foreign, kind);
 
-    camera.eye = r.vec3(r.require_key(j, path, "eye", "the eye position [x, y, z]"), "camera.eye");
-    camera.lookat =
-        r.vec3(r.require_key(j, path, "lookat", "the look-at point [x, y, z]"), "camera.lookat");
+    camera.eye =
+        r.vec3(r.require_key(j, path, "eye", "the eye position [x, y, z]"), "camera.eye");
+    camera.lookat = r.vec3(r.require_key(j, path, "lookat", "the look-at point [x, y, z]"),
+                           "camera.lookat");
     if (j.contains("up")) camera.up = r.vec3(j["up"], "camera.up");
     if (j.contains("fov")) camera.fov = r.number(j["fov"], "camera.fov");
     if (j.contains("width")) camera.width = r.number(j["width"], "camera.width");
     if (camera.type == CameraType::thinlens) {
-        camera.aperture = r.number(
-            r.require_key(j, path, "aperture", "the lens radius (a number >= 0)"), "camera.aperture");
+        camera.aperture =
+            r.number(r.require_key(j, path, "aperture", "the lens radius (a number >= 0)"),
+                     "camera.aperture");
         if (j.contains("focus_distance")) {
             camera.focus_distance = r.number(j["focus_distance"], "camera.focus_distance");
         } else {
@@ -549,10 +558,12 @@ void read_background(const Reader& r, const Json& j, Background& bg) {
     const std::string path = "background";
     r.require_object(j, path, "type constant with color, or type gradient with bottom and top");
     static constexpr std::array<std::string_view, 2> types = {"constant", "gradient"};
-    bg.type = static_cast<BackgroundType>(r.choice(
-        r.require_key(j, path, "type", "\"constant\" or \"gradient\""), "background.type", types));
+    bg.type = static_cast<BackgroundType>(
+        r.choice(r.require_key(j, path, "type", "\"constant\" or \"gradient\""),
+                 "background.type", types));
     static constexpr std::array<ForeignKey, 3> foreign = {
-        ForeignKey{"color", "constant backgrounds"}, ForeignKey{"bottom", "gradient backgrounds"},
+        ForeignKey{"color", "constant backgrounds"},
+        ForeignKey{"bottom", "gradient backgrounds"},
         ForeignKey{"top", "gradient backgrounds"}};
     if (bg.type == BackgroundType::constant) {
         static constexpr std::array<std::string_view, 2> keys = {"type", "color"};
@@ -584,15 +595,18 @@ void read_render(const Reader& r, const Json& j, RenderSettings& render) {
 Material read_material(const Reader& r, const Json& j, const std::string& path) {
     static constexpr std::array<std::string_view, 8> keys = {
         "color", "kd", "ks", "shininess", "reflect", "transmit", "ior", "checker"};
-    r.require_object(j, path, "a material: color, kd, ks, shininess, reflect, transmit, ior, checker");
+    r.require_object(j, path,
+                     "a material: color, kd, ks, shininess, reflect, transmit, ior, checker");
     r.check_keys(j, path, keys);
     Material m;
     if (j.contains("color")) m.color = r.color(j["color"], child_path(path, "color"));
     if (j.contains("kd")) m.kd = r.number(j["kd"], child_path(path, "kd"));
     if (j.contains("ks")) m.ks = r.number(j["ks"], child_path(path, "ks"));
-    if (j.contains("shininess")) m.shininess = r.number(j["shininess"], child_path(path, "shininess"));
+    if (j.contains("shininess"))
+        m.shininess = r.number(j["shininess"], child_path(path, "shininess"));
     if (j.contains("reflect")) m.reflect = r.color(j["reflect"], child_path(path, "reflect"));
-    if (j.contains("transmit")) m.transmit = r.number(j["transmit"], child_path(path, "transmit"));
+    if (j.contains("transmit"))
+        m.transmit = r.number(j["transmit"], child_path(path, "transmit"));
     if (j.contains("ior")) m.ior = r.number(j["ior"], child_path(path, "ior"));
     if (j.contains("checker")) {
         const std::string cpath = child_path(path, "checker");
@@ -601,8 +615,9 @@ Material read_material(const Reader& r, const Json& j, const std::string& path) 
         static constexpr std::array<std::string_view, 2> ckeys = {"color", "size"};
         r.check_keys(c, cpath, ckeys);
         Checker checker;
-        checker.color = r.color(r.require_key(c, cpath, "color", "the second color of the checker"),
-                                child_path(cpath, "color"));
+        checker.color =
+            r.color(r.require_key(c, cpath, "color", "the second color of the checker"),
+                    child_path(cpath, "color"));
         if (c.contains("size")) checker.size = r.number(c["size"], child_path(cpath, "size"));
         m.checker = checker;
     }
@@ -614,10 +629,12 @@ Material read_material(const Reader& r, const Json& j, const std::string& path) 
 Vec3 normalized_normal(const Reader& r, Vec3 n, const std::string& path) {
     const double x = n.x, y = n.y, z = n.z;
     const double len2 = x * x + y * y + z * z;
-    if (!(len2 > 0.0)) r.fail(path, "expected a non-zero normal vector, found " + format_vec(n));
+    if (!(len2 > 0.0))
+        r.fail(path, "expected a non-zero normal vector, found " + format_vec(n));
     if (std::fabs(len2 - 1.0) <= kUnitTolerance) return n;
     const double len = std::sqrt(len2);
-    return {static_cast<float>(x / len), static_cast<float>(y / len), static_cast<float>(z / len)};
+    return {static_cast<float>(x / len), static_cast<float>(y / len),
+            static_cast<float>(z / len)};
 }
 
 struct MaterialTable {
@@ -645,15 +662,16 @@ std::uint32_t read_object_material(const Reader& r, const Json& j, const std::st
             const std::string known = table.names.empty()
                                           ? "the scene defines no named materials"
                                           : "the scene defines " + join_quoted(table.names);
-            r.fail(mpath, "unknown material " + quote_text(name) + suggestion(name, table.names) +
+            r.fail(mpath, "unknown material " + quote_text(name) +
+                              suggestion(name, table.names) +
                               "; expected the name of a material in \"materials\" (" + known +
                               ") or an inline material object");
         }
         return found->second;
     }
     if (!it->is_object()) {
-        r.fail(mpath, "expected a material name or an inline material object, found " +
-                          describe(*it));
+        r.fail(mpath,
+               "expected a material name or an inline material object, found " + describe(*it));
     }
     scene.materials.push_back(NamedMaterial{"", read_material(r, *it, mpath)});
     return static_cast<std::uint32_t>(scene.materials.size() - 1);
@@ -680,17 +698,20 @@ void read_objects(const Reader& r, const Json& j, Scene& scene, MaterialTable& t
                      child_path(path, "type"), types));
         if (obj.type == ObjectType::sphere) {
             r.check_keys(o, path, sphere_keys, foreign, "a sphere");
-            obj.center = r.vec3(r.require_key(o, path, "center", "the sphere's center [x, y, z]"),
-                                child_path(path, "center"));
+            obj.center =
+                r.vec3(r.require_key(o, path, "center", "the sphere's center [x, y, z]"),
+                       child_path(path, "center"));
             obj.radius = r.number(r.require_key(o, path, "radius", "the sphere's radius (> 0)"),
                                   child_path(path, "radius"));
         } else {
             r.check_keys(o, path, plane_keys, foreign, "a plane");
-            obj.point = r.vec3(r.require_key(o, path, "point", "a point on the plane [x, y, z]"),
-                               child_path(path, "point"));
+            obj.point =
+                r.vec3(r.require_key(o, path, "point", "a point on the plane [x, y, z]"),
+                       child_path(path, "point"));
             const std::string npath = child_path(path, "normal");
             obj.normal = normalized_normal(
-                r, r.vec3(r.require_key(o, path, "normal", "the plane's normal [x, y, z]"), npath),
+                r,
+                r.vec3(r.require_key(o, path, "normal", "the plane's normal [x, y, z]"), npath),
                 npath);
         }
         if (o.contains("name")) {
@@ -707,9 +728,9 @@ void read_objects(const Reader& r, const Json& j, Scene& scene, MaterialTable& t
 void read_lights(const Reader& r, const Json& j, Scene& scene) {
     if (!j.is_array()) r.fail("lights", "expected an array of lights, found " + describe(j));
     static constexpr std::array<std::string_view, 2> types = {"point", "directional"};
-    static constexpr std::array<ForeignKey, 3> foreign = {ForeignKey{"position", "point lights"},
-                                                          ForeignKey{"falloff", "point lights"},
-                                                          ForeignKey{"direction", "directional lights"}};
+    static constexpr std::array<ForeignKey, 3> foreign = {
+        ForeignKey{"position", "point lights"}, ForeignKey{"falloff", "point lights"},
+        ForeignKey{"direction", "directional lights"}};
     static constexpr std::array<std::string_view, 4> point_keys = {"type", "position", "color",
                                                                    "falloff"};
     static constexpr std::array<std::string_view, 3> directional_keys = {"type", "direction",
@@ -726,16 +747,18 @@ void read_lights(const Reader& r, const Json& j, Scene& scene) {
                      child_path(path, "type"), types));
         if (light.type == LightType::point) {
             r.check_keys(l, path, point_keys, foreign, "a point light");
-            light.position = r.vec3(r.require_key(l, path, "position", "the light's position [x, y, z]"),
-                                    child_path(path, "position"));
+            light.position =
+                r.vec3(r.require_key(l, path, "position", "the light's position [x, y, z]"),
+                       child_path(path, "position"));
             if (l.contains("falloff")) {
-                light.inverse_square = r.choice(l["falloff"], child_path(path, "falloff"), falloffs) == 1;
+                light.inverse_square =
+                    r.choice(l["falloff"], child_path(path, "falloff"), falloffs) == 1;
             }
         } else {
             r.check_keys(l, path, directional_keys, foreign, "a directional light");
-            light.direction = r.vec3(
-                r.require_key(l, path, "direction", "the direction the light travels [x, y, z]"),
-                child_path(path, "direction"));
+            light.direction = r.vec3(r.require_key(l, path, "direction",
+                                                   "the direction the light travels [x, y, z]"),
+                                     child_path(path, "direction"));
         }
         if (l.contains("color")) light.color = r.color(l["color"], child_path(path, "color"));
         scene.lights.push_back(light);
@@ -761,16 +784,18 @@ void refuse_unanimated_keys(const Reader& r, const Json& key, const std::string&
 }
 
 int read_key_frame(const Reader& r, const Json& key, const std::string& path) {
-    return static_cast<int>(r.integer(
-        r.require_key(key, path, "frame", "the key's frame number (an integer >= 0)"),
-        child_path(path, "frame"), 0, kMaxIntValue));
+    return static_cast<int>(
+        r.integer(r.require_key(key, path, "frame", "the key's frame number (an integer >= 0)"),
+                  child_path(path, "frame"), 0, kMaxIntValue));
 }
 
 std::vector<CameraKey> read_camera_keys(const Reader& r, const Json& j) {
     const std::string path = "animation.camera";
     if (!j.is_array()) {
-        r.fail(path, "expected an array of camera keys such as {\"frame\": 0, \"eye\": [0, 1, 5]}, "
-                     "found " + describe(j));
+        r.fail(path,
+               "expected an array of camera keys such as {\"frame\": 0, \"eye\": [0, 1, 5]}, "
+               "found " +
+                   describe(j));
     }
     static constexpr std::array<std::string_view, 5> keys = {"frame", "eye", "lookat", "up",
                                                              "fov"};
@@ -810,11 +835,14 @@ std::string known_object_names(const Scene& scene) {
     return out;
 }
 
-std::vector<ObjectTrack> read_object_tracks(const Reader& r, const Json& j, const Scene& scene) {
+std::vector<ObjectTrack> read_object_tracks(const Reader& r, const Json& j,
+                                            const Scene& scene) {
     const std::string path = "animation.objects";
     if (!j.is_object()) {
-        r.fail(path, "expected an object mapping object names to key arrays, such as "
-                     "{\"ball\": [{\"frame\": 0, \"center\": [0, 1, 0]}]}, found " + describe(j));
+        r.fail(path,
+               "expected an object mapping object names to key arrays, such as "
+               "{\"ball\": [{\"frame\": 0, \"center\": [0, 1, 0]}]}, found " +
+                   describe(j));
     }
     std::unordered_map<std::string_view, std::uint32_t> by_name;
     std::vector<std::string_view> names;
@@ -837,8 +865,10 @@ std::vector<ObjectTrack> read_object_tracks(const Reader& r, const Json& j, cons
                               known_object_names(scene) + ")");
         }
         if (!value.is_array()) {
-            r.fail(tpath, "expected an array of object keys such as {\"frame\": 0, \"center\": "
-                          "[0, 1, 0]}, found " + describe(value));
+            r.fail(tpath,
+                   "expected an array of object keys such as {\"frame\": 0, \"center\": "
+                   "[0, 1, 0]}, found " +
+                       describe(value));
         }
         ObjectTrack track;
         track.name = name;
@@ -852,8 +882,10 @@ std::vector<ObjectTrack> read_object_tracks(const Reader& r, const Json& j, cons
             r.check_keys(k, kpath, keys);
             ObjectKey key;
             key.frame = read_key_frame(r, k, kpath);
-            if (k.contains("center")) key.center = r.vec3(k["center"], child_path(kpath, "center"));
-            if (k.contains("radius")) key.radius = r.number(k["radius"], child_path(kpath, "radius"));
+            if (k.contains("center"))
+                key.center = r.vec3(k["center"], child_path(kpath, "center"));
+            if (k.contains("radius"))
+                key.radius = r.number(k["radius"], child_path(kpath, "radius"));
             track.keys.push_back(key);
         }
         out.push_back(std::move(track));
@@ -864,7 +896,8 @@ std::vector<ObjectTrack> read_object_tracks(const Reader& r, const Json& j, cons
 Animation read_animation(const Reader& r, const Json& j, const Scene& scene) {
     const std::string path = "animation";
     r.require_object(j, path, "frames, fps, camera, objects");
-    static constexpr std::array<std::string_view, 4> keys = {"frames", "fps", "camera", "objects"};
+    static constexpr std::array<std::string_view, 4> keys = {"frames", "fps", "camera",
+                                                             "objects"};
     r.check_keys(j, path, keys);
     Animation a;
     a.frames = static_cast<int>(
@@ -873,8 +906,8 @@ Animation read_animation(const Reader& r, const Json& j, const Scene& scene) {
     if (j.contains("fps")) {
         const Json& fps = j["fps"];
         if (!fps.is_number()) {
-            r.fail("animation.fps", "expected frames per second (a number > 0), found " +
-                                        describe(fps));
+            r.fail("animation.fps",
+                   "expected frames per second (a number > 0), found " + describe(fps));
         }
         a.fps = fps.get<double>();
     }
@@ -904,7 +937,7 @@ std::string format_gib(std::int64_t bytes) {
 }
 
 class Validator {
-public:
+  public:
     explicit Validator(const Scene& scene) : scene_(scene) {}
 
     [[noreturn]] void fail(const std::string& path, const std::string& message) const {
@@ -970,7 +1003,8 @@ public:
         if (memory > 0 && bytes > memory) {
             fail("image", "a " + size + " image needs about " + format_gib(bytes) +
                               " for its framebuffer alone (12 bytes per pixel); expected it to "
-                              "fit in the " + format_gib(memory) + " of physical memory");
+                              "fit in the " +
+                              format_gib(memory) + " of physical memory");
         }
     }
 
@@ -1019,7 +1053,8 @@ public:
 
     void render() const {
         int_range(scene_.render.max_depth, "render.max_depth", 0, kMaxDepthLimit);
-        if (scene_.render.epsilon) positive(*scene_.render.epsilon, "render.epsilon", "epsilon");
+        if (scene_.render.epsilon)
+            positive(*scene_.render.epsilon, "render.epsilon", "epsilon");
     }
 
     void materials() const {
@@ -1052,9 +1087,10 @@ public:
             const std::string path = index_path("objects", i);
             const Object& o = scene_.objects[i];
             if (o.material >= scene_.materials.size()) {
-                fail(child_path(path, "material"),
-                     "expected a material index below " + std::to_string(scene_.materials.size()) +
-                         " (the scene's material count), found " + std::to_string(o.material));
+                fail(child_path(path, "material"), "expected a material index below " +
+                                                       std::to_string(scene_.materials.size()) +
+                                                       " (the scene's material count), found " +
+                                                       std::to_string(o.material));
             }
             if (o.type == ObjectType::sphere) {
                 finite(o.center, child_path(path, "center"));
@@ -1068,15 +1104,17 @@ public:
                 if (!(std::fabs(len2 - 1.0) <= kValidateUnitTolerance)) {
                     fail(child_path(path, "normal"),
                          "expected a unit-length normal (scene files are normalised on load), "
-                         "found " + format_vec(o.normal));
+                         "found " +
+                             format_vec(o.normal));
                 }
             }
             if (!o.name.empty()) {
                 const auto [it, inserted] = names.emplace(o.name, i);
                 if (!inserted) {
-                    fail(child_path(path, "name"),
-                         "expected a unique object name, found " + quote_text(o.name) +
-                             " again (first used by objects[" + std::to_string(it->second) + "])");
+                    fail(child_path(path, "name"), "expected a unique object name, found " +
+                                                       quote_text(o.name) +
+                                                       " again (first used by objects[" +
+                                                       std::to_string(it->second) + "])");
                 }
             }
         }
@@ -1084,8 +1122,9 @@ public:
         // that overflows float would make it infinite.
         const float eps = self_intersection_epsilon(scene_);
         if (!std::isfinite(eps)) {
-            fail("objects", "the spheres' bounding box overflows float range; expected "
-                            "coordinates and radii small enough that its diagonal is finite");
+            fail("objects",
+                 "the spheres' bounding box overflows float range; expected "
+                 "coordinates and radii small enough that its diagonal is finite");
         }
     }
 
@@ -1095,7 +1134,8 @@ public:
         for (std::size_t i = 0; i < keys.size(); ++i) {
             const std::string fpath = child_path(index_path(path, i), "frame");
             if (keys[i].frame < 0) {
-                fail(fpath, "expected a frame number >= 0, found " + std::to_string(keys[i].frame));
+                fail(fpath,
+                     "expected a frame number >= 0, found " + std::to_string(keys[i].frame));
             }
             if (i > 0 && keys[i].frame <= keys[i - 1].frame) {
                 fail(fpath, "expected key frames in strictly increasing order, found frame " +
@@ -1124,27 +1164,30 @@ public:
             const CameraKey& k = a.camera[i];
             const std::string path = index_path("animation.camera", i);
             if (!k.eye && !k.lookat && !k.up && !k.fov) {
-                fail(path, "a camera key sets nothing; expected at least one of \"eye\", "
-                           "\"lookat\", \"up\", \"fov\" besides \"frame\"");
+                fail(path,
+                     "a camera key sets nothing; expected at least one of \"eye\", "
+                     "\"lookat\", \"up\", \"fov\" besides \"frame\"");
             }
             if (k.eye) finite(*k.eye, child_path(path, "eye"));
             if (k.lookat) finite(*k.lookat, child_path(path, "lookat"));
             if (k.up) {
                 finite(*k.up, child_path(path, "up"));
                 if (*k.up == Vec3{}) {
-                    fail(child_path(path, "up"), "expected a non-zero up vector, found [0, 0, 0]");
+                    fail(child_path(path, "up"),
+                         "expected a non-zero up vector, found [0, 0, 0]");
                 }
             }
             if (k.fov) {
                 const std::string fpath = child_path(path, "fov");
                 if (c.type == CameraType::orthographic) {
-                    fail(fpath, "key \"fov\" applies only to pinhole, thinlens and fisheye "
-                                "cameras, not to an orthographic camera");
+                    fail(fpath,
+                         "key \"fov\" applies only to pinhole, thinlens and fisheye "
+                         "cameras, not to an orthographic camera");
                 }
                 const float fov = *k.fov;
                 const bool fisheye = c.type == CameraType::fisheye;
-                const bool ok = fisheye ? (fov > 0.0f && fov <= 360.0f)
-                                        : (fov > 0.0f && fov < 180.0f);
+                const bool ok =
+                    fisheye ? (fov > 0.0f && fov <= 360.0f) : (fov > 0.0f && fov < 180.0f);
                 if (!ok) {
                     fail(fpath, std::string("expected a field of view in ") +
                                     (fisheye ? "(0, 360]" : "(0, 180)") + " degrees, found " +
@@ -1157,9 +1200,9 @@ public:
         for (const ObjectTrack& track : a.objects) {
             const std::string path = child_path("animation.objects", track.name);
             if (track.object >= scene_.objects.size()) {
-                fail(path, "expected an object index below " +
-                               std::to_string(scene_.objects.size()) +
-                               " (the scene's object count), found " + std::to_string(track.object));
+                fail(path,
+                     "expected an object index below " + std::to_string(scene_.objects.size()) +
+                         " (the scene's object count), found " + std::to_string(track.object));
             }
             const Object& o = scene_.objects[track.object];
             const std::string opath = index_path("objects", track.object);
@@ -1176,13 +1219,15 @@ public:
                 const ObjectKey& k = track.keys[i];
                 const std::string kpath = index_path(path, i);
                 if (!k.center && !k.radius) {
-                    fail(kpath, "an object key sets nothing; expected \"center\" and/or "
-                                "\"radius\" besides \"frame\"");
+                    fail(kpath,
+                         "an object key sets nothing; expected \"center\" and/or "
+                         "\"radius\" besides \"frame\"");
                 }
                 const auto sphere_only = [&](std::string_view key) {
                     fail(child_path(kpath, key),
-                         "key " + quote_text(key) + " applies only to spheres, not to a plane (" +
-                             opath + ", " + quote_text(o.name) + ")");
+                         "key " + quote_text(key) +
+                             " applies only to spheres, not to a plane (" + opath + ", " +
+                             quote_text(o.name) + ")");
                 };
                 if (k.center) {
                     if (o.type != ObjectType::sphere) sphere_only("center");
@@ -1267,7 +1312,7 @@ public:
         }
     }
 
-private:
+  private:
     const Scene& scene_;
 };
 
@@ -1292,8 +1337,9 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
     Scene scene;
     scene.source = source;
     if (root.contains("image")) read_image(r, root["image"], scene.image);
-    read_camera(r, r.require_key(root, "", "camera", "an object with at least \"eye\" and \"lookat\""),
-                scene.camera);
+    read_camera(
+        r, r.require_key(root, "", "camera", "an object with at least \"eye\" and \"lookat\""),
+        scene.camera);
     if (root.contains("background")) read_background(r, root["background"], scene.background);
     if (root.contains("ambient")) scene.ambient = r.color(root["ambient"], "ambient");
     if (root.contains("render")) read_render(r, root["render"], scene.render);
@@ -1302,8 +1348,8 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
     if (root.contains("materials")) {
         const Json& mats = root["materials"];
         if (!mats.is_object()) {
-            r.fail("materials", "expected an object mapping names to materials, found " +
-                                    describe(mats));
+            r.fail("materials",
+                   "expected an object mapping names to materials, found " + describe(mats));
         }
         for (const auto& [name, value] : mats.items()) {
             const std::string path = child_path("materials", name);
@@ -1315,7 +1361,8 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
     }
     if (root.contains("objects")) read_objects(r, root["objects"], scene, table);
     if (root.contains("lights")) read_lights(r, root["lights"], scene);
-    if (root.contains("animation")) scene.animation = read_animation(r, root["animation"], scene);
+    if (root.contains("animation"))
+        scene.animation = read_animation(r, root["animation"], scene);
 
     validate_scene(scene);
     return scene;
@@ -1323,10 +1370,10 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
 
 Scene load_scene_file(const std::string& path) {
     const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                                &std::fclose);
+                                                               &std::fclose);
     if (!file) {
-        throw SceneError(path, "", "cannot open scene file: " +
-                                       std::generic_category().message(errno));
+        throw SceneError(path, "",
+                         "cannot open scene file: " + std::generic_category().message(errno));
     }
     std::string text;
     std::array<char, 1 << 16> buffer;
@@ -1337,8 +1384,8 @@ Scene load_scene_file(const std::string& path) {
     }
     // A directory opens fine on Linux and fails here, with EISDIR.
     if (std::ferror(file.get())) {
-        throw SceneError(path, "", "cannot read scene file: " +
-                                       std::generic_category().message(errno));
+        throw SceneError(path, "",
+                         "cannot read scene file: " + std::generic_category().message(errno));
     }
     return parse_scene_json(text, path);
 }

@@ -47,7 +47,7 @@ enum class ObjectType { sphere, plane };
 
 struct Object {
     ObjectType type = ObjectType::sphere;
-    std::string name;       // optional; unique when set (animation targets)
+    std::string name;            // optional; unique when set (animation targets)
     std::uint32_t material = 0;  // index into Scene::materials
     // sphere
     Vec3 center;

@@ -8,16 +8,17 @@
 namespace octray {
 
 class SceneError : public std::runtime_error {
-public:
+  public:
     // what() reads "<file>: <json_path>: <message>" (parts left out when empty).
     SceneError(std::string file, std::string json_path, const std::string& message)
         : std::runtime_error(compose(file, json_path, message)),
-          file_(std::move(file)), json_path_(std::move(json_path)) {}
+          file_(std::move(file)),
+          json_path_(std::move(json_path)) {}
 
     const std::string& file() const { return file_; }
     const std::string& json_path() const { return json_path_; }
 
-private:
+  private:
     static std::string compose(const std::string& file, const std::string& path,
                                const std::string& message) {
         std::string out;

@@ -5,11 +5,10 @@
 #include <bit>
 #include <charconv>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <system_error>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "scene/load.h"
 
@@ -29,7 +28,8 @@ Json number(float f) {
     double d = 0.0;
     const auto parsed = std::from_chars(buf.data(), printed.ptr, d);
     if (printed.ec == std::errc{} && parsed.ec == std::errc{} &&
-        std::bit_cast<std::uint32_t>(static_cast<float>(d)) == std::bit_cast<std::uint32_t>(f)) {
+        std::bit_cast<std::uint32_t>(static_cast<float>(d)) ==
+            std::bit_cast<std::uint32_t>(f)) {
         return Json(d);
     }
     return Json(static_cast<double>(f));
@@ -71,7 +71,8 @@ Json material(const Material& m) {
     j["transmit"] = number(m.transmit);
     j["ior"] = number(m.ior);
     if (m.checker) {
-        j["checker"] = Json{{"color", color(m.checker->color)}, {"size", number(m.checker->size)}};
+        j["checker"] =
+            Json{{"color", color(m.checker->color)}, {"size", number(m.checker->size)}};
     }
     return j;
 }
@@ -123,7 +124,9 @@ Json light(const Light& l) {
     return j;
 }
 
-std::string dump(const Json& j) { return j.dump(-1, ' ', false, Json::error_handler_t::replace); }
+std::string dump(const Json& j) {
+    return j.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
 
 // Only the properties a key sets, so that the scene's values still show through the others.
 Json camera_key(const CameraKey& k) {

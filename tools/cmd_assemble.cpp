@@ -2,7 +2,6 @@
 // image, bit for bit (render/README.md, "Assembling crops").
 
 #include <CLI/CLI.hpp>
-
 #include <iostream>
 #include <memory>
 #include <string>
@@ -44,7 +43,8 @@ void run_assemble(const AssembleArguments& args) {
 void add_assemble_command(CLI::App& app, CommandRunner& run) {
     auto args = std::make_shared<AssembleArguments>();
     CLI::App* cmd = app.add_subcommand(
-        "assemble", "Stitch cropped EXR parts of one render (render --crop) into the full image");
+        "assemble",
+        "Stitch cropped EXR parts of one render (render --crop) into the full image");
     cmd->add_option("parts", args->parts,
                     "The parts: OpenEXR files whose data windows are crops of one display\n"
                     "window, with the same channels and pixel types")

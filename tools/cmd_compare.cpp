@@ -3,7 +3,6 @@
 // and the exit codes are idiff's; render/COMPARE.md defines them.
 
 #include <CLI/CLI.hpp>
-
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -36,9 +35,11 @@ struct CompareArguments {
 // before looking at the exit status.
 void print_json_outcome(const CompareArguments& args, std::string_view verdict, int code,
                         const std::string& reason) {
-    const nlohmann::ordered_json j = {{"a", args.a},         {"b", args.b},
-                              {"verdict", verdict},  {"exit_code", code},
-                              {"reason", reason}};
+    const nlohmann::ordered_json j = {{"a", args.a},
+                                      {"b", args.b},
+                                      {"verdict", verdict},
+                                      {"exit_code", code},
+                                      {"reason", reason}};
     std::cout << j.dump(2) << '\n' << std::flush;
 }
 
@@ -99,8 +100,9 @@ CLI::Validator quiet(CLI::Validator validator) { return validator.description(""
 void add_compare_command(CLI::App& app, CommandRunner& run) {
     auto args = std::make_shared<CompareArguments>();
     CLI::App* cmd = app.add_subcommand(
-        "compare", "Compare two images (OpenEXR or PNG) as idiff does: error figures per "
-                   "channel, a pass/warn/fail verdict and exit code");
+        "compare",
+        "Compare two images (OpenEXR or PNG) as idiff does: error figures per "
+        "channel, a pass/warn/fail verdict and exit code");
     cmd->add_option("a", args->a, "First image (the reference)")->type_name("A")->required();
     cmd->add_option("b", args->b, "Second image")->type_name("B")->required();
 

@@ -1,7 +1,6 @@
 // `octray scene`: write the scene a spec describes (a built-in, or a file normalised) as JSON.
 
 #include <CLI/CLI.hpp>
-
 #include <cerrno>
 #include <fstream>
 #include <iostream>
@@ -47,8 +46,9 @@ void run_scene(const SceneArguments& args) {
 void add_scene_command(CLI::App& app, CommandRunner& run) {
     auto args = std::make_shared<SceneArguments>();
     CLI::App* cmd = app.add_subcommand(
-        "scene", "Write a scene (built-in or file) as JSON; rendering that file gives the "
-                 "identical image");
+        "scene",
+        "Write a scene (built-in or file) as JSON; rendering that file gives the "
+        "identical image");
     cmd->add_option("scene", args->scene,
                     "Scene: a built-in (whitted, random:N, sphereflake:L, with optional\n"
                     ",width=W,height=H,spp=N,seed=S,max_depth=D) or a JSON file")

@@ -31,7 +31,7 @@ std::string exit_code_help();
 // A command-line mistake only found once the command runs (an option combination, a path
 // that is not available yet): exits with kExitUsage like a parse error.
 class UsageError : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 

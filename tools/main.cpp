@@ -1,7 +1,6 @@
 // octray: the command line. Thin by design: parse, call the library, report.
 
 #include <CLI/CLI.hpp>
-
 #include <csignal>
 #include <exception>
 #include <iostream>
@@ -31,7 +30,8 @@ int run_command(const std::function<void()>& action) {
     } catch (const CommandExit& e) {
         return e.status;
     } catch (const UsageError& e) {
-        std::cerr << "octray: error: " << e.what() << "\nRun with --help for more information.\n";
+        std::cerr << "octray: error: " << e.what()
+                  << "\nRun with --help for more information.\n";
         return kExitUsage;
     } catch (const SceneError& e) {
         std::cerr << "octray: scene error: " << e.what() << '\n';

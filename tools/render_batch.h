@@ -22,10 +22,10 @@ namespace octray::tools {
 enum class RenderPath { scalar, simd };
 
 struct BatchScene {
-    std::string spec;    // as given on the command line
-    std::string name;    // {scene} in output patterns
-    std::string sha256;  // octray.sceneSha256
-    Scene scene;         // loaded, overrides applied, validated
+    std::string spec;               // as given on the command line
+    std::string name;               // {scene} in output patterns
+    std::string sha256;             // octray.sceneSha256
+    Scene scene;                    // loaded, overrides applied, validated
     std::optional<PixelRect> crop;  // --crop, checked against the image
 };
 

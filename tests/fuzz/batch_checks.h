@@ -50,7 +50,8 @@ inline void check_frame_spec(std::string_view input) {
         std::unordered_set<int> seen;
         for (int f : frames) {
             if (f < 0) throw BatchInvariantBroken("frames are >= 0", input);
-            if (!seen.insert(f).second) throw BatchInvariantBroken("frames are distinct", input);
+            if (!seen.insert(f).second)
+                throw BatchInvariantBroken("frames are distinct", input);
         }
         if (frames.size() <= 10000) {
             std::string written;
@@ -93,7 +94,8 @@ inline void check_frame_spec(std::string_view input) {
         return;
     }
     if (pattern_refused) {
-        throw BatchInvariantBroken("pattern_has_frame_field refuses what expand refuses", input);
+        throw BatchInvariantBroken("pattern_has_frame_field refuses what expand refuses",
+                                   input);
     }
     if (has_frame == (a == b)) {
         throw BatchInvariantBroken("a frame field makes frames 7 and 8 differ", input);

@@ -54,7 +54,8 @@ Scene glass_and_mirrors(CameraType camera) {
     s.camera.width = 7.0f;
     s.camera.aperture = 0.05f;
     s.camera.focus_distance = 5.5f;
-    s.background = {BackgroundType::gradient, Rgb(0.0f), {0.9f, 0.9f, 1.0f}, {0.2f, 0.4f, 0.8f}};
+    s.background = {
+        BackgroundType::gradient, Rgb(0.0f), {0.9f, 0.9f, 1.0f}, {0.2f, 0.4f, 0.8f}};
     s.ambient = Rgb(0.05f);
     Material floor;
     floor.checker = Checker{{0.1f, 0.1f, 0.1f}, 0.5f};

@@ -9,20 +9,21 @@
 // one point, radii from 1e-6 to 1e3, spheres far apart along one axis, duplicates that tie,
 // planes); any-hit equals the reference's occlusion and agrees with closest hit.
 
+#include "scene/bvh.h"
+
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <random>
 #include <string>
-#include <tbb/task_arena.h>
 #include <vector>
 
 #include "core/aligned.h"
 #include "kernels/dispatch.h"
 #include "render/reference.h"
-#include "scene/bvh.h"
 #include "scene/compile.h"
 
 namespace octray {
@@ -156,8 +157,7 @@ double half_area(double dx, double dy, double dz) { return dx * dy + dy * dz + d
 
 // Half the surface area of child j's box.
 double child_half_area(const BvhNode8& n, int j) {
-    return half_area(n.max_x[j] - n.min_x[j], n.max_y[j] - n.min_y[j],
-                     n.max_z[j] - n.min_z[j]);
+    return half_area(n.max_x[j] - n.min_x[j], n.max_y[j] - n.min_y[j], n.max_z[j] - n.min_z[j]);
 }
 
 // Walks the tree; returns the subtree's exact box and counts each sphere's leaves.
@@ -380,13 +380,13 @@ struct RaySoA {
         }
     }
     kernels::RayStream stream() {
-        return {ox.data(), oy.data(), oz.data(), dx.data(),    dy.data(),
-                dz.data(), w.data(),  w.data(),  w.data(),     pixel.data()};
+        return {ox.data(), oy.data(), oz.data(), dx.data(), dy.data(),
+                dz.data(), w.data(),  w.data(),  w.data(),  pixel.data()};
     }
     kernels::ShadowStream shadow() {
         const std::size_t c = t_max.size();
-        return {ox.data(),    oy.data(),          oz.data(),   dx.data(),
-                dy.data(),    dz.data(),          t_max.data(), term.data(),
+        return {ox.data(),       oy.data(),           oz.data(),    dx.data(),
+                dy.data(),       dz.data(),           t_max.data(), term.data(),
                 term.data() + c, term.data() + 2 * c, pixel.data()};
     }
 };
@@ -397,7 +397,8 @@ std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (std::uint32_t i = 0; i < c.spheres.count; ++i) {
         const float p[3] = {c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
-        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+        for (int a = 0; a < 3; ++a)
+            lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
     }
     if (c.spheres.count == 0) lo[0] = lo[1] = lo[2] = -1, hi[0] = hi[1] = hi[2] = 1;
     std::uniform_real_distribution<float> u01(0.0f, 1.0f), unit(-1.0f, 1.0f);
@@ -453,8 +454,8 @@ std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_
             r.direction = {axis == 0 ? sign : 0.0f, axis == 1 ? sign : 0.0f,
                            axis == 2 ? sign : 0.0f};
         } else {
-            r.direction = (kind == 1 ? in_box(0.0f) - r.origin
-                                     : Vec3{unit(rng), unit(rng), unit(rng)});
+            r.direction =
+                (kind == 1 ? in_box(0.0f) - r.origin : Vec3{unit(rng), unit(rng), unit(rng)});
             if (!(length(r.direction) > 1e-3f)) r.direction = {0, 1, 0};
             if (kind != 1) r.direction = normalize(r.direction);
         }
@@ -503,9 +504,9 @@ class BvhTraversalTest : public ::testing::Test {
                 const float want_t = hit ? hit->t : INFINITY;
                 if (id[i] != want_id || !(t[i] == want_t)) {
                     ++mismatches;
-                    ADD_FAILURE() << "closest hit, ray " << i << " t_min " << t_min << ": got "
-                                  << id[i] << " at " << t[i] << ", reference " << want_id
-                                  << " at " << want_t;
+                    ADD_FAILURE()
+                        << "closest hit, ray " << i << " t_min " << t_min << ": got " << id[i]
+                        << " at " << t[i] << ", reference " << want_id << " at " << want_t;
                 }
             }
         }

@@ -72,8 +72,8 @@ TEST(Aov, KnownValuesOfASphereAPlaneAndAMiss) {
     std::set<std::tuple<float, float, float>> plane_colors;
     for (std::size_t k = 0; k < a.id.size(); ++k)
         if (a.id[k] == 2u) plane_colors.insert({a.albedo[k].r, a.albedo[k].g, a.albedo[k].b});
-    EXPECT_EQ(plane_colors, (std::set<std::tuple<float, float, float>>{
-                                {0.2f, 0.3f, 0.4f}, {0.9f, 0.8f, 0.7f}}));
+    EXPECT_EQ(plane_colors, (std::set<std::tuple<float, float, float>>{{0.2f, 0.3f, 0.4f},
+                                                                       {0.9f, 0.8f, 0.7f}}));
 
     // Without the plane the corner misses: Z = +inf, N = 0, albedo = 0, id = 0.
     scene.objects.pop_back();
@@ -148,9 +148,9 @@ TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
     ExrImage wrong = make_exr_image(render_reference(scene, {}), ExrWriteOptions{});
     RenderOptions crop;
     crop.crop = PixelRect{0, 0, 5, 5};
-    EXPECT_THROW(append_aov_channels(wrong, compute_aovs(scene, crop, AovSet{true}),
-                                     ExrPixelType::half),
-                 std::invalid_argument);
+    EXPECT_THROW(
+        append_aov_channels(wrong, compute_aovs(scene, crop, AovSet{true}), ExrPixelType::half),
+        std::invalid_argument);
 }
 
 }  // namespace

@@ -29,8 +29,8 @@ ExrImage render_part(const Scene& scene, std::optional<PixelRect> crop, bool flo
     attributes.strings.emplace_back("software", "octray test");
     attributes.rationals.emplace_back("framesPerSecond", ExrRational{24, 1});
     add_camera_attributes(attributes, scene);
-    ExrImage exr = make_exr_image(result, ExrWriteOptions{float32, ExrCompression::zip},
-                                  attributes);
+    ExrImage exr =
+        make_exr_image(result, ExrWriteOptions{float32, ExrCompression::zip}, attributes);
     append_aov_channels(exr, compute_aovs(scene, options, AovSet{true, true, true, true}),
                         float32 ? ExrPixelType::float32 : ExrPixelType::half);
     return exr;
@@ -72,7 +72,11 @@ TEST(Assemble, PartsMakeTheFullRenderBitForBit) {
         // 2 x 2
         {{0, 0, 15, 10}, {15, 0, 29, 10}, {0, 10, 15, 19}, {15, 10, 29, 19}},
         // irregular: a one-pixel part, a single row, uneven columns, given out of order
-        {{0, 0, 1, 1}, {1, 0, 29, 1}, {20, 1, 29, 19}, {0, 1, 7, 19}, {7, 1, 20, 18},
+        {{0, 0, 1, 1},
+         {1, 0, 29, 1},
+         {20, 1, 29, 19},
+         {0, 1, 7, 19},
+         {7, 1, 20, 18},
          {7, 18, 20, 19}},
         // one part that is the whole image
         {{0, 0, 29, 19}},

@@ -2,15 +2,14 @@
 // Test images for the compare suites, written with OpenEXR and libpng directly (never with
 // the code under test), and a per-test scratch directory.
 
-#include <gtest/gtest.h>
-#include <png.h>
-#include <unistd.h>
-
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
+#include <gtest/gtest.h>
 #include <half.h>
+#include <png.h>
+#include <unistd.h>
 
 #include <csetjmp>
 #include <cstdint>
@@ -28,7 +27,7 @@ namespace fs = std::filesystem;
 
 // A fresh directory per test under the build tree; kept when the test fails.
 class ScratchDirTest : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         std::string name = std::string(info->test_suite_name()) + "." + info->name();
@@ -48,7 +47,8 @@ protected:
 };
 
 // A w x h image with the given channels, every value `fill`.
-inline ChannelImage make_image(int w, int h, std::vector<std::string> names, float fill = 0.0f) {
+inline ChannelImage make_image(int w, int h, std::vector<std::string> names,
+                               float fill = 0.0f) {
     ChannelImage image(w, h, std::move(names));
     for (float& v : image.planes) v = fill;
     return image;
@@ -81,7 +81,8 @@ inline void write_test_exr(const std::string& path, const ChannelImage& image,
             size = sizeof(half);
         } else if (type == Imf::UINT) {
             uints.emplace_back();
-            for (std::size_t i = 0; i < n; ++i) uints.back().push_back(static_cast<unsigned>(plane[i]));
+            for (std::size_t i = 0; i < n; ++i)
+                uints.back().push_back(static_cast<unsigned>(plane[i]));
             base = reinterpret_cast<const char*>(uints.back().data());
         } else {
             base = reinterpret_cast<const char*>(plane);
@@ -100,8 +101,8 @@ inline bool png_write_rows(png_structp png, png_infop info, std::FILE* f, int w,
                            int color_type, int bit_depth, png_bytepp rows) {
     if (setjmp(png_jmpbuf(png))) return false;
     png_init_io(png, f);
-    png_set_IHDR(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h),
-                 bit_depth, color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+    png_set_IHDR(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), bit_depth,
+                 color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
     png_write_image(png, rows);

@@ -86,9 +86,12 @@ TEST(Crop, RayCountsCoverOnlyTheCropAndAgreeBetweenPaths) {
 
 TEST(Crop, BadCropsAreRefusedByBothPaths) {
     const Scene scene = golden_scene("pinhole_checker", 16, 8);
-    for (const PixelRect& bad : std::vector<PixelRect>{
-             {0, 0, 0, 8}, {4, 4, 2, 6}, {-1, 0, 4, 4}, {0, 0, 17, 8}, {0, 0, 16, 9},
-             {16, 0, 17, 1}}) {
+    for (const PixelRect& bad : std::vector<PixelRect>{{0, 0, 0, 8},
+                                                       {4, 4, 2, 6},
+                                                       {-1, 0, 4, 4},
+                                                       {0, 0, 17, 8},
+                                                       {0, 0, 16, 9},
+                                                       {16, 0, 17, 1}}) {
         RenderOptions options;
         options.crop = bad;
         for (Path path : {Path::reference, Path::packet}) {

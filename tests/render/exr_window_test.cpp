@@ -3,16 +3,15 @@
 // read_exr_image (every channel in its own type) and by compare's read_image; M44f,
 // Rational and opaque attributes; the camera matrices against the camera's own rays.
 
-#include <gtest/gtest.h>
-
+#include <ImfChannelList.h>
 #include <ImfChromaticitiesAttribute.h>
+#include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
-#include <ImfFrameBuffer.h>
-#include <ImfChannelList.h>
 #include <ImfStandardAttributes.h>
 #include <ImfVecAttribute.h>
+#include <gtest/gtest.h>
 #include <half.h>
 
 #include <cmath>
@@ -185,8 +184,8 @@ void expect_matrices_match_rays(const Scene& scene) {
     ASSERT_TRUE(to_ndc);
     const ReferenceTracer tracer(scene);
     const int w = scene.image.width, h = scene.image.height;
-    for (const auto& [i, j] : std::vector<std::pair<int, int>>{{0, 0}, {w - 1, 0}, {5, 7},
-                                                                {w / 2, h / 2}, {w - 1, h - 1}}) {
+    for (const auto& [i, j] : std::vector<std::pair<int, int>>{
+             {0, 0}, {w - 1, 0}, {5, 7}, {w / 2, h / 2}, {w - 1, h - 1}}) {
         const Ray ray = *tracer.camera_ray(i, j, 0);  // spp 1: the pixel center
         for (float t : {1.0f, 3.0f, 10.0f}) {
             const Vec3 p = ray.origin + ray.direction * t;

@@ -1,10 +1,10 @@
 #include "render/image_compare.h"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -442,7 +442,8 @@ TEST(CompareReport, EndsWithTheReasonAndListsEveryChannel) {
     const CompareResult r = compare_images(a, b, options);
     const std::string text = format_compare_report(r, options, "a.exr", "b.png");
     EXPECT_NE(text.find("A = a.exr"), std::string::npos);
-    EXPECT_NE(text.find("max error 0.5 at (1, 1) B: A = 0, B = 0.5"), std::string::npos) << text;
+    EXPECT_NE(text.find("max error 0.5 at (1, 1) B: A = 0, B = 0.5"), std::string::npos)
+        << text;
     EXPECT_NE(text.find("1 pixels (25%) over fail 1e-06"), std::string::npos) << text;
     const std::string last_line = r.reason + "\n";
     EXPECT_EQ(text.substr(text.size() - last_line.size()), last_line);

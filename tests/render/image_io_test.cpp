@@ -1,8 +1,5 @@
 #include "render/image_io.h"
 
-#include <gtest/gtest.h>
-#include <png.h>
-
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
 #include <ImfFloatAttribute.h>
@@ -11,7 +8,10 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
+#include <gtest/gtest.h>
 #include <half.h>
+#include <png.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -19,7 +19,6 @@
 #include <limits>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 namespace octray {
@@ -30,7 +29,7 @@ namespace fs = std::filesystem;
 // Each test gets its own empty directory, so "nothing else was left behind" is a plain
 // directory listing.
 class ImageIoTest : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         std::string name = std::string(info->test_suite_name()) + "." + info->name();
@@ -81,8 +80,7 @@ ReadExr read_exr(const std::string& path) {
     const int width = window.max.x - window.min.x + 1;
     const int height = window.max.y - window.min.y + 1;
     out.image = Image(width, height);
-    for (auto it = file.header().channels().begin(); it != file.header().channels().end();
-         ++it)
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it)
         out.channel_types.push_back(it.channel().type);
 
     // Address the buffer so that data-window row min.y lands in image row 0.
@@ -103,26 +101,30 @@ ReadExr read_exr(const std::string& path) {
 float as_half(float v) { return static_cast<float>(half(v)); }
 
 const std::vector<ExrCompression> kAllCompressions = {
-    ExrCompression::none,  ExrCompression::rle,  ExrCompression::zips, ExrCompression::zip,
-    ExrCompression::piz,   ExrCompression::pxr24, ExrCompression::b44, ExrCompression::b44a,
-    ExrCompression::dwaa,  ExrCompression::dwab};
+    ExrCompression::none, ExrCompression::rle,   ExrCompression::zips, ExrCompression::zip,
+    ExrCompression::piz,  ExrCompression::pxr24, ExrCompression::b44,  ExrCompression::b44a,
+    ExrCompression::dwaa, ExrCompression::dwab};
 
 // Which codecs lose information for which channel type: B44 is lossy for HALF and stores
 // FLOAT uncompressed; PXR24 rounds FLOAT to 24 bits and keeps HALF exact; DWA quantises
 // R, G and B in the DCT domain whatever their type.
 bool is_lossy(ExrCompression c, bool float32) {
     switch (c) {
-        case ExrCompression::pxr24: return float32;
+        case ExrCompression::pxr24:
+            return float32;
         case ExrCompression::b44:
-        case ExrCompression::b44a: return !float32;
+        case ExrCompression::b44a:
+            return !float32;
         case ExrCompression::dwaa:
-        case ExrCompression::dwab: return true;
-        default: return false;
+        case ExrCompression::dwab:
+            return true;
+        default:
+            return false;
     }
 }
 
 TEST(ExrCompressionNames, RoundTripEveryName) {
-    const std::vector<std::string> names = {"none", "rle",  "zips", "zip",  "piz",
+    const std::vector<std::string> names = {"none",  "rle", "zips", "zip",  "piz",
                                             "pxr24", "b44", "b44a", "dwaa", "dwab"};
     ASSERT_EQ(names.size(), kAllCompressions.size());
     for (std::size_t i = 0; i < names.size(); ++i) {
@@ -236,8 +238,8 @@ TEST_F(ImageIoTest, ExrRowZeroIsTheTopRow) {
     // Read scan line min.y alone: it must be image row 0.
     std::vector<float> line(5);
     Imf::FrameBuffer fb;
-    fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(line.data()),
-                              sizeof(float), 0));
+    fb.insert("R",
+              Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(line.data()), sizeof(float), 0));
     file.setFrameBuffer(fb);
     file.readPixels(window.min.y);
     for (float v : line) EXPECT_EQ(v, 1.0f);
@@ -385,7 +387,9 @@ TEST_F(ImageIoTest, PngEncodesKnownValues) {
     const PngPixels png = read_png(path);
     ASSERT_EQ(png.width, 4);
     ASSERT_EQ(png.height, 2);
-    auto px = [&](int x, int y, int k) { return static_cast<int>(png.rgb[(y * 4 + x) * 3 + k]); };
+    auto px = [&](int x, int y, int k) {
+        return static_cast<int>(png.rgb[(y * 4 + x) * 3 + k]);
+    };
     EXPECT_EQ(px(0, 0, 0), 0);    // 0 -> 0
     EXPECT_EQ(px(0, 0, 1), 255);  // 1 -> 255
     EXPECT_EQ(px(0, 0, 2), 188);  // 0.5 linear -> 0.7354 sRGB -> 187.5 -> 188

@@ -195,7 +195,7 @@ void claim_data_window(const std::string& path, int width, int height) {
     const std::size_t at = bytes.find(name);
     ASSERT_NE(at, std::string::npos);
     const std::int32_t window[4] = {0, 0, width - 1, height - 1};  // little-endian host
-    f.seekp(static_cast<std::streamoff>(at + name.size() + 4));   // after the size field
+    f.seekp(static_cast<std::streamoff>(at + name.size() + 4));    // after the size field
     f.write(reinterpret_cast<const char*>(window), sizeof window);
 }
 
@@ -242,7 +242,8 @@ TEST_F(ImageReadTest, LargeUncompressedExrStillLoads) {
 
 TEST_F(ImageReadTest, TruncatedPngIsAClearIoError) {
     std::vector<std::uint16_t> samples(32 * 32 * 3);
-    for (std::size_t i = 0; i < samples.size(); ++i) samples[i] = static_cast<std::uint16_t>(i * 7919 % 256);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        samples[i] = static_cast<std::uint16_t>(i * 7919 % 256);
     write_test_png(path("t.png"), 32, 32, 3, 8, samples);
     testing::truncate_file(path("t.png"), testing::fs::file_size(path("t.png")) / 2);
     const std::string message = read_error(path("t.png"));

@@ -54,8 +54,9 @@ inline Image sub_image(const Image& full, const PixelRect& r) {
 // A fresh directory for one test's files.
 inline std::filesystem::path test_dir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    const std::filesystem::path dir = std::filesystem::path(OCTRAY_TEST_TMPDIR) /
-                                      (std::string(info->test_suite_name()) + "." + info->name());
+    const std::filesystem::path dir =
+        std::filesystem::path(OCTRAY_TEST_TMPDIR) /
+        (std::string(info->test_suite_name()) + "." + info->name());
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;

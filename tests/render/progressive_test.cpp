@@ -46,7 +46,8 @@ TEST(Progressive, FinalImageEqualsThePlainRenderOnBothPaths) {
                     std::vector<int> seen;
                     const RenderResult progressive = render_progressive(
                         [&](const RenderOptions& o) { return render_with(path, scene, o); },
-                        spp, options, [&](const RenderResult& so_far, int samples) {
+                        spp, options,
+                        [&](const RenderResult& so_far, int samples) {
                             seen.push_back(samples);
                             EXPECT_EQ(so_far.rect, plain.rect);
                             EXPECT_EQ(so_far.image.width(), plain.image.width());

@@ -267,8 +267,8 @@ TEST(ReferenceShading, InverseSquareFalloffAndDirectionalLights) {
     add_sphere(d, {0, 0, 0}, 1.0f);
     // Travels along -z and -y at 45 degrees: N.l = cos 45 at the front point.
     add_directional_light(d, {0, -1, -1}, Rgb(1.0f));
-    expect_rgb_near(ReferenceTracer(d).render_pixel(16, 16, 0, counts),
-                    Rgb(std::sqrt(0.5f)), 1e-6f);
+    expect_rgb_near(ReferenceTracer(d).render_pixel(16, 16, 0, counts), Rgb(std::sqrt(0.5f)),
+                    1e-6f);
 }
 
 TEST(ReferenceShading, LightBehindTheSurfaceContributesNothingAndCastsNoShadowRay) {

@@ -2,6 +2,8 @@
 // per-property interpolation, holding outside the keys, writing it back, and rendering
 // posed frames of scene/examples/bounce.json.
 
+#include "scene/animation.h"
+
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -9,13 +11,11 @@
 #include <cstdint>
 #include <functional>
 #include <initializer_list>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "render/reference.h"
-#include "scene/animation.h"
 #include "scene/load.h"
 
 namespace octray {
@@ -73,7 +73,8 @@ void expect_error(const Json& j, const std::string& path,
         EXPECT_EQ(e.file(), kFile) << what;
         EXPECT_EQ(e.json_path(), path) << what;
         for (const std::string& n : needles) {
-            EXPECT_NE(what.find(n), std::string::npos) << "missing \"" << n << "\" in: " << what;
+            EXPECT_NE(what.find(n), std::string::npos)
+                << "missing \"" << n << "\" in: " << what;
         }
     }
 }
@@ -175,8 +176,8 @@ TEST(AnimationPose, ExactAtKeysAndLinearBetween) {
 TEST(AnimationPose, MidpointBetweenTwoKeys) {
     Json j = base_scene();
     j["animation"]["frames"] = 11;
-    j["animation"]["camera"] = Json::array(
-        {{{"frame", 0}, {"fov", 30}}, {{"frame", 10}, {"fov", 60}}});
+    j["animation"]["camera"] =
+        Json::array({{{"frame", 0}, {"fov", 30}}, {{"frame", 10}, {"fov", 60}}});
     j["animation"]["objects"]["ball"] = Json::array(
         {{{"frame", 0}, {"center", {0, 0, 0}}}, {{"frame", 10}, {"center", {2, 4, -6}}}});
     const Scene s = parse(j);
@@ -258,7 +259,8 @@ TEST(AnimationPose, VisitingFramesGivesTheCamerasOfCameraAtFrame) {
             << f;
     });
     EXPECT_EQ(visited.size(), 54u);
-    EXPECT_TRUE(same_bits(camera_at_frame(s, 20).fov, lerp_expected(30.0f, 60.0f, 18.0 / 19.0)));
+    EXPECT_TRUE(
+        same_bits(camera_at_frame(s, 20).fov, lerp_expected(30.0f, 60.0f, 18.0 / 19.0)));
 }
 
 TEST(AnimationPose, PosedSceneIsAStillAndDeterministic) {
@@ -323,12 +325,14 @@ TEST(AnimationError, UnknownAndUnanimatedKeys) {
     expect_error(j, "animation.frame", {"unknown key \"frame\"", "did you mean \"frames\"?"});
     j = base_scene();
     j["animation"]["camera"][1]["eyes"] = {0, 0, 0};
-    expect_error(j, "animation.camera[1].eyes", {"unknown key", "did you mean \"eye\"?",
-                                                 "\"frame\", \"eye\", \"lookat\", \"up\", \"fov\""});
+    expect_error(j, "animation.camera[1].eyes",
+                 {"unknown key", "did you mean \"eye\"?",
+                  "\"frame\", \"eye\", \"lookat\", \"up\", \"fov\""});
     j = base_scene();
     j["animation"]["camera"][0]["aperture"] = 0.1;
-    expect_error(j, "animation.camera[0].aperture",
-                 {"key \"aperture\" cannot be animated", "\"eye\", \"lookat\", \"up\", \"fov\""});
+    expect_error(
+        j, "animation.camera[0].aperture",
+        {"key \"aperture\" cannot be animated", "\"eye\", \"lookat\", \"up\", \"fov\""});
     j = base_scene();
     j["animation"]["objects"]["ball"][0]["material"] = "x";
     expect_error(j, "animation.objects.ball[0].material",
@@ -363,8 +367,9 @@ TEST(AnimationError, ObjectNames) {
 TEST(AnimationError, SphereKeysOnAPlane) {
     Json j = base_scene();
     j["animation"]["objects"]["floor"] = Json::array({{{"frame", 0}, {"radius", 2}}});
-    expect_error(j, "animation.objects.floor[0].radius",
-                 {"key \"radius\" applies only to spheres, not to a plane (objects[0], \"floor\")"});
+    expect_error(
+        j, "animation.objects.floor[0].radius",
+        {"key \"radius\" applies only to spheres, not to a plane (objects[0], \"floor\")"});
     j["animation"]["objects"]["floor"] = Json::array({{{"frame", 0}, {"center", {0, 1, 0}}}});
     expect_error(j, "animation.objects.floor[0].center", {"applies only to spheres"});
 }
@@ -380,7 +385,8 @@ TEST(AnimationError, Values) {
     expect_error(j, "animation.objects.ball[1].center", {"expected an array of 3 numbers"});
     j = base_scene();
     j["animation"]["camera"][1]["fov"] = 180;
-    expect_error(j, "animation.camera[1].fov", {"expected a field of view in (0, 180)", "found 180"});
+    expect_error(j, "animation.camera[1].fov",
+                 {"expected a field of view in (0, 180)", "found 180"});
     j["animation"]["camera"][1]["fov"] = 0;
     expect_error(j, "animation.camera[1].fov", {"found 0"});
     j = base_scene();
@@ -391,8 +397,9 @@ TEST(AnimationError, Values) {
     expect_error(j, "animation.camera[1].fov", {"(0, 360]"});
     j = base_scene();
     j["camera"] = {{"type", "orthographic"}, {"eye", {0, 1, 5}}, {"lookat", {0, 0, 0}}};
-    expect_error(j, "animation.camera[1].fov",
-                 {"applies only to pinhole, thinlens and fisheye cameras, not to an orthographic"});
+    expect_error(
+        j, "animation.camera[1].fov",
+        {"applies only to pinhole, thinlens and fisheye cameras, not to an orthographic"});
     j = base_scene();
     j["animation"]["camera"][1]["up"] = {0, 0, 0};
     expect_error(j, "animation.camera[1].up", {"expected a non-zero up vector"});
@@ -401,8 +408,8 @@ TEST(AnimationError, Values) {
 TEST(AnimationError, InterpolatedCameraIsCheckedOnEveryFrame) {
     // up turns from +y to -y: on the frame halfway it is [0, 0, 0].
     Json j = base_scene();
-    j["animation"]["camera"] = Json::array(
-        {{{"frame", 0}, {"up", {0, 1, 0}}}, {{"frame", 10}, {"up", {0, -1, 0}}}});
+    j["animation"]["camera"] =
+        Json::array({{{"frame", 0}, {"up", {0, 1, 0}}}, {{"frame", 10}, {"up", {0, -1, 0}}}});
     expect_error(j, "animation.camera",
                  {"at frame 5 the interpolated camera is unusable", "non-zero up vector"});
     // The eye passes through the look-at point on frame 2.
@@ -447,7 +454,8 @@ TEST(AnimationError, HandBuiltAnimationIsValidated) {
         ADD_FAILURE() << "expected a SceneError";
     } catch (const SceneError& e) {
         EXPECT_EQ(e.json_path(), "animation.objects.ball");
-        EXPECT_NE(std::string(e.what()).find("is named \"moon\""), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("is named \"moon\""), std::string::npos)
+            << e.what();
     }
     bad = s;
     bad.animation->objects.push_back(bad.animation->objects[0]);
@@ -507,8 +515,9 @@ TEST(AnimationWrite, RoundTripIsExact) {
     j["animation"]["fps"] = 29.97;
     j["animation"]["camera"][0]["lookat"] = {0.1, 0.2, 0.3};
     j["animation"]["camera"][0]["up"] = {0, 1, 0.1};
-    j["animation"]["objects"]["moon"] = Json::array(
-        {{{"frame", 3}, {"radius", 0.7}}, {{"frame", 9}, {"center", {1e-7, 3, -4}}, {"radius", 1.3}}});
+    j["animation"]["objects"]["moon"] =
+        Json::array({{{"frame", 3}, {"radius", 0.7}},
+                     {{"frame", 9}, {"center", {1e-7, 3, -4}}, {"radius", 1.3}}});
     for (const Scene& s : {parse(j), load_scene_file(kBounce)}) {
         const std::string text = scene_to_json(s);
         const Scene back = parse_scene_json(text, "written.json");
@@ -517,7 +526,8 @@ TEST(AnimationWrite, RoundTripIsExact) {
         EXPECT_EQ(scene_to_json(back), text);
         // Every frame poses the same.
         for (int f : {0, 5, 24, 47}) {
-            EXPECT_EQ(scene_to_json(scene_at_frame(s, f)), scene_to_json(scene_at_frame(back, f)));
+            EXPECT_EQ(scene_to_json(scene_at_frame(s, f)),
+                      scene_to_json(scene_at_frame(back, f)));
         }
     }
 }
@@ -556,7 +566,8 @@ bool same_pixels(const Image& a, const Image& b) {
     for (int y = 0; y < a.height(); ++y) {
         for (int x = 0; x < a.width(); ++x) {
             const Rgb p = a.at(x, y), q = b.at(x, y);
-            if (!(same_bits(p.r, q.r) && same_bits(p.g, q.g) && same_bits(p.b, q.b))) return false;
+            if (!(same_bits(p.r, q.r) && same_bits(p.g, q.g) && same_bits(p.b, q.b)))
+                return false;
         }
     }
     return true;

@@ -1,6 +1,8 @@
 // The built-in scenes of shared/spec/scene-format.md: splitmix64 and random:N to the
 // letter, sphereflake geometry, the whitted scene's framing, and the ",key=value" options.
 
+#include "scene/builtin.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "scene/builtin.h"
 #include "scene/camera.h"
 #include "scene/load.h"
 
@@ -32,7 +33,8 @@ void expect_error(const std::string& spec, const std::string& path,
             EXPECT_NE(what.find(": " + path + ": "), std::string::npos) << what;
         }
         for (const std::string& n : needles) {
-            EXPECT_NE(what.find(n), std::string::npos) << "missing \"" << n << "\" in: " << what;
+            EXPECT_NE(what.find(n), std::string::npos)
+                << "missing \"" << n << "\" in: " << what;
         }
     }
 }
@@ -294,35 +296,42 @@ TEST(SceneBuiltin, OverridesReplaceImageAndRenderSettings) {
     EXPECT_EQ(w.render.seed, 5u);
     EXPECT_EQ(w.render.max_depth, 0);
     EXPECT_EQ(w.source, "whitted,spp=9,seed=5,max_depth=0");
-    const Scene f = make_builtin_scene("sphereflake:1,width=64,height=48,seed=18446744073709551615");
+    const Scene f =
+        make_builtin_scene("sphereflake:1,width=64,height=48,seed=18446744073709551615");
     EXPECT_EQ(f.image.width, 64);
     EXPECT_EQ(f.render.seed, 18446744073709551615ull);
 }
 
 TEST(SceneBuiltinError, BadCountsAndLevels) {
-    expect_error("random", "", {"expected random:N with N a sphere count from 1 to 16777216",
-                                "found no count"});
+    expect_error(
+        "random", "",
+        {"expected random:N with N a sphere count from 1 to 16777216", "found no count"});
     expect_error("random:0", "", {"from 1 to 16777216", "found \"0\""});
     expect_error("random:abc", "", {"from 1 to 16777216", "found \"abc\""});
     expect_error("random:16777217", "", {"found \"16777217\""});
     expect_error("random:99999999999999999999999", "", {"found \"99999999999999999999999\""});
     expect_error("random:-4", "", {"found \"-4\""});
-    expect_error("sphereflake", "", {"expected sphereflake:L with L a recursion level from 0 to 7"});
+    expect_error("sphereflake", "",
+                 {"expected sphereflake:L with L a recursion level from 0 to 7"});
     expect_error("sphereflake:8", "", {"from 0 to 7", "found \"8\""});
     expect_error("sphereflake:-1", "", {"found \"-1\""});
     expect_error("whitted:3", "", {"whitted takes no argument"});
-    expect_error("teapot", "", {"unknown built-in scene \"teapot\"", "whitted, random:N or sphereflake:L"});
+    expect_error("teapot", "",
+                 {"unknown built-in scene \"teapot\"", "whitted, random:N or sphereflake:L"});
 }
 
 TEST(SceneBuiltinError, BadOptions) {
-    expect_error("random:16,depth=3", "depth",
-                 {"unknown option \"depth\"", "valid options: width, height, spp, seed, max_depth"});
-    expect_error("whitted,width=0", "width", {"expected an integer from 1 to 2147483647, found \"0\""});
+    expect_error(
+        "random:16,depth=3", "depth",
+        {"unknown option \"depth\"", "valid options: width, height, spp, seed, max_depth"});
+    expect_error("whitted,width=0", "width",
+                 {"expected an integer from 1 to 2147483647, found \"0\""});
     expect_error("whitted,width=12px", "width", {"expected an integer", "found \"12px\""});
     expect_error("whitted,height=-2", "height", {"found \"-2\""});
     expect_error("whitted,spp=", "spp", {"expected an integer from 1", "found \"\""});
     expect_error("whitted,max_depth=65", "max_depth", {"expected an integer from 0 to 64"});
-    expect_error("whitted,seed=-1", "seed", {"expected a non-negative integer", "found \"-1\""});
+    expect_error("whitted,seed=-1", "seed",
+                 {"expected a non-negative integer", "found \"-1\""});
     expect_error("whitted,width=64,width=32", "width", {"option given twice"});
     expect_error("whitted,width", "width", {"expected key=value", "found \"width\""});
     expect_error("random:4,", "", {"empty option", "key=value"});

@@ -1,6 +1,8 @@
 // JSON scene loading: every key of shared/spec/scene-format.md, the defaults of
 // scene/README.md, and every error with its file, JSON path and expectation.
 
+#include "scene/load.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,11 +13,8 @@
 #include <functional>
 #include <initializer_list>
 #include <limits>
-#include <string>
-
 #include <nlohmann/json.hpp>
-
-#include "scene/load.h"
+#include <string>
 
 namespace octray {
 namespace {
@@ -71,7 +70,8 @@ void expect_error(const std::function<void()>& f, const std::string& file,
             EXPECT_NE(what.find(": " + path + ": "), std::string::npos) << what;
         }
         for (const std::string& n : needles) {
-            EXPECT_NE(what.find(n), std::string::npos) << "missing \"" << n << "\" in: " << what;
+            EXPECT_NE(what.find(n), std::string::npos)
+                << "missing \"" << n << "\" in: " << what;
         }
     }
 }
@@ -86,9 +86,7 @@ void expect_text_error(const std::string& text, const std::string& path,
     expect_error([&] { parse_scene_json(text, kFile); }, kFile, path, needles);
 }
 
-Json minimal_scene() {
-    return Json{{"camera", {{"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}}}};
-}
+Json minimal_scene() { return Json{{"camera", {{"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}}}}; }
 
 // ---------------------------------------------------------------------------------------
 // Valid scenes
@@ -191,10 +189,10 @@ TEST(SceneLoad, DefaultsOfAMinimalScene) {
 TEST(SceneLoad, ObjectsWithoutMaterialShareTheDefaultMaterial) {
     Json j = minimal_scene();
     j["materials"] = {{"red", {{"color", {1, 0, 0}}}}};
-    j["objects"] = Json::array({{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}},
-                                {{"type", "sphere"}, {"center", {1, 0, 0}}, {"radius", 1},
-                                 {"material", "red"}},
-                                {{"type", "plane"}, {"point", {0, -1, 0}}, {"normal", {0, 1, 0}}}});
+    j["objects"] = Json::array(
+        {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}},
+         {{"type", "sphere"}, {"center", {1, 0, 0}}, {"radius", 1}, {"material", "red"}},
+         {{"type", "plane"}, {"point", {0, -1, 0}}, {"normal", {0, 1, 0}}}});
     const Scene s = parse(j);
     ASSERT_EQ(s.materials.size(), 2u);
     EXPECT_EQ(s.objects[0].material, 1u);
@@ -226,10 +224,15 @@ TEST(SceneLoad, BareNumberIsGrey) {
 
 TEST(SceneLoad, InlineMaterialsGetOneEntryEach) {
     Json j = minimal_scene();
-    j["objects"] = Json::array(
-        {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1},
-          {"material", {{"color", {0, 1, 0}}, {"checker", {{"color", 0}}}}}},
-         {{"type", "sphere"}, {"center", {3, 0, 0}}, {"radius", 1}, {"material", Json::object()}}});
+    j["objects"] =
+        Json::array({{{"type", "sphere"},
+                      {"center", {0, 0, 0}},
+                      {"radius", 1},
+                      {"material", {{"color", {0, 1, 0}}, {"checker", {{"color", 0}}}}}},
+                     {{"type", "sphere"},
+                      {"center", {3, 0, 0}},
+                      {"radius", 1},
+                      {"material", Json::object()}}});
     const Scene s = parse(j);
     ASSERT_EQ(s.materials.size(), 2u);
     EXPECT_EQ(s.objects[0].material, 0u);
@@ -242,11 +245,11 @@ TEST(SceneLoad, InlineMaterialsGetOneEntryEach) {
 
 TEST(SceneLoad, PlaneNormalsAreNormalised) {
     Json j = minimal_scene();
-    j["objects"] = Json::array(
-        {{{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {0, 2, 0}}},
-         {{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {3, 0, 4}}},
-         {{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {1e-30, 0, 0}}},
-         {{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {3e38, 3e38, 0}}}});
+    j["objects"] =
+        Json::array({{{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {0, 2, 0}}},
+                     {{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {3, 0, 4}}},
+                     {{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {1e-30, 0, 0}}},
+                     {{"type", "plane"}, {"point", {0, 0, 0}}, {"normal", {3e38, 3e38, 0}}}});
     const Scene s = parse(j);
     EXPECT_EQ(s.objects[0].normal, (Vec3{0, 1, 0}));
     EXPECT_FLOAT_EQ(s.objects[1].normal.x, 0.6f);
@@ -258,13 +261,16 @@ TEST(SceneLoad, PlaneNormalsAreNormalised) {
 
 TEST(SceneLoad, CameraTypesAndTheirKeys) {
     Json j = minimal_scene();
-    j["camera"] = {{"type", "orthographic"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}},
-                   {"width", 4}};
+    j["camera"] = {
+        {"type", "orthographic"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"width", 4}};
     EXPECT_EQ(parse(j).camera.type, CameraType::orthographic);
     EXPECT_EQ(parse(j).camera.width, 4.0f);
 
-    j["camera"] = {{"type", "thinlens"}, {"eye", {0, 3, 4}}, {"lookat", {0, 0, 0}},
-                   {"fov", 40}, {"aperture", 0.1}};
+    j["camera"] = {{"type", "thinlens"},
+                   {"eye", {0, 3, 4}},
+                   {"lookat", {0, 0, 0}},
+                   {"fov", 40},
+                   {"aperture", 0.1}};
     const Scene thin = parse(j);
     EXPECT_EQ(thin.camera.type, CameraType::thinlens);
     EXPECT_EQ(thin.camera.aperture, 0.1f);
@@ -272,7 +278,8 @@ TEST(SceneLoad, CameraTypesAndTheirKeys) {
     j["camera"]["focus_distance"] = 2.5;
     EXPECT_EQ(parse(j).camera.focus_distance, 2.5f);
 
-    j["camera"] = {{"type", "fisheye"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"fov", 360}};
+    j["camera"] = {
+        {"type", "fisheye"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"fov", 360}};
     EXPECT_EQ(parse(j).camera.type, CameraType::fisheye);
     EXPECT_EQ(parse(j).camera.fov, 360.0f);
 }
@@ -316,8 +323,10 @@ TEST(SceneLoadError, InvalidJsonGivesLineAndColumn) {
     // The second ',' is line 2, column 27.
     expect_text_error(text, "", {"invalid JSON at line 2, column 27", "expected"});
     expect_text_error("", "", {"invalid JSON at line 1, column 1"});
-    expect_text_error("{\"camera\": {\"eye\": [0, 0, 5]", "", {"invalid JSON at line 1, column 29"});
-    expect_text_error("{ \"a\": tru }", "", {"invalid JSON at line 1, column", "invalid literal"});
+    expect_text_error("{\"camera\": {\"eye\": [0, 0, 5]", "",
+                      {"invalid JSON at line 1, column 29"});
+    expect_text_error("{ \"a\": tru }", "",
+                      {"invalid JSON at line 1, column", "invalid literal"});
 }
 
 TEST(SceneLoadError, TopLevelMustBeAnObject) {
@@ -328,26 +337,31 @@ TEST(SceneLoadError, NonFiniteNumbers) {
     // nlohmann would turn 1e999 into infinity; it is refused where it is written.
     std::string text = kFullScene;
     text.replace(text.find("\"radius\": 1,"), 12, "\"radius\": 1e999,");
-    expect_text_error(text, "objects[0].radius", {"expected a finite number", "1e999", "line 15, column 60"});
+    expect_text_error(text, "objects[0].radius",
+                      {"expected a finite number", "1e999", "line 15, column 60"});
     text = kFullScene;
     text.replace(text.find("[-1, -1, -0.5]"), 14, "[-1, -1e400, -0.5]");
     expect_text_error(text, "lights[1].direction[1]", {"expected a finite number", "-1e400"});
     // Finite as a double, infinite as a float.
     Json j = full_scene();
     j["objects"][0]["radius"] = 1e39;
-    expect_json_error(j, "objects[0].radius", {"expected a finite number within float range", "1e+39"});
+    expect_json_error(j, "objects[0].radius",
+                      {"expected a finite number within float range", "1e+39"});
 }
 
 TEST(SceneLoadError, UnknownKeysAreNamedWithTheirPath) {
     Json j = full_scene();
     j["objets"] = Json::array();
-    expect_json_error(j, "objets", {"unknown key \"objets\"", "did you mean \"objects\"", "expected one of"});
+    expect_json_error(
+        j, "objets", {"unknown key \"objets\"", "did you mean \"objects\"", "expected one of"});
     j = full_scene();
     j["objects"][1]["raduis"] = 1;
-    expect_json_error(j, "objects[1].raduis", {"unknown key \"raduis\"", "expected one of: \"type\""});
+    expect_json_error(j, "objects[1].raduis",
+                      {"unknown key \"raduis\"", "expected one of: \"type\""});
     j = full_scene();
     j["objects"][0]["raduis"] = 1;
-    expect_json_error(j, "objects[0].raduis", {"unknown key \"raduis\"", "did you mean \"radius\""});
+    expect_json_error(j, "objects[0].raduis",
+                      {"unknown key \"raduis\"", "did you mean \"radius\""});
     j = full_scene();
     j["materials"]["glass"]["transmitt"] = 1;
     expect_json_error(j, "materials.glass.transmitt", {"did you mean \"transmit\""});
@@ -371,11 +385,14 @@ TEST(SceneLoadError, UnknownKeysAreNamedWithTheirPath) {
 TEST(SceneLoadError, KeysOfAnotherTypeAreErrors) {
     Json j = full_scene();
     j["camera"]["width"] = 2;
-    expect_json_error(j, "camera.width", {"\"width\" applies only to orthographic cameras",
-                                          "not to a pinhole camera"});
+    expect_json_error(
+        j, "camera.width",
+        {"\"width\" applies only to orthographic cameras", "not to a pinhole camera"});
     j = full_scene();
-    j["camera"] = {{"type", "orthographic"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"fov", 30}};
-    expect_json_error(j, "camera.fov", {"applies only to pinhole, thinlens and fisheye cameras"});
+    j["camera"] = {
+        {"type", "orthographic"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"fov", 30}};
+    expect_json_error(j, "camera.fov",
+                      {"applies only to pinhole, thinlens and fisheye cameras"});
     j = full_scene();
     j["camera"]["aperture"] = 0.1;
     expect_json_error(j, "camera.aperture", {"applies only to thinlens cameras"});
@@ -420,10 +437,12 @@ TEST(SceneLoadError, WrongTypes) {
     expect_json_error(j, "ambient", {"expected a color: [r, g, b] or a number (grey)"});
     j = full_scene();
     j["objects"][0]["type"] = "cube";
-    expect_json_error(j, "objects[0].type", {"expected one of \"sphere\", \"plane\"", "\"cube\""});
+    expect_json_error(j, "objects[0].type",
+                      {"expected one of \"sphere\", \"plane\"", "\"cube\""});
     j = full_scene();
     j["camera"]["type"] = "pinhol";
-    expect_json_error(j, "camera.type", {"expected one of \"pinhole\"", "did you mean \"pinhole\""});
+    expect_json_error(j, "camera.type",
+                      {"expected one of \"pinhole\"", "did you mean \"pinhole\""});
     j = full_scene();
     j["lights"][0]["falloff"] = "quadratic";
     expect_json_error(j, "lights[0].falloff", {"expected one of \"none\", \"inverse-square\""});
@@ -438,7 +457,8 @@ TEST(SceneLoadError, WrongTypes) {
     expect_json_error(j, "materials", {"expected an object mapping names to materials"});
     j = full_scene();
     j["objects"][0]["material"] = 3;
-    expect_json_error(j, "objects[0].material", {"expected a material name or an inline material"});
+    expect_json_error(j, "objects[0].material",
+                      {"expected a material name or an inline material"});
     j = full_scene();
     j["objects"][0]["name"] = 7;
     expect_json_error(j, "objects[0].name", {"expected a string, found 7"});
@@ -447,13 +467,15 @@ TEST(SceneLoadError, WrongTypes) {
 TEST(SceneLoadError, MissingRequiredKeys) {
     Json j = full_scene();
     j.erase("camera");
-    expect_json_error(j, "camera", {"missing required key \"camera\"", "\"eye\" and \"lookat\""});
+    expect_json_error(j, "camera",
+                      {"missing required key \"camera\"", "\"eye\" and \"lookat\""});
     j = full_scene();
     j["camera"].erase("eye");
     expect_json_error(j, "camera.eye", {"missing required key \"eye\""});
     j = full_scene();
     j["objects"][2].erase("type");
-    expect_json_error(j, "objects[2].type", {"missing required key \"type\"", "\"sphere\" or \"plane\""});
+    expect_json_error(j, "objects[2].type",
+                      {"missing required key \"type\"", "\"sphere\" or \"plane\""});
     j = full_scene();
     j["objects"][0].erase("radius");
     expect_json_error(j, "objects[0].radius", {"missing required key \"radius\""});
@@ -479,14 +501,16 @@ TEST(SceneLoadError, RadiusMustBePositive) {
 TEST(SceneLoadError, ZeroLengthNormal) {
     Json j = full_scene();
     j["objects"][1]["normal"] = {0, 0, 0};
-    expect_json_error(j, "objects[1].normal", {"expected a non-zero normal vector", "[0, 0, 0]"});
+    expect_json_error(j, "objects[1].normal",
+                      {"expected a non-zero normal vector", "[0, 0, 0]"});
 }
 
 TEST(SceneLoadError, CameraUpParallelToView) {
     Json j = full_scene();
     j["camera"]["eye"] = {0, 5, 0};
     j["camera"]["lookat"] = {0, 0, 0};
-    expect_json_error(j, "camera", {"up vector is parallel to the view direction", "found pinhole camera"});
+    expect_json_error(j, "camera",
+                      {"up vector is parallel to the view direction", "found pinhole camera"});
     j = full_scene();
     j["camera"]["lookat"] = j["camera"]["eye"];
     expect_json_error(j, "camera", {"eye and lookat coincide"});
@@ -503,7 +527,8 @@ TEST(SceneLoadError, FieldOfViewOutOfRange) {
     expect_json_error(j, "camera", {"field of view must lie in (0, 180)", "fov 0"});
     j["camera"]["type"] = "fisheye";
     j["camera"]["fov"] = 361;
-    expect_json_error(j, "camera", {"field of view must lie in (0, 360] degrees", "fisheye camera"});
+    expect_json_error(j, "camera",
+                      {"field of view must lie in (0, 360] degrees", "fisheye camera"});
 }
 
 TEST(SceneLoadError, UnknownMaterialName) {
@@ -531,16 +556,19 @@ TEST(SceneLoadError, ImageSize) {
     j["image"]["width"] = 0;
     expect_json_error(j, "image.width", {"expected an integer from 1 to 2147483647, found 0"});
     j["image"]["width"] = -640;
-    expect_json_error(j, "image.width", {"expected an integer from 1 to 2147483647, found -640"});
+    expect_json_error(j, "image.width",
+                      {"expected an integer from 1 to 2147483647, found -640"});
     j["image"]["width"] = 640.5;
     expect_json_error(j, "image.width", {"expected an integer", "found 640.5"});
     j["image"]["width"] = "640";
     expect_json_error(j, "image.width", {"expected an integer", "the string \"640\""});
     j["image"]["width"] = 3000000000u;
-    expect_json_error(j, "image.width", {"expected an integer from 1 to 2147483647", "3000000000"});
+    expect_json_error(j, "image.width",
+                      {"expected an integer from 1 to 2147483647", "3000000000"});
     j = full_scene();
     j["image"]["height"] = -1;
-    expect_json_error(j, "image.height", {"expected an integer from 1 to 2147483647, found -1"});
+    expect_json_error(j, "image.height",
+                      {"expected an integer from 1 to 2147483647, found -1"});
     j = full_scene();
     j["image"]["spp"] = 0;
     expect_json_error(j, "image.spp", {"expected an integer from 1 to 2147483647, found 0"});
@@ -549,8 +577,9 @@ TEST(SceneLoadError, ImageSize) {
 TEST(SceneLoadError, ImageTooManyPixels) {
     Json j = full_scene();
     j["image"] = {{"width", 65536}, {"height", 65536}};
-    expect_json_error(j, "image", {"a 65536 x 65536 image has 4294967296 pixels",
-                                   "expected at most 2147483647"});
+    expect_json_error(
+        j, "image",
+        {"a 65536 x 65536 image has 4294967296 pixels", "expected at most 2147483647"});
 }
 
 TEST(SceneLoadError, ImageLargerThanMemory) {
@@ -560,13 +589,15 @@ TEST(SceneLoadError, ImageLargerThanMemory) {
     const double memory = static_cast<double>(pages) * static_cast<double>(page);
     // The largest image the pixel limit allows needs 24 GiB; on machines with more memory
     // than that, the pixel limit is the one that applies.
-    if (memory >= 2147483647.0 * 12.0) GTEST_SKIP() << "more memory than any allowed image needs";
+    if (memory >= 2147483647.0 * 12.0)
+        GTEST_SKIP() << "more memory than any allowed image needs";
     const int side = 46340;  // 46340^2 < 2^31 - 1
     ASSERT_GT(static_cast<double>(side) * side * 12.0, memory);
     Json j = full_scene();
     j["image"] = {{"width", side}, {"height", side}};
-    expect_json_error(j, "image", {"a 46340 x 46340 image needs about 24.0 GiB",
-                                   "12 bytes per pixel", "of physical memory"});
+    expect_json_error(j, "image",
+                      {"a 46340 x 46340 image needs about 24.0 GiB", "12 bytes per pixel",
+                       "of physical memory"});
 }
 
 TEST(SceneLoadError, MaxDepthRange) {
@@ -584,11 +615,13 @@ TEST(SceneLoadError, Seed) {
     j["render"]["seed"] = 1.5;
     expect_json_error(j, "render.seed", {"expected a non-negative integer", "found 1.5"});
     j["render"]["seed"] = "7";
-    expect_json_error(j, "render.seed", {"expected a non-negative integer", "the string \"7\""});
+    expect_json_error(j, "render.seed",
+                      {"expected a non-negative integer", "the string \"7\""});
     // One past the uint64 range: nlohmann reads it as a float.
     std::string text = kFullScene;
     text.replace(text.find("\"seed\": 42"), 10, "\"seed\": 18446744073709551616");
-    expect_text_error(text, "render.seed", {"expected a non-negative integer", "18446744073709551615"});
+    expect_text_error(text, "render.seed",
+                      {"expected a non-negative integer", "18446744073709551615"});
 }
 
 TEST(SceneLoadError, Epsilon) {
@@ -599,21 +632,22 @@ TEST(SceneLoadError, Epsilon) {
 
 TEST(SceneLoadError, ThinLens) {
     Json j = full_scene();
-    j["camera"] = {{"type", "thinlens"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}},
-                   {"aperture", -0.1}};
+    j["camera"] = {
+        {"type", "thinlens"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"aperture", -0.1}};
     expect_json_error(j, "camera.aperture", {"expected a lens radius >= 0, found -0.1"});
     j["camera"]["aperture"] = 0.1;
     j["camera"]["focus_distance"] = 0;
     expect_json_error(j, "camera.focus_distance", {"expected a focus distance > 0, found 0"});
     j["camera"].erase("aperture");
     j["camera"]["focus_distance"] = 1;
-    expect_json_error(j, "camera.aperture", {"missing required key \"aperture\"", "lens radius"});
+    expect_json_error(j, "camera.aperture",
+                      {"missing required key \"aperture\"", "lens radius"});
 }
 
 TEST(SceneLoadError, OrthographicWidth) {
     Json j = full_scene();
-    j["camera"] = {{"type", "orthographic"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}},
-                   {"width", 0}};
+    j["camera"] = {
+        {"type", "orthographic"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"width", 0}};
     expect_json_error(j, "camera.width", {"expected a film width > 0, found 0"});
     j["camera"]["width"] = -2;
     expect_json_error(j, "camera.width", {"expected a film width > 0, found -2"});
@@ -622,12 +656,15 @@ TEST(SceneLoadError, OrthographicWidth) {
 TEST(SceneLoadError, MaterialValues) {
     Json j = full_scene();
     j["materials"]["floor"]["checker"]["size"] = 0;
-    expect_json_error(j, "materials.floor.checker.size", {"expected a checker size > 0, found 0"});
+    expect_json_error(j, "materials.floor.checker.size",
+                      {"expected a checker size > 0, found 0"});
     j = full_scene();
     j["materials"]["glass"]["ior"] = 0;
-    expect_json_error(j, "materials.glass.ior", {"expected an index of refraction > 0, found 0"});
+    expect_json_error(j, "materials.glass.ior",
+                      {"expected an index of refraction > 0, found 0"});
     j["materials"]["glass"]["ior"] = -1.5;
-    expect_json_error(j, "materials.glass.ior", {"expected an index of refraction > 0, found -1.5"});
+    expect_json_error(j, "materials.glass.ior",
+                      {"expected an index of refraction > 0, found -1.5"});
     j = full_scene();
     j["materials"]["chrome"]["color"] = {1, -1, 0};
     expect_json_error(j, "materials.chrome.color", {"non-negative components", "[1, -1, 0]"});
@@ -658,7 +695,8 @@ TEST(SceneLoadError, AnimationNeedsAFrameCount) {
 TEST(SceneLoadError, ObjectNamesAreUnique) {
     Json j = full_scene();
     j["objects"][2]["name"] = "ball";
-    expect_json_error(j, "objects[2].name", {"expected a unique object name", "\"ball\"", "objects[0]"});
+    expect_json_error(j, "objects[2].name",
+                      {"expected a unique object name", "\"ball\"", "objects[0]"});
 }
 
 TEST(SceneLoadError, NestingDepth) {
@@ -742,7 +780,8 @@ TEST(SceneValidate, ReportsJsonLikePaths) {
     expect_invalid(s, "objects[3].material.ior", {"expected an index of refraction > 0"});
     s = valid_scene();
     s.materials[1].material.shininess = std::numeric_limits<float>::quiet_NaN();
-    expect_invalid(s, "materials.glass.shininess", {"expected a Phong exponent >= 0, found nan"});
+    expect_invalid(s, "materials.glass.shininess",
+                   {"expected a Phong exponent >= 0, found nan"});
     s = valid_scene();
     s.camera.fov = 200.0f;
     expect_invalid(s, "camera", {"field of view must lie in (0, 180)"});

@@ -14,7 +14,7 @@
 namespace octray {
 namespace {
 
-#define EXPECT_SAME_FLOAT(a, b) \
+#define EXPECT_SAME_FLOAT(a, b)                                                               \
     EXPECT_EQ(std::bit_cast<std::uint32_t>(float(a)), std::bit_cast<std::uint32_t>(float(b))) \
         << #a << " = " << (a) << " vs " << (b)
 
@@ -136,7 +136,8 @@ TEST(SceneWrite, RoundTripSphereflake2) {
 }
 
 TEST(SceneWrite, RoundTripOverriddenBuiltin) {
-    expect_round_trip(make_builtin_scene("random:5,width=33,height=17,spp=5,seed=9,max_depth=2"));
+    expect_round_trip(
+        make_builtin_scene("random:5,width=33,height=17,spp=5,seed=9,max_depth=2"));
 }
 
 // A scene that uses every feature of the format.
@@ -182,16 +183,18 @@ TEST(SceneWrite, RoundTripEveryFeature) {
     expect_round_trip(s);
 
     // Every other camera and background type.
-    for (const char* camera :
-         {R"({"type": "pinhole", "eye": [0, 1, 5], "lookat": [0, 0, 0], "fov": 33.3})",
-          R"({"type": "orthographic", "eye": [0, 1, 5], "lookat": [0, 0, 0], "width": 7.1})",
-          R"({"type": "fisheye", "eye": [0, 1, 5], "lookat": [0, 0, 0], "up": [0, 0, 1], "fov": 360})"}) {
+    for (
+        const char* camera :
+        {R"({"type": "pinhole", "eye": [0, 1, 5], "lookat": [0, 0, 0], "fov": 33.3})",
+         R"({"type": "orthographic", "eye": [0, 1, 5], "lookat": [0, 0, 0], "width": 7.1})",
+         R"({"type": "fisheye", "eye": [0, 1, 5], "lookat": [0, 0, 0], "up": [0, 0, 1], "fov": 360})"}) {
         std::string text = kEveryFeature;
         const std::size_t start = text.find("{ \"type\": \"thinlens\"");
         const std::size_t end = text.find('}', start) + 1;
         text.replace(start, end - start, camera);
         const std::size_t bg = text.find("{ \"type\": \"gradient\"");
-        text.replace(bg, text.find('}', bg) + 1 - bg, R"({"type": "constant", "color": [0.2, 0.1, 0.3]})");
+        text.replace(bg, text.find('}', bg) + 1 - bg,
+                     R"({"type": "constant", "color": [0.2, 0.1, 0.3]})");
         SCOPED_TRACE(camera);
         expect_round_trip(parse_scene_json(text, "variant.json"));
     }

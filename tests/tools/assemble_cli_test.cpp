@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 using testing::RunResult;
 
 class AssembleCliTest : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "assemble_cli" / info->name();
@@ -47,8 +47,9 @@ protected:
         ExrAttributes attributes;
         add_camera_attributes(attributes, scene_);
         attributes.ints.emplace_back("octray:frame", 3);
-        ExrImage exr = make_exr_image(render_packet(scene_, options),
-                                      ExrWriteOptions{float32, ExrCompression::zip}, attributes);
+        ExrImage exr =
+            make_exr_image(render_packet(scene_, options),
+                           ExrWriteOptions{float32, ExrCompression::zip}, attributes);
         append_aov_channels(exr, compute_aovs(scene_, options, AovSet{true, true, false, true}),
                             float32 ? ExrPixelType::float32 : ExrPixelType::half);
         write_exr(path(name), exr);
@@ -83,7 +84,8 @@ TEST_F(AssembleCliTest, QuartersMakeTheFullRender) {
     for (std::size_t k = 0; k < out.channels.size(); ++k) {
         EXPECT_EQ(out.channels[k].name, full.channels[k].name);
         EXPECT_EQ(out.channels[k].type, full.channels[k].type);
-        EXPECT_TRUE(out.channels[k].samples == full.channels[k].samples) << out.channels[k].name;
+        EXPECT_TRUE(out.channels[k].samples == full.channels[k].samples)
+            << out.channels[k].name;
     }
     EXPECT_EQ(out.attributes.matrices, full.attributes.matrices);
     EXPECT_EQ(out.attributes.ints, full.attributes.ints);
@@ -148,8 +150,7 @@ TEST_F(AssembleCliTest, UnreadablePartsAndUnwritableOutputExit4) {
 
     r = assemble({"a.exr", "-o", "no/such/dir/out.exr"});
     EXPECT_EQ(r.status, 4) << r.output;
-    EXPECT_NE(r.output.find("cannot write no/such/dir/out.exr"), std::string::npos)
-        << r.output;
+    EXPECT_NE(r.output.find("cannot write no/such/dir/out.exr"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(path("out.exr")));
 
     // One part that is the whole image is a valid (if trivial) assembly.

@@ -1,6 +1,8 @@
 // Batch specifications (tools/batch.h): frame specs, output patterns, shards, crops and
 // scene names, with the message of every refusal.
 
+#include "tools/batch.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,20 +17,21 @@
 #include <vector>
 
 #include "batch_checks.h"
-#include "tools/batch.h"
 
 namespace octray::batch {
 namespace {
 
 // Runs `f`, which must throw a SpecError whose message holds every needle.
-void expect_spec_error(const std::function<void()>& f, std::initializer_list<std::string> needles) {
+void expect_spec_error(const std::function<void()>& f,
+                       std::initializer_list<std::string> needles) {
     try {
         f();
         ADD_FAILURE() << "expected a SpecError";
     } catch (const SpecError& e) {
         const std::string what = e.what();
         for (const std::string& n : needles) {
-            EXPECT_NE(what.find(n), std::string::npos) << "missing \"" << n << "\" in: " << what;
+            EXPECT_NE(what.find(n), std::string::npos)
+                << "missing \"" << n << "\" in: " << what;
         }
     }
 }
@@ -116,7 +119,7 @@ TEST(FrameSpec, Errors) {
 TEST(OutputPattern, HashRuns) {
     EXPECT_EQ(expand_output_pattern("out_####.exr", 7, "s"), "out_0007.exr");
     EXPECT_EQ(expand_output_pattern("out_#.exr", 7, "s"), "out_7.exr");
-    EXPECT_EQ(expand_output_pattern("out_#.exr", 123, "s"), "out_123.exr");   // more digits
+    EXPECT_EQ(expand_output_pattern("out_#.exr", 123, "s"), "out_123.exr");  // more digits
     EXPECT_EQ(expand_output_pattern("out_##.exr", 12345, "s"), "out_12345.exr");
     EXPECT_EQ(expand_output_pattern("a##b###", 5, "s"), "a05b005");
     EXPECT_EQ(expand_output_pattern("f####", 0, "s"), "f0000");
@@ -124,7 +127,8 @@ TEST(OutputPattern, HashRuns) {
 
 TEST(OutputPattern, BraceFields) {
     EXPECT_EQ(expand_output_pattern("{scene}_{frame}.exr", 42, "bounce"), "bounce_42.exr");
-    EXPECT_EQ(expand_output_pattern("{scene}_{frame:04d}.exr", 42, "bounce"), "bounce_0042.exr");
+    EXPECT_EQ(expand_output_pattern("{scene}_{frame:04d}.exr", 42, "bounce"),
+              "bounce_0042.exr");
     EXPECT_EQ(expand_output_pattern("{frame:01d}", 42, "b"), "42");
     EXPECT_EQ(expand_output_pattern("{frame:09d}", 42, "b"), "000000042");
     EXPECT_EQ(expand_output_pattern("{frame:02d}", 12345, "b"), "12345");
@@ -150,12 +154,14 @@ TEST(OutputPattern, HasFrameField) {
 }
 
 TEST(OutputPattern, BadFields) {
-    const auto bad = [](const std::string& pattern, std::initializer_list<std::string> needles) {
+    const auto bad = [](const std::string& pattern,
+                        std::initializer_list<std::string> needles) {
         SCOPED_TRACE(pattern);
         expect_spec_error([&] { (void)expand_output_pattern(pattern, 1, "s"); }, needles);
         expect_spec_error([&] { (void)pattern_has_frame_field(pattern); }, needles);
     };
-    bad("{fram}.exr", {"output pattern \"{fram}.exr\"", "unknown field \"{fram}\"", "{frame:04d}"});
+    bad("{fram}.exr",
+        {"output pattern \"{fram}.exr\"", "unknown field \"{fram}\"", "{frame:04d}"});
     bad("{}.exr", {"unknown field \"{}\""});
     bad("{Frame}", {"unknown field"});
     bad("{frame:4d}", {"unsupported frame format \"{frame:4d}\""});
@@ -252,7 +258,8 @@ TEST(Shard, EnvironmentErrors) {
                         std::initializer_list<std::string> needles) {
         expect_spec_error([&] { (void)shard_from_environment(env(vars), count); }, needles);
     };
-    bad({}, std::nullopt, {"no array job found", "SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"});
+    bad({}, std::nullopt,
+        {"no array job found", "SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"});
     bad({}, 4, {"no array job found"});
     bad({{"JOB_COMPLETION_INDEX", "2"}}, std::nullopt,
         {"JOB_COMPLETION_INDEX=2", "Kubernetes", "expected a shard count"});
@@ -266,13 +273,17 @@ TEST(Shard, EnvironmentErrors) {
         {"gives shard 3 of 3"});
     bad({{"SLURM_ARRAY_TASK_ID", "2"}, {"SLURM_ARRAY_TASK_COUNT", "4"}}, 5,
         {"disagrees with SLURM_ARRAY_TASK_COUNT=4"});
-    bad({{"SLURM_ARRAY_TASK_ID", "0"}, {"SLURM_ARRAY_TASK_MIN", "1"},
+    bad({{"SLURM_ARRAY_TASK_ID", "0"},
+         {"SLURM_ARRAY_TASK_MIN", "1"},
          {"SLURM_ARRAY_TASK_COUNT", "4"}},
         std::nullopt, {"MIN + k * STEP"});
-    bad({{"SLURM_ARRAY_TASK_ID", "15"}, {"SLURM_ARRAY_TASK_MIN", "10"},
-         {"SLURM_ARRAY_TASK_STEP", "10"}, {"SLURM_ARRAY_TASK_COUNT", "4"}},
+    bad({{"SLURM_ARRAY_TASK_ID", "15"},
+         {"SLURM_ARRAY_TASK_MIN", "10"},
+         {"SLURM_ARRAY_TASK_STEP", "10"},
+         {"SLURM_ARRAY_TASK_COUNT", "4"}},
         std::nullopt, {"MIN + k * STEP"});
-    bad({{"SLURM_ARRAY_TASK_ID", "1"}, {"SLURM_ARRAY_TASK_STEP", "0"},
+    bad({{"SLURM_ARRAY_TASK_ID", "1"},
+         {"SLURM_ARRAY_TASK_STEP", "0"},
          {"SLURM_ARRAY_TASK_COUNT", "4"}},
         std::nullopt, {"expected a step >= 1"});
     bad({{"SLURM_ARRAY_TASK_ID", "1"}, {"SLURM_ARRAY_TASK_COUNT", "0"}}, std::nullopt,
@@ -369,7 +380,8 @@ std::vector<std::string> corpus(const std::string& target) {
     std::vector<std::string> inputs;
     for (const fs::path& f : files) {
         std::ifstream in(f, std::ios::binary);
-        inputs.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        inputs.emplace_back(std::istreambuf_iterator<char>(in),
+                            std::istreambuf_iterator<char>());
     }
     return inputs;
 }

@@ -1,11 +1,6 @@
 // End-to-end tests of the `octray` executable: run it as a user would (through the shell),
 // then check its exit status, its messages and the files it leaves behind.
 
-#include <gtest/gtest.h>
-#include <png.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
 #include <ImfFloatAttribute.h>
@@ -14,6 +9,10 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
+#include <gtest/gtest.h>
+#include <png.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -30,11 +29,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using octray::testing::RunResult;
 using octray::testing::run_octray;
+using octray::testing::RunResult;
 
 class CliTest : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "cli" /
@@ -130,9 +129,9 @@ TEST_F(CliTest, HelpExplainsCommandsOptionsAndExitCodes) {
 
     const RunResult render = octray({"render", "--help"});
     EXPECT_EQ(render.status, 0);
-    for (const char* option : {"--output", "--width", "--height", "--spp", "--threads", "--seed",
-                               "--max-depth", "--path", "--png", "--float", "--compression",
-                               "--tile", "Examples", "Exit codes"})
+    for (const char* option :
+         {"--output", "--width", "--height", "--spp", "--threads", "--seed", "--max-depth",
+          "--path", "--png", "--float", "--compression", "--tile", "Examples", "Exit codes"})
         EXPECT_TRUE(contains(render.output, option)) << option << "\n" << render.output;
 }
 
@@ -175,8 +174,8 @@ TEST_F(CliTest, RendersSmallBuiltinWithAttributesAndPreview) {
     // One primary ray per pixel sample of the pinhole camera; the kinds add up to the total.
     double sum = 0.0;
     for (const char* kind : {"primary", "shadow", "reflected", "refracted"}) {
-        const auto* count = h.findTypedAttribute<Imf::DoubleAttribute>(
-            std::string("octray.rays.") + kind);
+        const auto* count =
+            h.findTypedAttribute<Imf::DoubleAttribute>(std::string("octray.rays.") + kind);
         ASSERT_NE(count, nullptr) << kind;
         EXPECT_GE(count->value(), 0.0);
         sum += count->value();
@@ -329,14 +328,18 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
 // every --isa; `verify` agrees and `info` names the ISA it uses.
 TEST_F(CliTest, SimdPathMatchesScalarAndVerifyPasses) {
     const std::string spec = "whitted,width=40,height=30";
-    ASSERT_EQ(octray({"render", spec, "--path", "scalar", "-o", "scalar.exr", "--float"}).status, 0);
+    ASSERT_EQ(
+        octray({"render", spec, "--path", "scalar", "-o", "scalar.exr", "--float"}).status, 0);
     const RunResult simd = octray({"render", spec, "-o", "simd.exr", "--float"});
     ASSERT_EQ(simd.status, 0) << simd.output;
     EXPECT_TRUE(contains(simd.output, "simd (")) << simd.output;  // "simd (avx2) path"
-    EXPECT_TRUE(same_bits(read_exr_pixels(path("scalar.exr")), read_exr_pixels(path("simd.exr"))));
-    const RunResult sse2 = octray({"render", spec, "--isa", "sse2", "-o", "sse2.exr", "--float"});
+    EXPECT_TRUE(
+        same_bits(read_exr_pixels(path("scalar.exr")), read_exr_pixels(path("simd.exr"))));
+    const RunResult sse2 =
+        octray({"render", spec, "--isa", "sse2", "-o", "sse2.exr", "--float"});
     ASSERT_EQ(sse2.status, 0) << sse2.output;
-    EXPECT_TRUE(same_bits(read_exr_pixels(path("scalar.exr")), read_exr_pixels(path("sse2.exr"))));
+    EXPECT_TRUE(
+        same_bits(read_exr_pixels(path("scalar.exr")), read_exr_pixels(path("sse2.exr"))));
     EXPECT_EQ(octray({"render", spec, "--isa", "avx512", "-o", "x.exr"}).status, 2);
 
     const RunResult verify = octray({"verify", spec, "--tile", "x"});

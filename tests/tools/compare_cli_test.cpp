@@ -4,16 +4,15 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
-#include <nlohmann/json.hpp>
-
 #include <array>
 #include <cstdio>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "tests/render/compare_fixtures.h"
 #include "run_octray.h"
+#include "tests/render/compare_fixtures.h"
 
 namespace octray {
 namespace {
@@ -24,7 +23,7 @@ using testing::write_test_exr;
 using testing::RunResult;
 
 class CompareCliTest : public testing::ScratchDirTest {
-protected:
+  protected:
     // Runs `octray compare <args...>` in the scratch directory.
     RunResult compare(std::vector<std::string> args, bool capture_stderr = true) {
         args.insert(args.begin(), "compare");
@@ -74,7 +73,8 @@ TEST_F(CompareCliTest, OverTheFailLimitExits2) {
 
 TEST_F(CompareCliTest, PercentAllowancesAndHardFail) {
     write_pair(0.125f);
-    EXPECT_EQ(compare({"a.exr", "b.exr", "--failpercent", "2", "--warnpercent", "2"}).status, 0);
+    EXPECT_EQ(compare({"a.exr", "b.exr", "--failpercent", "2", "--warnpercent", "2"}).status,
+              0);
     const RunResult r = compare(
         {"a.exr", "b.exr", "--failpercent", "2", "--warnpercent", "2", "--hardfail", "0.1"});
     EXPECT_EQ(r.status, 2) << r.output;
