@@ -19,21 +19,19 @@
 // operands, same order), and a hit replaces the current one when it is nearer or equally
 // near with a lower file index: the brute-force result (the first listed object wins a
 // tie) whatever the visiting order. Box tests only decide which spheres are tested, so
-// they must never cull a sphere the brute-force quadratic would report. That quadratic
-// rounds. With u = 2^-24: the robust form (sphere_quadratic) computes l = O' - (b/a)V to
-// within ~9u|O'|, so a lane with disc >= 0 has its ray pass within r + 10u|O'| of the
-// center, and the roots q/a, c'/q put the point within a few u|O'| of that ray's chord
-// (c'/q loses digits only for an origin within ~1e-4 r of the surface moving tangentially,
-// where both true roots are ~0 and the origin lies in the box anyway). The textbook form
-// this replaced was far worse: its discriminant b² - (V·V)(O'·O' - r²) is off by
-// ~19u (V·V)(|O'|² + r²), a fuzzy sphere of radius ~sqrt(19u)|O'| for a tiny sphere far
-// away. The margin derived for that form is kept (it bounds the new one with room to
-// spare): every box is widened, per ray, by
-//   sqrt(r_min² + 32u(D² + r_max²)) - r_min + 64u(D + max|O|)
+// they must never cull a sphere the brute-force test would report. That test rounds. With
+// u = 2^-24, the robust form (sphere_quadratic) computes l = O' - (b/a)V to within ~9u|O'|,
+// so a lane with disc >= 0 has its ray pass within r + 10u|O'| of the center, and the
+// roots q/a, c'/q put the point within a few u|O'| of that ray's chord (c'/q loses digits
+// only for an origin within ~1e-4 r of the surface moving tangentially, where both true
+// roots are ~0 and the origin lies in the box anyway). So every box is widened, per ray, by
+//   32u D + 64u(D + max|O|)
 // where D is the distance from the ray origin to the farthest corner of the root box
-// (bounding |O'| for every sphere), r_min / r_max the scene's extreme radii, and the last
-// term covers the rounding of the slab test itself (FMA: it decides visits, not values)
-// and of O - c.
+// (bounding |O'| for every sphere): the first term the sphere test's rounding, with room
+// to spare, the second the rounding of the slab test itself (FMA: it decides visits, not
+// values) and of O - c. (The textbook form used before was far worse: a fuzzy sphere of
+// radius ~sqrt(19u)|O'| around a tiny sphere far away, and a widening of
+// sqrt(r_min^2 + 32u(D^2 + r_max^2)) - r_min, up to half a radius on random:1048576.)
 // The tests (tests/kernels/bvh_traversal_test.cpp) check hit for hit against brute force
 // on degenerate scenes (radii from 1e-6 to 1e3, coincident spheres, spheres far apart).
 
@@ -85,12 +83,9 @@ F bvh_margin(const SceneView& s, const V3<F>& o) {
     const F ex = far_extent(o.x, s.bvh_lo[0], s.bvh_hi[0]);
     const F ey = far_extent(o.y, s.bvh_lo[1], s.bvh_hi[1]);
     const F ez = far_extent(o.z, s.bvh_lo[2], s.bvh_hi[2]);
-    const F d2 = ex * ex + ey * ey + ez * ez;
-    const F fuzz = F(kBvhFuzz) * (d2 + F(s.bvh_max_r2));
-    const F r_min(sqrtf(s.bvh_min_r2));
+    const F d = xsimd::sqrt(ex * ex + ey * ey + ez * ez);
     const F o_max = xsimd::max(xsimd::max(xsimd::abs(o.x), xsimd::abs(o.y)), xsimd::abs(o.z));
-    const F m = (xsimd::sqrt(F(s.bvh_min_r2) + fuzz) - r_min) +
-                F(kBvhSlack) * (xsimd::sqrt(d2) + o_max);
+    const F m = F(kBvhFuzz) * d + F(kBvhSlack) * (d + o_max);
     return m * F(1.0f + 0x1.0p-10f);  // the rounding of this very computation
 }
 

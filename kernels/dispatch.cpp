@@ -159,7 +159,6 @@ kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& 
     v.bvh_cx = bvh.cx.data(), v.bvh_cy = bvh.cy.data(), v.bvh_cz = bvh.cz.data();
     v.bvh_r2 = bvh.r2.data(), v.bvh_object = bvh.object.data();
     for (int a = 0; a < 3; ++a) v.bvh_lo[a] = bvh.lo[a], v.bvh_hi[a] = bvh.hi[a];
-    v.bvh_min_r2 = bvh.min_r2, v.bvh_max_r2 = bvh.max_r2;
     v.bvh_packet_min_lanes = packet_min_lanes;
     v.bvh_shadow_sort_min_spheres = kBvhShadowSortMinSpheres;
     return v;
