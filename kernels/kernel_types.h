@@ -41,7 +41,7 @@ struct SceneView {
     // Per object (file index): what shading needs.
     std::uint32_t object_count;
     const std::uint32_t *object_is_plane, *object_material, *object_checker;
-    const float *object_cx, *object_cy, *object_cz, *object_radius;
+    const float *object_cx, *object_cy, *object_cz;
     const float *object_nx, *object_ny, *object_nz;
     const float *object_t1x, *object_t1y, *object_t1z, *object_t2x, *object_t2y, *object_t2z;
 

@@ -249,13 +249,16 @@ void check_invariants(const NamedScene& ns) {
         EXPECT_EQ(seen[i], 1) << "sphere slot " << i << " in exactly one leaf";
     // The leaf arrays are a permutation of the scene's spheres, objects once each.
     std::vector<int> object_seen(c.objects.count, 0);
+    std::vector<float> r2_of_object(c.objects.count, -1.0f);
+    for (std::uint32_t i = 0; i < c.spheres.count; ++i)
+        r2_of_object[c.spheres.object[i]] = c.spheres.r2[i];
     for (std::uint32_t i = 0; i < bvh.sphere_count; ++i) {
         const std::uint32_t obj = bvh.object[i];
         ASSERT_LT(obj, c.objects.count);
         ++object_seen[obj];
         EXPECT_EQ(c.objects.is_plane[obj], 0u);
         EXPECT_EQ(bvh.cx[i], c.objects.cx[obj]);
-        EXPECT_EQ(bvh.r2[i], c.objects.radius[obj] * c.objects.radius[obj]);
+        EXPECT_EQ(bvh.r2[i], r2_of_object[obj]);
     }
     for (std::uint32_t k = 0; k < c.objects.count; ++k)
         EXPECT_EQ(object_seen[k], c.objects.is_plane[k] ? 0 : 1) << "object " << k;
