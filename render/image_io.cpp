@@ -17,6 +17,7 @@
 #include <fcntl.h>
 #include <half.h>
 #include <png.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -49,31 +50,60 @@ std::string window_text(const PixelRect& r) {
            std::to_string(r.x1) + ", " + std::to_string(r.y1) + ")";
 }
 
-// "<dir>/.<name>.tmp.<pid>.<random>": hidden, in the target's directory so that the final
-// rename stays on one file system (and so stays atomic), and unique per process and call.
-std::string temporary_path_for(const fs::path& target, std::uint64_t salt) {
+// "<dir>/.<name>.<kind>.<pid>.<random>": hidden, in the target's directory so that the
+// final rename stays on one file system (and so stays atomic), and unique per process and
+// call. The kind is "new" while the file is being created and locked, "tmp" after.
+std::string temporary_path_for(const fs::path& target, const char* kind, std::uint64_t salt) {
     fs::path dir = target.parent_path();
     if (dir.empty()) dir = ".";
-    char suffix[64];
-    std::snprintf(suffix, sizeof suffix, ".tmp.%ld.%016llx", static_cast<long>(::getpid()),
+    char suffix[80];
+    std::snprintf(suffix, sizeof suffix, ".%s.%ld.%016llx", kind, static_cast<long>(::getpid()),
                   static_cast<unsigned long long>(salt));
     return (dir / ("." + target.filename().string() + suffix)).string();
 }
 
-// Creates the temporary file exclusively (O_EXCL: never clobber another writer's file) and
-// returns its path. The writer callback then truncates and fills it. Mode 0666 lets the
-// umask decide the final permissions, as for any file the user creates.
-std::string create_temporary_file(const fs::path& target) {
+// A temporary file, held by its writer: the open descriptor carries an exclusive flock(2)
+// from before the file has its ".tmp." name until after it was renamed over the target.
+// The lock ends with the descriptor, so also when the writer is killed: a ".tmp." file
+// nobody holds the lock of is stale (remove_stale_temporaries).
+struct HeldTemporary {
+    std::string path;
+    int fd = -1;
+    HeldTemporary() = default;
+    HeldTemporary(const HeldTemporary&) = delete;
+    HeldTemporary& operator=(const HeldTemporary&) = delete;
+    ~HeldTemporary() {
+        if (fd >= 0) ::close(fd);
+    }
+};
+
+// Creates the temporary file exclusively (O_EXCL: never clobber another writer's file),
+// locks it, then gives it its ".tmp." name. The writer callback then truncates and fills
+// it. Mode 0666 lets the umask decide the final permissions, as for any file the user
+// creates.
+void create_temporary_file(const fs::path& target, HeldTemporary& held) {
     std::random_device entropy;
     std::mt19937_64 generator((static_cast<std::uint64_t>(entropy()) << 32) ^ entropy());
     for (int attempt = 0; attempt < 16; ++attempt) {
-        const std::string tmp = temporary_path_for(target, generator());
-        const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd >= 0) {
-            ::close(fd);
-            return tmp;
+        const std::uint64_t salt = generator();
+        const std::string fresh = temporary_path_for(target, "new", salt);
+        const int fd = ::open(fresh.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0) {
+            if (errno != EEXIST) throw std::runtime_error(errno_message(errno));
+            continue;
         }
-        if (errno != EEXIST) throw std::runtime_error(errno_message(errno));
+        held.fd = fd;
+        // Where locks do not work (some network file systems), the file is only not
+        // provably stale: other runs leave it alone.
+        (void)::flock(fd, LOCK_EX | LOCK_NB);
+        const std::string tmp = temporary_path_for(target, "tmp", salt);
+        if (std::rename(fresh.c_str(), tmp.c_str()) != 0) {
+            const int error = errno;
+            std::remove(fresh.c_str());
+            throw std::runtime_error(errno_message(error));
+        }
+        held.path = tmp;
+        return;
     }
     throw std::runtime_error("could not create a unique temporary file next to it");
 }
@@ -244,22 +274,49 @@ std::uint8_t to_srgb8(float linear) {
 
 // libpng reports errors by calling this and then longjmp-ing back to setjmp; we keep the
 // message so it can become an exception once we are back in ordinary C++ control flow.
+// libpng's own writer says only "Write Error"; ours keeps the OS reason (errno) of a
+// failed write so that the message can say it ("No space left on device").
 struct PngErrorState {
     char message[256] = "";
+    std::FILE* file = nullptr;
+    int write_errno = 0;
 };
 
 void png_error_handler(png_structp png, png_const_charp message) {
     auto* state = static_cast<PngErrorState*>(png_get_error_ptr(png));
-    std::snprintf(state->message, sizeof state->message, "libpng: %s", message);
+    if (state->write_errno != 0)
+        std::snprintf(state->message, sizeof state->message, "libpng: %s: %s", message,
+                      std::strerror(state->write_errno));
+    else
+        std::snprintf(state->message, sizeof state->message, "libpng: %s", message);
     png_longjmp(png, 1);
 }
 
 void png_warning_handler(png_structp, png_const_charp) {}
 
+void png_write_data(png_structp png, png_bytep data, png_size_t length) {
+    auto* state = static_cast<PngErrorState*>(png_get_io_ptr(png));
+    errno = 0;
+    if (std::fwrite(data, 1, length, state->file) != length) {
+        state->write_errno = errno != 0 ? errno : EIO;
+        png_error(png, "Write Error");
+    }
+}
+
+void png_flush_data(png_structp png) {
+    auto* state = static_cast<PngErrorState*>(png_get_io_ptr(png));
+    errno = 0;
+    if (std::fflush(state->file) != 0) {
+        state->write_errno = errno != 0 ? errno : EIO;
+        png_error(png, "Write Error");
+    }
+}
+
 // The libpng calls, in a function with only trivially destructible locals: longjmp must
 // never skip a C++ destructor. Returns an empty string on success, else the reason.
 std::string write_png_rows(std::FILE* file, int width, int height, png_bytepp rows) {
     PngErrorState error;
+    error.file = file;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_error_handler,
                                               png_warning_handler);
     if (png == nullptr) return "libpng: cannot create the write structure";
@@ -272,7 +329,7 @@ std::string write_png_rows(std::FILE* file, int width, int height, png_bytepp ro
         png_destroy_write_struct(&png, &info);
         return error.message;
     }
-    png_init_io(png, file);
+    png_set_write_fn(png, &error, png_write_data, png_flush_data);
     png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height),
                  8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
@@ -323,25 +380,70 @@ void require_image(const Image& image) {
 
 void write_file_atomically(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write) {
-    std::string tmp;
+    HeldTemporary tmp;
     try {
-        tmp = create_temporary_file(fs::path(path));
-        write(tmp);
-        if (std::rename(tmp.c_str(), path.c_str()) != 0)
+        create_temporary_file(fs::path(path), tmp);
+        write(tmp.path);
+        if (std::rename(tmp.path.c_str(), path.c_str()) != 0)
             throw std::runtime_error(errno_message(errno));
     } catch (const std::exception& e) {
-        if (!tmp.empty()) std::remove(tmp.c_str());
+        if (!tmp.path.empty()) std::remove(tmp.path.c_str());
         throw IoError("cannot write " + path + ": " + e.what());
     } catch (...) {
-        if (!tmp.empty()) std::remove(tmp.c_str());
+        if (!tmp.path.empty()) std::remove(tmp.path.c_str());
         throw IoError("cannot write " + path + ": unknown error");
     }
+}
+
+std::vector<std::string> remove_stale_temporaries(const std::string& target) {
+    const fs::path path(target);
+    fs::path dir = path.parent_path();
+    if (dir.empty()) dir = ".";
+    const std::string prefix = "." + path.filename().string() + ".tmp.";
+    std::vector<std::string> removed;
+    std::error_code error;
+    for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
+        const std::string name = it->path().filename().string();
+        if (name.compare(0, prefix.size(), prefix) != 0) continue;
+        const std::string file = it->path().string();
+        // O_NONBLOCK: a FIFO planted under such a name must not block the open.
+        int fd = ::open(file.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+        if (fd < 0) fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+        if (fd < 0) continue;
+        // The lock is free only when no writer holds it: its writer is gone. (Names are
+        // never reused, so if the writer renamed it away meanwhile, the unlink finds
+        // nothing.)
+        if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::unlink(file.c_str()) == 0)
+            removed.push_back(file);
+        ::close(fd);
+    }
+    return removed;
 }
 
 std::optional<ExrCompression> parse_exr_compression(std::string_view name) {
     for (const auto& [text, value] : kCompressionNames)
         if (text == name) return value;
     return std::nullopt;
+}
+
+int exr_lines_per_chunk(ExrCompression compression) {
+    switch (compression) {
+        case ExrCompression::none:
+        case ExrCompression::rle:
+        case ExrCompression::zips:
+            return 1;
+        case ExrCompression::zip:
+        case ExrCompression::pxr24:
+            return 16;
+        case ExrCompression::piz:
+        case ExrCompression::b44:
+        case ExrCompression::b44a:
+        case ExrCompression::dwaa:
+            return 32;
+        case ExrCompression::dwab:
+            return 256;
+    }
+    return 256;
 }
 
 std::string_view to_string(ExrCompression compression) {

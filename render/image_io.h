@@ -30,9 +30,19 @@ class IoError : public std::runtime_error {
 void write_file_atomically(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write);
 
+// Removes the temporaries ("<dir>/.<name>.tmp.*") that writers of `target` which are gone
+// (killed mid-write) left behind, and returns their paths. A writer holds an flock(2) on
+// its temporary until the rename, so a temporary of a live writer, in this process or any
+// other, is never removed; one whose lock cannot be taken (a file system without locks)
+// stays too.
+std::vector<std::string> remove_stale_temporaries(const std::string& target);
+
 enum class ExrCompression { none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab };
 
 std::optional<ExrCompression> parse_exr_compression(std::string_view name);
+// The scan lines the codec compresses as one block (OpenEXR's line buffer): none, rle and
+// zips 1, zip and pxr24 16, piz, b44, b44a and dwaa 32, dwab 256.
+int exr_lines_per_chunk(ExrCompression compression);
 std::string_view to_string(ExrCompression compression);
 
 struct ExrWriteOptions {

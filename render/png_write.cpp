@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <csetjmp>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -14,24 +15,50 @@
 namespace octray {
 namespace {
 
+// The message of a libpng error, with the OS reason (errno) of a failed write: libpng's
+// own writer would say only "Write Error".
 struct PngSinkError {
     char message[256] = {};
+    std::FILE* file = nullptr;
+    int write_errno = 0;
 };
 
 void on_png_error(png_structp png, png_const_charp message) {
     auto* error = static_cast<PngSinkError*>(png_get_error_ptr(png));
-    std::snprintf(error->message, sizeof error->message, "%s", message);
+    if (error->write_errno != 0)
+        std::snprintf(error->message, sizeof error->message, "%s: %s", message,
+                      std::strerror(error->write_errno));
+    else
+        std::snprintf(error->message, sizeof error->message, "%s", message);
     png_longjmp(png, 1);
+}
+
+void on_png_write(png_structp png, png_bytep data, png_size_t length) {
+    auto* error = static_cast<PngSinkError*>(png_get_io_ptr(png));
+    errno = 0;
+    if (std::fwrite(data, 1, length, error->file) != length) {
+        error->write_errno = errno != 0 ? errno : EIO;
+        png_error(png, "Write Error");
+    }
+}
+
+void on_png_flush(png_structp png) {
+    auto* error = static_cast<PngSinkError*>(png_get_io_ptr(png));
+    errno = 0;
+    if (std::fflush(error->file) != 0) {
+        error->write_errno = errno != 0 ? errno : EIO;
+        png_error(png, "Write Error");
+    }
 }
 
 void on_png_warning(png_structp, png_const_charp) {}
 
 // libpng reports errors by longjmp back here; nothing with a destructor is created in this
 // frame after setjmp, so the jump skips none.
-bool write_rgb8_rows(png_structp png, png_infop info, std::FILE* file, png_uint_32 width,
+bool write_rgb8_rows(png_structp png, png_infop info, PngSinkError* sink, png_uint_32 width,
                      png_uint_32 height, png_bytepp rows) {
     if (setjmp(png_jmpbuf(png))) return false;
-    png_init_io(png, file);
+    png_set_write_fn(png, sink, on_png_write, on_png_flush);
     png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
@@ -60,11 +87,12 @@ void write_png_rgb8(const std::string& path, int width, int height,
         std::FILE* file = std::fopen(tmp_path.c_str(), "wb");
         if (!file) throw IoError(tmp_path + ": " + std::generic_category().message(errno));
         PngSinkError error;
+        error.file = file;
         png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, on_png_error,
                                                   on_png_warning);
         png_infop info = png ? png_create_info_struct(png) : nullptr;
         bool ok = png && info &&
-                  write_rgb8_rows(png, info, file, static_cast<png_uint_32>(width),
+                  write_rgb8_rows(png, info, &error, static_cast<png_uint_32>(width),
                                   static_cast<png_uint_32>(height), rows.data());
         png_destroy_write_struct(&png, info ? &info : nullptr);
         const int close_status = std::fclose(file);

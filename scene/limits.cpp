@@ -27,9 +27,22 @@ std::uint64_t u64(int v) { return v > 0 ? static_cast<std::uint64_t>(v) : 0; }
 
 // core/image.h: one Rgb (three floats) per pixel.
 constexpr std::uint64_t kFramebufferBytesPerPixel = 12;
-// render/image_io.cpp write_exr: half output converts the image into interleaved RGB
-// halves first; float output points OpenEXR at the framebuffer itself.
-constexpr std::uint64_t kHalfOutputBytesPerPixel = 6;
+// render/progressive.cpp: while a pass renders, the last pass's image and sample sums are
+// kept, and the pass makes its own: four images.
+constexpr std::uint64_t kProgressiveImages = 4;
+// render/image_io.cpp make_exr_image and render/aov.cpp append_aov_channels: every
+// channel is copied into the EXR image, as half (2 bytes) or float (4); the id AOV is
+// UINT (4).
+constexpr std::uint64_t kColorChannels = 3;
+constexpr std::uint64_t kDepthChannels = 1, kNormalChannels = 3, kAlbedoChannels = 3;
+// OpenEXR's scan-line writer holds one block of lines of every channel, uncompressed and
+// compressed (at worst as large again, plus the codec's own state): three copies.
+constexpr std::uint64_t kExrLineBufferCopies = 3;
+// render/image_io.cpp write_png_file: 8-bit RGB rows and a row pointer per row.
+constexpr std::uint64_t kPngBytesPerPixel = 3, kPngBytesPerRow = 8;
+// render/aov.h AovImages: depth a float, normal a Vec3, albedo an Rgb, id a uint32.
+constexpr std::uint64_t kAovDepthBytes = 4, kAovNormalBytes = 12, kAovAlbedoBytes = 12,
+                        kAovIdBytes = 4;
 
 // scene/compile.h, per entry (arrays are padded to kCompiledPadding = 8 entries):
 constexpr std::uint64_t kCompiledSphereBytes = 7 * 4;     // cx cy cz r2 radius material object
@@ -38,6 +51,20 @@ constexpr std::uint64_t kCompiledObjectBytes = 16 * 4;    // CompiledObjects' 16
 constexpr std::uint64_t kCompiledMaterialBytes = 16 * 4;  // CompiledMaterials' 16 columns
 constexpr std::uint64_t kCompiledLightBytes = 11 * 4;     // CompiledLights' 11 columns
 constexpr std::uint64_t kPadding = 8;
+
+// scene/bvh.cpp build_sphere_bvh, per sphere: two PrimRef arrays (32 bytes each) and
+// 2n - 1 BinaryNodes (28 bytes) while building, the 8-wide nodes (224 bytes each; one per
+// 26 spheres measured on random:1000000, counted as one per 4) and the BVH's copy of the
+// spheres (5 columns). Its arrays sit on 2 MiB huge pages: a page of rounding for each
+// of its 8 arrays.
+constexpr std::uint64_t kBvhBuildBytesPerSphere = 2 * 32 + 2 * 28;
+constexpr std::uint64_t kBvhNodeBytesPerSphere = 224 / 4;
+constexpr std::uint64_t kBvhSphereBytes = 5 * 4;
+constexpr std::uint64_t kBvhPageRounding = 8 * (std::uint64_t{2} << 20);
+
+// tools/render_batch.cpp: each frame renders a posed copy of the scene (scene_at_frame)
+// while the batch keeps the loaded one.
+constexpr std::uint64_t kAuthoredCopies = 2;
 
 // render/packet_renderer.cpp TileScratch, per camera sample of a tile (S = tile pixels *
 // spp): samples 5 columns; rays and next 10 columns each, each grown to 2 S (next is
@@ -50,6 +77,15 @@ constexpr std::uint64_t kTileBytesPerShadowRay = 12 * 4;
 constexpr std::uint64_t kTileBytesPerGenerationSample = 9 * 4 + 2 * (4 * 4);
 // The tile's three accumulators per pixel.
 constexpr std::uint64_t kTileBytesPerPixel = 3 * 4;
+
+// Measured (peak resident set size of `octray render`, Debian 12, glibc malloc): the
+// process rendering a 1x1 image of a small scene, code, libraries and TBB's threads
+// included, peaks at 14 MiB; counted as 32.
+constexpr std::uint64_t kProcessBytes = std::uint64_t{32} << 20;
+// Loading a scene file: its text, the JSON tree (an object of `octray scene`'s output,
+// about 110 bytes of text, takes several hundred bytes of tree) and the scene built from
+// it; a file of random spheres peaks at about 6.2 bytes per byte, counted as 8.
+constexpr std::uint64_t kLoadBytesPerFileByte = 8;
 
 std::string gib(std::uint64_t bytes) {
     char buf[48];
@@ -67,10 +103,13 @@ std::string gib(std::uint64_t bytes) {
 std::string RenderMemoryEstimate::describe() const {
     std::string out = "about " + gib(total) + " (framebuffer " + gib(framebuffer);
     if (output) out += ", EXR output " + gib(output);
+    if (aovs) out += ", AOVs " + gib(aovs);
     out += ", scene " + gib(scene);
+    if (load) out += ", loading the scene " + gib(load) + " before that";
     if (per_thread) {
         out += ", ray streams " + gib(per_thread) + " per thread x " + std::to_string(threads);
     }
+    if (fixed) out += ", the process " + gib(fixed);
     return out + ")";
 }
 
@@ -80,12 +119,32 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
     const std::uint64_t width = u64(scene.image.width), height = u64(scene.image.height);
     const std::uint64_t pixels = sat_mul(width, height);
 
-    // The framebuffer, plus the packet path's per-column and per-row film positions.
-    e.framebuffer = sat_mul(pixels, kFramebufferBytesPerPixel);
+    // The render's images, plus the packet path's per-column and per-row film positions.
+    e.framebuffer = sat_mul(sat_mul(pixels, kFramebufferBytesPerPixel),
+                            params.progressive ? kProgressiveImages : 1);
     if (params.packet_path) e.framebuffer = sat_add(e.framebuffer, sat_mul(width + height, 4));
-    e.output = params.float32_output ? 0 : sat_mul(pixels, kHalfOutputBytesPerPixel);
 
-    // The authored scene (scene/scene.h) and its compiled copy.
+    // The AOV buffers, and the EXR image: a copy of every channel, and the writer's block
+    // of lines of all of them.
+    if (params.aov_depth) e.aovs = sat_add(e.aovs, sat_mul(pixels, kAovDepthBytes));
+    if (params.aov_normal) e.aovs = sat_add(e.aovs, sat_mul(pixels, kAovNormalBytes));
+    if (params.aov_albedo) e.aovs = sat_add(e.aovs, sat_mul(pixels, kAovAlbedoBytes));
+    if (params.aov_id) e.aovs = sat_add(e.aovs, sat_mul(pixels, kAovIdBytes));
+    std::uint64_t float_channels = kColorChannels;
+    if (params.aov_depth) float_channels += kDepthChannels;
+    if (params.aov_normal) float_channels += kNormalChannels;
+    if (params.aov_albedo) float_channels += kAlbedoChannels;
+    const std::uint64_t bytes_per_pixel =
+        float_channels * (params.float32_output ? 4 : 2) + (params.aov_id ? 4 : 0);
+    const std::uint64_t lines = std::min(height, u64(std::max(params.exr_lines_per_chunk, 1)));
+    e.output =
+        sat_add(sat_mul(pixels, bytes_per_pixel),
+                sat_mul(sat_mul(sat_mul(lines, width), bytes_per_pixel), kExrLineBufferCopies));
+    if (params.png_preview)
+        e.output = sat_add(e.output, sat_add(sat_mul(pixels, kPngBytesPerPixel),
+                                             sat_mul(height, kPngBytesPerRow)));
+
+    // The authored scene (scene/scene.h), its compiled copy and the BVH.
     std::uint64_t spheres = 0, planes = 0, names = 0;
     for (const Object& o : scene.objects) {
         (o.type == ObjectType::sphere ? spheres : planes) += 1;
@@ -103,7 +162,22 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
     compiled = sat_add(compiled, sat_mul(objects + kPadding, kCompiledObjectBytes));
     compiled = sat_add(compiled, sat_mul(materials + kPadding, kCompiledMaterialBytes));
     compiled = sat_add(compiled, sat_mul(lights + kPadding, kCompiledLightBytes));
-    e.scene = sat_add(authored, params.packet_path ? compiled : 0);
+    std::uint64_t bvh = 0;
+    const std::uint32_t bvh_spheres =
+        static_cast<std::uint32_t>(std::min<std::uint64_t>(spheres, 0xFFFFFFFFu));
+    if (params.packet_path && spheres > 0 && accel_uses_bvh(params.accel, bvh_spheres)) {
+        bvh = sat_mul(spheres + kPadding,
+                      kBvhBuildBytesPerSphere + kBvhNodeBytesPerSphere + kBvhSphereBytes);
+        bvh = sat_add(bvh, kBvhPageRounding);
+    }
+    e.scene = sat_add(sat_mul(authored, kAuthoredCopies),
+                      params.packet_path ? sat_add(compiled, bvh) : 0);
+    // Loading comes before rendering, and what it allocates is freed before the first
+    // frame (measured: the peak of a render is the larger of the two, not their sum).
+    e.load = params.scene_file_bytes > 0
+                 ? estimate_load_memory(params.scene_file_bytes).load
+                 : authored;  // a built-in is generated; its digest hashes the spec string
+    e.fixed = kProcessBytes;
 
     // One thread's tile scratch. A tile never exceeds the image.
     if (params.packet_path) {
@@ -122,8 +196,10 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
                                           : std::thread::hardware_concurrency();
     e.threads = std::max(1u, threads);
 
-    e.total = sat_add(sat_add(e.framebuffer, e.output),
-                      sat_add(e.scene, sat_mul(e.threads, e.per_thread)));
+    const std::uint64_t rendering =
+        sat_add(sat_add(sat_add(e.framebuffer, e.output), sat_add(e.aovs, e.scene)),
+                sat_mul(e.threads, e.per_thread));
+    e.total = sat_add(e.fixed, std::max(e.load, rendering));
     return e;
 }
 
@@ -137,6 +213,27 @@ void check_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
                          std::to_string(scene.image.spp) + " spp needs " + e.describe() +
                          "; expected at most the memory limit of " + gib(limit_bytes) + " (" +
                          std::to_string(limit_bytes) + " bytes)");
+}
+
+RenderMemoryEstimate estimate_load_memory(std::uint64_t file_bytes) {
+    RenderMemoryEstimate e;
+    e.load = sat_mul(file_bytes, kLoadBytesPerFileByte);
+    e.fixed = kProcessBytes;
+    e.threads = 0;
+    e.total = sat_add(e.load, e.fixed);
+    return e;
+}
+
+void check_load_memory_limit(const std::string& path, std::uint64_t file_bytes,
+                             std::uint64_t limit_bytes) {
+    const RenderMemoryEstimate e = estimate_load_memory(file_bytes);
+    if (e.total <= limit_bytes) return;
+    throw SceneError(path, "",
+                     "loading this " + std::to_string(file_bytes) +
+                         "-byte scene file needs about " + gib(e.total) + " (parsing it " +
+                         gib(e.load) + ", the process " + gib(e.fixed) +
+                         "), before rendering; expected at most the memory limit of " +
+                         gib(limit_bytes) + " (" + std::to_string(limit_bytes) + " bytes)");
 }
 
 std::optional<std::uint64_t> parse_memory_size(std::string_view text) {

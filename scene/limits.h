@@ -3,17 +3,21 @@
 // the memory a render of a scene takes, a check against a limit (`octray render
 // --max-memory`), and the parser for sizes such as "512M" or "4G".
 //
-// The estimate counts what grows with the input, from the layouts in core/image.h,
-// scene/compile.h, render/packet_renderer.cpp and render/image_io.cpp; fixed costs
-// (code, thread stacks, OpenEXR's line buffers, a few MB) are not counted. It errs on the
-// high side for the packet path's per-thread ray streams, which it sizes as if every ray
-// of every generation of a tile lived at once.
+// The estimate counts what the process really allocates, from the layouts in
+// core/image.h, scene/compile.h, scene/bvh.cpp, render/packet_renderer.cpp,
+// render/progressive.cpp, render/aov.h, render/image_io.cpp and tools/render_batch.cpp,
+// plus the process's own fixed footprint and the parse of a scene file; it is meant to be
+// an upper bound of the peak resident set size (tests/tools/memory_estimate_test.cpp
+// measures it). It errs on the high side: the packet path's per-thread ray streams are
+// sized as if every ray of every generation of a tile lived at once, the BVH's build
+// buffers as if they lived through the render.
 
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
 
+#include "scene/accel.h"
 #include "scene/scene.h"
 
 namespace octray {
@@ -23,18 +27,33 @@ struct RenderMemoryParams {
     int threads = 0;  // 0: std::thread::hardware_concurrency()
     int tile_width = 16;
     int tile_height = 16;
-    bool packet_path = true;      // the SIMD renderer's per-tile ray streams (the default)
-    bool float32_output = false;  // EXR written as 32-bit floats instead of half
+    bool packet_path = true;         // the SIMD renderer's per-tile ray streams (the default)
+    Accel accel = Accel::automatic;  // the packet path's sphere BVH (--accel)
+    bool float32_output = false;     // EXR written as 32-bit floats instead of half
+    int exr_lines_per_chunk = 16;    // the codec's scan lines per block (zip: 16, dwab: 256)
+    bool png_preview = false;        // --png
+    bool progressive = false;        // --progressive: a pass renders while the last is kept
+    // --aov: the buffers of compute_aovs and their EXR channels.
+    bool aov_depth = false, aov_normal = false, aov_albedo = false, aov_id = false;
+    std::uint64_t scene_file_bytes = 0;  // the JSON file the scene was parsed from (0: none)
 };
 
 // Bytes, each term saturating at UINT64_MAX instead of overflowing.
 struct RenderMemoryEstimate {
-    std::uint64_t framebuffer = 0;  // 12 bytes (three floats) per pixel
-    std::uint64_t output = 0;       // the EXR writer's converted copy of the image
-    std::uint64_t scene = 0;        // the authored scene plus its compiled SoA copy
+    std::uint64_t framebuffer = 0;  // the render's images: 12 bytes (three floats) per
+                                    // pixel, two images and their sample sums if progressive
+    std::uint64_t output = 0;       // the EXR writer's channels (color and AOVs) and line
+                                    // buffers, and the PNG preview's bytes
+    std::uint64_t aovs = 0;         // compute_aovs' buffers
+    std::uint64_t scene = 0;        // the authored scene, its compiled SoA copy, the BVH
+                                    // and what building it takes
+    std::uint64_t load = 0;         // loading the scene: a file's text, JSON tree and the
+                                    // scene built from it; a built-in's generation
+    std::uint64_t fixed = 0;        // the process itself: code, libraries, thread pool
     std::uint64_t per_thread = 0;   // one thread's tile scratch (packet path)
     std::uint64_t threads = 1;      // the thread count the total assumes
-    std::uint64_t total = 0;        // framebuffer + output + scene + threads * per_thread
+    std::uint64_t total = 0;        // fixed + the larger of load and the rest (per_thread
+                                    // times threads)
 
     // "about 1.2 GiB (framebuffer 0.9 GiB, EXR output 0.5 GiB, ...)".
     std::string describe() const;
@@ -47,6 +66,16 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
 // when the estimate exceeds `limit_bytes`.
 void check_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
                         const RenderMemoryParams& params = {});
+
+// What loading a scene file of `file_bytes` bytes takes (its text, its JSON tree, the
+// scene built from it and the process), known from the file's size before a byte of it is
+// parsed.
+RenderMemoryEstimate estimate_load_memory(std::uint64_t file_bytes);
+
+// Throws SceneError (file: `path`) when loading a scene file of `file_bytes` bytes would
+// exceed `limit_bytes`: a huge file is refused before it is read.
+void check_load_memory_limit(const std::string& path, std::uint64_t file_bytes,
+                             std::uint64_t limit_bytes);
 
 // "1048576", "512K", "512M", "4G", "1T" (binary units, optional "iB"/"B" suffix, case
 // insensitive); nullopt for anything else, zero, or a size over UINT64_MAX bytes.

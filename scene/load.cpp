@@ -4,6 +4,8 @@
 
 #include "scene/load.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -1368,26 +1370,60 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
     return scene;
 }
 
-Scene load_scene_file(const std::string& path) {
-    const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                               &std::fclose);
-    if (!file) {
+std::string read_scene_file(const std::string& path) {
+    // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused below anyway.
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
         throw SceneError(path, "",
                          "cannot open scene file: " + std::generic_category().message(errno));
     }
+    const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(::fdopen(fd, "rb"),
+                                                               &std::fclose);
+    if (!file) {
+        const int error = errno;
+        ::close(fd);
+        throw SceneError(path, "",
+                         "cannot read scene file: " + std::generic_category().message(error));
+    }
+    // Only a regular file has an end: /dev/zero, /dev/urandom or a pipe would be read
+    // forever (or block), so they are refused before the first byte is read.
+    struct stat info {};
+    if (::fstat(fd, &info) != 0) {
+        throw SceneError(path, "",
+                         "cannot read scene file: " + std::generic_category().message(errno));
+    }
+    if (S_ISDIR(info.st_mode)) {
+        throw SceneError(path, "",
+                         "cannot read scene file: " + std::generic_category().message(EISDIR) +
+                             "; expected a regular file");
+    }
+    if (!S_ISREG(info.st_mode)) {
+        const char* kind = S_ISCHR(info.st_mode)    ? "a character device"
+                           : S_ISBLK(info.st_mode)  ? "a block device"
+                           : S_ISFIFO(info.st_mode) ? "a pipe (FIFO)"
+                           : S_ISSOCK(info.st_mode) ? "a socket"
+                                                    : "not a plain file";
+        throw SceneError(path, "",
+                         std::string("cannot read scene file: it is ") + kind +
+                             "; expected a regular file (a JSON scene)");
+    }
     std::string text;
+    text.reserve(static_cast<std::size_t>(info.st_size));
     std::array<char, 1 << 16> buffer;
     for (;;) {
         const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), file.get());
         text.append(buffer.data(), n);
         if (n < buffer.size()) break;
     }
-    // A directory opens fine on Linux and fails here, with EISDIR.
     if (std::ferror(file.get())) {
         throw SceneError(path, "",
                          "cannot read scene file: " + std::generic_category().message(errno));
     }
-    return parse_scene_json(text, path);
+    return text;
+}
+
+Scene load_scene_file(const std::string& path) {
+    return parse_scene_json(read_scene_file(path), path);
 }
 
 Scene load_scene(const std::string& spec) {

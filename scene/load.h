@@ -13,6 +13,10 @@ namespace octray {
 // Parses a JSON scene. `source` names the file in error messages. Throws SceneError.
 Scene parse_scene_json(std::string_view json_text, const std::string& source);
 
+// The bytes of a scene file. Refuses anything but a regular file (a directory, a device
+// such as /dev/zero, a FIFO) before reading, so a read always ends. Throws SceneError.
+std::string read_scene_file(const std::string& path);
+
 // Reads and parses a JSON scene file. Throws SceneError (unreadable file included).
 Scene load_scene_file(const std::string& path);
 

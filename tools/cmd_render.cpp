@@ -105,14 +105,8 @@ std::optional<TileSize> parse_tile(const std::string& text) {
 // or for a built-in, of its spec string as given (`printf %s SPEC | sha256sum`): the
 // generators are deterministic, so the spec names the scene, and hashing it costs nothing
 // where serializing random:1048576 to JSON and hashing that took seconds.
-std::string scene_digest(const std::string& spec, const Scene& scene) {
-    if (!is_builtin_scene(spec)) {
-        std::ifstream in(spec, std::ios::binary);
-        std::ostringstream bytes;
-        bytes << in.rdbuf();
-        if (in) return sha256_hex(bytes.str());
-        return sha256_hex(scene_to_json(scene));  // the file vanished since it was loaded
-    }
+std::string scene_digest(const std::string& spec) {
+    if (!is_builtin_scene(spec)) return sha256_hex(read_scene_file(spec));
     return sha256_hex(spec);
 }
 
@@ -146,7 +140,7 @@ BatchScene load_batch_scene(const std::string& spec, const RenderArguments& args
             throw UsageError(std::string("the options make the scene invalid: ") + e.what());
         }
     }
-    loaded.sha256 = scene_digest(spec, scene);
+    loaded.sha256 = scene_digest(spec);
     return loaded;
 }
 
@@ -297,6 +291,32 @@ void run_render(const RenderArguments& args) {
     else if (args.shard_count_option->count())
         throw UsageError("--shard-count goes with --shard auto (Kubernetes Indexed Jobs)");
 
+    const auto limit_note = [&] {
+        return args.max_memory.empty()
+                   ? std::string(
+                         " (the limit is this machine's memory; --max-memory sets another)")
+                   : " (--max-memory " + args.max_memory + ")";
+    };
+    // A scene file too large to parse within the limit is refused from its size, before
+    // any scene is read.
+    std::map<std::string, std::uint64_t> file_sizes;
+    for (const std::string& spec : args.scenes) {
+        if (is_builtin_scene(spec)) continue;
+        std::error_code error;
+        const fs::file_status status = fs::status(spec, error);
+        if (error || !fs::is_regular_file(status)) continue;  // the loader says why
+        const std::uint64_t size = fs::file_size(spec, error);
+        if (error) continue;
+        file_sizes[spec] = size;
+        if (memory_limit > 0) {
+            try {
+                check_load_memory_limit(spec, size, memory_limit);
+            } catch (const SceneError& e) {
+                throw UsageError(e.what() + limit_note());
+            }
+        }
+    }
+
     std::vector<BatchScene> scenes;
     for (const std::string& spec : args.scenes) scenes.push_back(load_batch_scene(spec, args));
 
@@ -305,7 +325,15 @@ void run_render(const RenderArguments& args) {
     memory.tile_width = tile->width;
     memory.tile_height = tile->height;
     memory.packet_path = settings.path == RenderPath::simd;
+    memory.accel = settings.options.accel;
     memory.float32_output = args.float32;
+    memory.exr_lines_per_chunk = exr_lines_per_chunk(*compression);
+    memory.png_preview = !args.png.empty();
+    memory.progressive = args.progressive;
+    memory.aov_depth = settings.aovs.depth;
+    memory.aov_normal = settings.aovs.normal;
+    memory.aov_albedo = settings.aovs.albedo;
+    memory.aov_id = settings.aovs.id;
     for (BatchScene& scene : scenes) {
         if (!args.crop.empty()) {
             try {
@@ -317,14 +345,12 @@ void run_render(const RenderArguments& args) {
             }
         }
         if (memory_limit > 0) {
+            const auto size = file_sizes.find(scene.spec);
+            memory.scene_file_bytes = size != file_sizes.end() ? size->second : 0;
             try {
                 check_memory_limit(scene.scene, memory_limit, memory);
             } catch (const SceneError& e) {
-                throw UsageError(std::string(e.what()) +
-                                 (args.max_memory.empty()
-                                      ? " (the limit is this machine's memory; --max-memory "
-                                        "sets another)"
-                                      : " (--max-memory " + args.max_memory + ")"));
+                throw UsageError(e.what() + limit_note());
             }
         }
     }
@@ -388,13 +414,15 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
             ->type_name("N")
             ->check(quiet(CLI::Range(1, 1 << 20)));
     cmd->add_flag("--skip-existing", args->skip_existing,
-                  "Resume: leave frames whose output already exists (outputs are written\n"
-                  "atomically, so an existing file is a finished frame; an empty one is a\n"
-                  "--placeholders claim)");
+                  "Resume: leave frames whose outputs (the EXR and the --png preview) all\n"
+                  "exist (outputs are written atomically, so an existing file is finished;\n"
+                  "an empty one is a --placeholders claim, an unfinished --progressive image\n"
+                  "the claim of the run writing it while that run lives)");
     cmd->add_flag("--placeholders", args->placeholders,
                   "Claim each frame with an empty output file before rendering it, so runs\n"
-                  "sharing one output directory never render a frame twice (claims of a run\n"
-                  "that crashed stay: delete empty files to release them)");
+                  "sharing one output directory never render a frame twice (empty claims of\n"
+                  "a run that crashed stay: delete empty files to release them; unfinished\n"
+                  "--progressive images of a run gone from this host are taken over)");
     cmd->add_option("--crop", args->crop,
                     "Render only pixels x0..x1-1, y0..y1-1 (row 0 on top) into an EXR whose\n"
                     "data window is that region; `octray assemble` stitches regions together")
@@ -415,7 +443,8 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                   "Render each frame in passes of 1, 2, 4, ... samples per pixel, rewriting\n"
                   "the image after each; the final image equals the plain render bit for bit");
     cmd->add_option("--max-memory", args->max_memory,
-                    "Refuse a render whose memory estimate exceeds this (512M, 4G, ...)\n"
+                    "Refuse a render whose memory estimate exceeds this (512M, 4G, ...);\n"
+                    "a scene file is first checked from its size, before it is parsed\n"
                     "[default: this machine's physical memory]")
         ->type_name("SIZE");
     args->width_option =

@@ -3,8 +3,11 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <fcntl.h>
 #include <oneapi/tbb/global_control.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -26,6 +29,7 @@
 #include "render/reference.h"
 #include "scene/animation.h"
 #include "scene/scene_error.h"
+#include "tools/claim_owner.h"
 #include "tools/commands.h"
 #include "tools/interrupt.h"
 
@@ -38,6 +42,8 @@ using Clock = std::chrono::steady_clock;
 // The attribute that marks an image written by a --progressive pass before the last one:
 // --skip-existing does not count such a file as a finished frame.
 constexpr const char* kSamplesSoFarAttribute = "octray.samplesSoFar";
+// The run that writes an unfinished pass: its claim (tools/claim_owner.h).
+constexpr const char* kOwnerAttribute = "octray.owner";
 
 enum class FailureKind { none, scene, io, internal, interrupted };
 
@@ -68,38 +74,64 @@ std::pair<std::string, float> capture_date() {
 }
 
 // A finished frame: a non-empty file that is not an unfinished --progressive pass.
-// An empty file is a --placeholders claim.
+// An empty file is a --placeholders claim; an unfinished pass is a claim of its owner
+// (tools/claim_owner.h) while that run lives.
 enum class Existing { none, claim, finished, unfinished };
 
-Existing existing_output(const std::string& path) {
+struct Found {
+    Existing kind = Existing::none;
+    std::string owner;  // octray.owner of an unfinished pass ("" if it has none)
+};
+
+Found existing_output(const std::string& path) {
     std::error_code error;
-    if (!fs::exists(path, error)) return Existing::none;
+    if (!fs::exists(path, error)) return {Existing::none, {}};
     const auto size = fs::file_size(path, error);
-    if (error) return Existing::finished;  // not a regular file: never overwrite it blindly
-    if (size == 0) return Existing::claim;
+    if (error) return {Existing::finished, {}};  // not a regular file: never overwrite it
+    if (size == 0) return {Existing::claim, {}};
     try {
         Imf::InputFile file(path.c_str());
         const auto* samples =
             file.header().findTypedAttribute<Imf::IntAttribute>(kSamplesSoFarAttribute);
-        if (samples != nullptr) return Existing::unfinished;
+        if (samples != nullptr) {
+            const auto* owner =
+                file.header().findTypedAttribute<Imf::StringAttribute>(kOwnerAttribute);
+            return {Existing::unfinished, owner != nullptr ? owner->value() : std::string()};
+        }
     } catch (const std::exception&) {
         // Not an EXR octray can read (a PNG preview target, or a damaged file): it exists.
     }
-    return Existing::finished;
+    return {Existing::finished, {}};
 }
 
-// Removes hidden temporaries (".<name>.tmp.*", see render/image_io.cpp) that a killed run
-// left next to `target`. Only this run renders `target` now, so any of them is stale.
-void remove_stale_temporaries(const std::string& target) {
-    const fs::path path(target);
-    fs::path dir = path.parent_path();
-    if (dir.empty()) dir = ".";
-    const std::string prefix = "." + path.filename().string() + ".tmp.";
-    std::error_code error;
-    for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
-        const std::string name = it->path().filename().string();
-        if (name.compare(0, prefix.size(), prefix) == 0) fs::remove(it->path(), error);
-    }
+// Takes over a stale unfinished image at `path` for --placeholders: replaces it by an
+// empty claim of this run. Two runs may find the same stale image; the one that holds the
+// file's lock and still finds it stale under the lock wins, the other finds it changed
+// and backs off. False if another run took it (or it cannot be locked).
+bool take_over(const std::string& path) {
+    int fd = ::open(path.c_str(), O_RDWR | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) return false;
+    struct Closer {
+        int fd;
+        ~Closer() { ::close(fd); }
+    } closer{fd};
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) return false;
+    const auto same_file = [&] {
+        struct stat held {
+        }, named{};
+        return ::fstat(fd, &held) == 0 && ::stat(path.c_str(), &named) == 0 &&
+               held.st_dev == named.st_dev && held.st_ino == named.st_ino;
+    };
+    if (!same_file()) return false;
+    const Found found = existing_output(path);
+    if (found.kind != Existing::unfinished || !owner_is_gone(found.owner) || !same_file())
+        return false;
+    write_file_atomically(path, [](const std::string& tmp) {
+        // The temporary is already there, empty: it becomes the claim.
+        (void)tmp;
+    });
+    return true;
 }
 
 // Claims `path` with an empty file; false if another run got there first.
@@ -131,7 +163,7 @@ class BatchRunner {
   public:
     BatchRunner(const std::vector<BatchScene>& scenes, const BatchSettings& settings,
                 ProgressReporter& progress)
-        : scenes_(scenes), settings_(settings), progress_(progress) {}
+        : scenes_(scenes), settings_(settings), progress_(progress), owner_(current_owner()) {}
 
     FrameResult run(std::size_t index, const BatchJob& job);
 
@@ -145,6 +177,7 @@ class BatchRunner {
     const std::vector<BatchScene>& scenes_;
     const BatchSettings& settings_;
     ProgressReporter& progress_;
+    std::string owner_;  // octray.owner of this run's unfinished passes
 };
 
 ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
@@ -169,8 +202,10 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
         {"octray.maxDepth", posed.render.max_depth},
         {"octray.frame", frame},
     };
-    if (samples_so_far < posed.image.spp)
+    if (samples_so_far < posed.image.spp) {
         a.ints.emplace_back(kSamplesSoFarAttribute, samples_so_far);
+        a.strings.emplace_back(kOwnerAttribute, owner_);
+    }
     // Ray counts are 64-bit; a double holds them exactly up to 2^53 (9e15 rays).
     a.doubles = {
         {"renderTimeSeconds", result.seconds},
@@ -214,23 +249,58 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         progress_.frame_finished(out.report, work);
         return out;
     };
-    // Resume and claims.
-    Existing existing = Existing::none;
-    if (settings_.skip_existing || settings_.placeholders) {
-        existing = existing_output(job.output);
-        if (existing == Existing::finished) return skip(FrameOutcome::skipped_existing);
-        if (existing == Existing::claim) return skip(FrameOutcome::skipped_claimed);
+    // A directory at an output path can never be replaced by an image: the frame fails
+    // before any time is spent rendering it, and it never counts as finished or claimed.
+    for (const std::string* file : {&job.output, &job.png}) {
+        std::error_code error;
+        if (file->empty() || !fs::is_directory(*file, error)) continue;
+        out.failure = FailureKind::io;
+        out.report.outcome = FrameOutcome::failed;
+        out.report.message = "I/O error: cannot write " + *file +
+                             ": it is a directory; expected an image file (or nothing) there";
+        progress_.note("octray: frame " + std::to_string(job.frame) + " of " + scene.spec +
+                       " failed: " + out.report.message);
+        progress_.frame_finished(out.report, work);
+        return out;
     }
-    bool claimed = false;
+    // Resume and claims. A frame is finished only when all its outputs are (the EXR and
+    // the --png preview); one missing output makes it render again.
+    // An unfinished --progressive image is a claim of the run writing it, rendered over
+    // only when that run is provably gone.
+    Existing existing = Existing::none;
+    Existing preview = Existing::finished;  // no --png: nothing to wait for
+    if (settings_.skip_existing || settings_.placeholders) {
+        const Found found = existing_output(job.output);
+        existing = found.kind;
+        if (!job.png.empty()) preview = existing_output(job.png).kind;
+        if (existing == Existing::claim || preview == Existing::claim)
+            return skip(FrameOutcome::skipped_claimed);
+        if (existing == Existing::finished && preview == Existing::finished)
+            return skip(FrameOutcome::skipped_existing);
+        if (existing == Existing::unfinished && !owner_is_gone(found.owner))
+            return skip(FrameOutcome::skipped_claimed);
+    }
+    std::string claimed;  // the placeholder this run created, if any
     const auto started = Clock::now();
     try {
-        // Only a missing output is claimed (O_EXCL: one run wins). An unfinished
-        // --progressive image is not a claim: it is rendered over.
-        if (settings_.placeholders && existing == Existing::none) {
-            if (!claim(job.output)) return skip(FrameOutcome::skipped_claimed);
-            claimed = true;
+        // A missing output is claimed (O_EXCL: one run wins): the EXR, or when only the
+        // preview is missing, the preview. A stale unfinished image is taken over.
+        if (settings_.placeholders) {
+            if (existing == Existing::unfinished) {
+                if (!take_over(job.output)) return skip(FrameOutcome::skipped_claimed);
+                claimed = job.output;
+            } else {
+                const std::string* missing = existing == Existing::none  ? &job.output
+                                             : preview == Existing::none ? &job.png
+                                                                         : nullptr;
+                if (missing != nullptr) {
+                    if (!claim(*missing)) return skip(FrameOutcome::skipped_claimed);
+                    claimed = *missing;
+                }
+            }
         }
         remove_stale_temporaries(job.output);
+        if (!job.png.empty()) remove_stale_temporaries(job.png);
         progress_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
 
         const Scene posed = scene_at_frame(scene.scene, job.frame);
@@ -277,7 +347,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         out.report.outcome = FrameOutcome::failed;
         out.report.message = std::string("internal error: ") + e.what();
     }
-    if (out.failure != FailureKind::none && claimed) release_claim(job.output);
+    if (out.failure != FailureKind::none && !claimed.empty()) release_claim(claimed);
     out.report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
     if (out.failure != FailureKind::interrupted) {
         if (out.failure != FailureKind::none)

@@ -31,12 +31,53 @@ TEST(RenderMemory, FramebufferAndHalfOutputScaleWithPixels) {
     const RenderMemoryEstimate e =
         estimate_render_memory(image_scene(1000, 500), reference_path);
     EXPECT_EQ(e.framebuffer, 1000u * 500u * 12u);
-    EXPECT_EQ(e.output, 1000u * 500u * 6u);
+    // The EXR image's half channels, and OpenEXR's block of 16 lines (zip) three times.
+    EXPECT_EQ(e.output, 1000u * 500u * 6u + 16u * 1000u * 6u * 3u);
     EXPECT_EQ(e.per_thread, 0u);
-    EXPECT_EQ(e.total, e.framebuffer + e.output + e.scene);
+    EXPECT_EQ(e.total, e.framebuffer + e.output + e.scene + e.fixed);
 
-    reference_path.float32_output = true;  // OpenEXR reads the framebuffer itself
-    EXPECT_EQ(estimate_render_memory(image_scene(1000, 500), reference_path).output, 0u);
+    // --float: the EXR image holds float copies of the channels (the framebuffer is not
+    // handed to OpenEXR), twice the half ones.
+    reference_path.float32_output = true;
+    EXPECT_EQ(estimate_render_memory(image_scene(1000, 500), reference_path).output,
+              2 * e.output);
+}
+
+// Issue 23: whitted at 4096 x 2160 with --float --aov depth,normal,albedo,id peaked at
+// 778 MB where 101.7 MiB was estimated. Every buffer is counted: the image (12 bytes a
+// pixel), the AOVs (32) and their float EXR copies (44).
+TEST(RenderMemory, AovsFloatOutputAndProgressivePassesAreCounted) {
+    RenderMemoryParams p;
+    p.threads = 1;
+    const Scene s = image_scene(4096, 2160);
+    const std::uint64_t pixels = 4096u * 2160u;
+    const RenderMemoryEstimate plain = estimate_render_memory(s, p);
+    p.float32_output = true;
+    p.aov_depth = p.aov_normal = p.aov_albedo = p.aov_id = true;
+    const RenderMemoryEstimate all = estimate_render_memory(s, p);
+    EXPECT_EQ(all.aovs, pixels * 32u);
+    EXPECT_GE(all.output, pixels * 44u);
+    EXPECT_GT(all.total, std::uint64_t{778} * 1000 * 1000);
+    EXPECT_NE(all.describe().find("AOVs"), std::string::npos) << all.describe();
+    p.progressive = true;
+    EXPECT_EQ(estimate_render_memory(s, p).framebuffer, all.framebuffer + 3 * pixels * 12u);
+    EXPECT_LT(plain.total, all.total);
+}
+
+// A scene file is estimated from its size before it is parsed.
+TEST(MemoryLimit, ASceneFileTooLargeToParseIsRefusedFromItsSize) {
+    const std::uint64_t bytes = std::uint64_t{350} << 20;     // 5 M spheres as JSON
+    EXPECT_GT(estimate_load_memory(bytes).total, 6 * bytes);  // measured: 6.2 bytes a byte
+    try {
+        check_load_memory_limit("big.json", bytes, 1024);
+        FAIL() << "a 350 MiB scene file parses in 1 KiB?";
+    } catch (const SceneError& err) {
+        const std::string what = err.what();
+        EXPECT_EQ(err.file(), "big.json");
+        EXPECT_NE(what.find("367001600-byte scene file"), std::string::npos) << what;
+        EXPECT_NE(what.find("1024 bytes"), std::string::npos) << what;
+    }
+    EXPECT_NO_THROW(check_load_memory_limit("small.json", 1000, 1 * kGiB));
 }
 
 TEST(RenderMemory, PacketScratchGrowsWithSppLightsDepthAndThreads) {
@@ -46,7 +87,7 @@ TEST(RenderMemory, PacketScratchGrowsWithSppLightsDepthAndThreads) {
     const RenderMemoryEstimate e1 = estimate_render_memory(base, p);
     EXPECT_GT(e1.per_thread, 0u);
     EXPECT_EQ(e1.threads, 2u);
-    EXPECT_EQ(e1.total, e1.framebuffer + e1.output + e1.scene + 2 * e1.per_thread);
+    EXPECT_EQ(e1.total, e1.framebuffer + e1.output + e1.scene + e1.fixed + 2 * e1.per_thread);
 
     const RenderMemoryEstimate e16 = estimate_render_memory(image_scene(640, 480, 16), p);
     EXPECT_GT(e16.per_thread, 15 * e1.per_thread);

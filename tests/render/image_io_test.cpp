@@ -11,9 +11,14 @@
 #include <gtest/gtest.h>
 #include <half.h>
 #include <png.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -279,6 +284,51 @@ TEST_F(ImageIoTest, WriteIntoMissingDirectoryThrowsAndLeavesNothing) {
                  IoError);
     EXPECT_FALSE(fs::exists(dir_ / "no"));
     EXPECT_TRUE(entries().empty());
+}
+
+// A disk that fills up in the middle of a PNG: libpng's own writer said only "libpng:
+// Write Error". The message must carry the OS reason. RLIMIT_FSIZE makes write() fail
+// with EFBIG once a file reaches the limit, for this process only and without privileges
+// (SIGXFSZ, whose default action would kill the process, is ignored meanwhile).
+TEST_F(ImageIoTest, PngWriteFailureSaysTheOsReason) {
+    // Noise does not compress: both PNGs are far over the limit and over stdio's buffer.
+    Image noise(128, 128);
+    std::vector<std::uint8_t> bytes(3 * 128 * 128);
+    std::uint32_t state = 12345;
+    const auto next = [&] { return state = state * 1664525u + 1013904223u; };
+    for (int y = 0; y < 128; ++y)
+        for (int x = 0; x < 128; ++x)
+            noise.at(x, y) = Rgb(static_cast<float>(next() >> 8) / 16777216.0f,
+                                 static_cast<float>(next() >> 8) / 16777216.0f,
+                                 static_cast<float>(next() >> 8) / 16777216.0f);
+    for (std::uint8_t& b : bytes) b = static_cast<std::uint8_t>(next() >> 24);
+
+    struct rlimit saved {};
+    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+    const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit small = saved;
+    small.rlim_cur = 2048;
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+    std::string preview_error, heatmap_error;
+    try {
+        write_png_preview((dir_ / "preview.png").string(), noise);
+    } catch (const IoError& e) {
+        preview_error = e.what();
+    }
+    try {
+        write_png_rgb8((dir_ / "heatmap.png").string(), 128, 128, bytes);
+    } catch (const IoError& e) {
+        heatmap_error = e.what();
+    }
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &saved), 0);
+    std::signal(SIGXFSZ, old_handler);
+
+    const std::string reason = std::strerror(EFBIG);  // "File too large"
+    EXPECT_NE(preview_error.find("preview.png"), std::string::npos) << preview_error;
+    EXPECT_NE(preview_error.find(reason), std::string::npos) << preview_error;
+    EXPECT_NE(heatmap_error.find("heatmap.png"), std::string::npos) << heatmap_error;
+    EXPECT_NE(heatmap_error.find(reason), std::string::npos) << heatmap_error;
+    EXPECT_TRUE(entries().empty()) << "a partial file or temporary was left";
 }
 
 TEST_F(ImageIoTest, NoTemporaryLeftAfterSuccess) {

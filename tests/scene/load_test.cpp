@@ -4,6 +4,7 @@
 #include "scene/load.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -720,6 +721,23 @@ TEST(SceneLoadError, UnreadableFile) {
     std::filesystem::create_directories(dir);
     expect_error([&] { load_scene_file(dir.string()); }, dir.string(), "",
                  {"cannot read scene file", "Is a directory"});
+}
+
+// A device or a pipe has no end (/dev/zero would be read forever, a FIFO blocks until a
+// writer comes): refused before reading, naming what the path is.
+TEST(SceneLoadError, NonRegularFilesAreRefusedBeforeReading) {
+    expect_error([&] { load_scene_file("/dev/null"); }, "/dev/null", "",
+                 {"a character device", "expected a regular file"});
+    expect_error([&] { load_scene("/dev/zero"); }, "/dev/zero", "",
+                 {"a character device", "expected a regular file"});
+    const std::filesystem::path dir = OCTRAY_TEST_TMPDIR;
+    std::filesystem::create_directories(dir);
+    const std::string fifo = (dir / "load_test_fifo.json").string();
+    std::filesystem::remove(fifo);
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    expect_error([&] { load_scene_file(fifo); }, fifo, "",
+                 {"a pipe", "expected a regular file"});
+    std::filesystem::remove(fifo);
 }
 
 TEST(SceneLoadError, ErrorsInAFileNameTheFile) {

@@ -4,14 +4,20 @@
 // progressive passes, per-frame attributes, failures that let the rest go on, and bad
 // input. Every image comparison is bit for bit.
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfMatrixAttribute.h>
+#include <ImfOutputFile.h>
 #include <ImfRationalAttribute.h>
 #include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -28,6 +34,7 @@
 #include "core/sha256.h"
 #include "render/image_read.h"
 #include "run_octray.h"
+#include "tools/claim_owner.h"
 
 namespace octray {
 namespace {
@@ -243,6 +250,27 @@ TEST_F(BatchCliTest, ResumeAfterAKillFinishesTheRestAndLeavesNoTemporaries) {
     expect_same_pixels(read("out/r.05.exr"), read("fresh.exr"), "frame 5");
 }
 
+// A run removed every ".<name>.tmp.*" next to a frame it rendered, also the temporary a
+// live run was writing (which then failed with exit 4). A writer holds a lock on its
+// temporary; only one whose lock is free (its writer is gone) is stale.
+TEST_F(BatchCliTest, ALiveWritersTemporaryIsLeftAlone) {
+    // This process plays the live writer: it holds the lock, as write_file_atomically does.
+    const fs::path live = dir_ / "out/.t.0.exr.tmp.1.00000000000000aa";
+    const fs::path stale = dir_ / "out/.t.0.exr.tmp.1.00000000000000bb";
+    std::ofstream(live) << "half-written by a live run";
+    std::ofstream(stale) << "left by a killed run";
+    const int fd = ::open(live.c_str(), O_RDWR | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+    const auto r =
+        run_octray({"render", "shot.json", "--frames", "0", "-o", "out/t.#.exr"}, dir_);
+    ::close(fd);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(live)) << "a live run's temporary was removed";
+    EXPECT_FALSE(fs::exists(stale)) << "a stale temporary stayed";
+    EXPECT_TRUE(fs::exists(dir_ / "out/t.0.exr"));
+}
+
 TEST_F(BatchCliTest, InterruptStopsCleanlyWithASummary) {
     const int status = shell(
         shell_quote(OCTRAY_EXE) +
@@ -307,6 +335,113 @@ TEST_F(BatchCliTest, ProgressiveFinalImageEqualsThePlainRender) {
         << "the final image is marked unfinished";
 }
 
+// A 40x30 image as an unfinished --progressive pass leaves it: octray.samplesSoFar, and
+// the run that writes it as octray.owner ("" for none, as older octrays wrote it).
+void write_unfinished_pass(const fs::path& path, const std::string& owner) {
+    Imf::Header header(40, 30);
+    header.insert("octray.samplesSoFar", Imf::IntAttribute(1));
+    if (!owner.empty()) header.insert("octray.owner", Imf::StringAttribute(owner));
+    header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    std::vector<float> pixels(40 * 30, 0.5f);
+    Imf::FrameBuffer frame_buffer;
+    frame_buffer.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(pixels.data()),
+                                        sizeof(float), 40 * sizeof(float)));
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(frame_buffer);
+    file.writePixels(30);
+}
+
+std::string owner_of(const fs::path& path) {
+    Imf::InputFile file(path.c_str());
+    const auto* owner = file.header().findTypedAttribute<Imf::StringAttribute>("octray.owner");
+    return owner != nullptr ? owner->value() : std::string();
+}
+
+bool unfinished(const fs::path& path) {
+    Imf::InputFile file(path.c_str());
+    return file.header().findTypedAttribute<Imf::IntAttribute>("octray.samplesSoFar") !=
+           nullptr;
+}
+
+// An unfinished progressive image is a claim held by the run writing it: other runs
+// rendered over it. It is rendered over only when its owner is provably gone (it ran on
+// this host and its process is not there any more).
+TEST_F(BatchCliTest, AnUnfinishedPassIsAClaimWhileItsOwnerLives) {
+    char host[256] = {};
+    ASSERT_EQ(::gethostname(host, sizeof host - 1), 0);
+    const pid_t child = ::fork();
+    if (child == 0) ::_exit(0);
+    ASSERT_GT(child, 0);
+    ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // reaped: its PID names no process
+    const std::string live = tools::current_owner();
+    write_unfinished_pass(dir_ / "out/u.0.exr", live);
+    write_unfinished_pass(dir_ / "out/u.1.exr",
+                          std::string(host) + ":" + std::to_string(child) + ":12345");
+    write_unfinished_pass(dir_ / "out/u.2.exr", "another-host.invalid:1:1");
+    write_unfinished_pass(dir_ / "out/u.3.exr", "");
+    for (const std::string option : {"--placeholders", "--skip-existing"}) {
+        const auto r =
+            run_octray({"render", "shot.json", "--frames", "0-3", "--spp", "2", "--progressive",
+                        option, "-o", "out/u.#.exr", "--progress", "lines"},
+                       dir_);
+        ASSERT_EQ(r.status, 0) << option << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "-> out/u.0.exr  skipped (claimed by another run)"))
+            << option << "\n"
+            << r.output;
+        EXPECT_TRUE(contains(r.output, "-> out/u.2.exr  skipped (claimed by another run)"))
+            << option << "\n"
+            << r.output;
+        EXPECT_EQ(owner_of(dir_ / "out/u.0.exr"), live) << option;
+        EXPECT_TRUE(unfinished(dir_ / "out/u.2.exr")) << option;
+        for (const int f : {1, 3}) {
+            const std::string name = "out/u." + std::to_string(f) + ".exr";
+            EXPECT_TRUE(contains(r.output, "-> " + name + "  ")) << option << "\n" << r.output;
+            EXPECT_FALSE(unfinished(dir_ / name)) << option << " " << name;
+            EXPECT_EQ(read(name).width, 40) << option << " " << name;
+        }
+        write_unfinished_pass(dir_ / "out/u.1.exr",
+                              std::string(host) + ":" + std::to_string(child) + ":12345");
+        write_unfinished_pass(dir_ / "out/u.3.exr", "");
+    }
+    EXPECT_TRUE(temporaries("out").empty());
+}
+
+// The same with real runs: a progressive run stopped after its first pass still holds
+// its frame (another run skips it); killed, it does not (another run renders it).
+TEST_F(BatchCliTest, AStoppedProgressiveRunKeepsItsFrameAndAKilledOneReleasesIt) {
+    const std::string octray = shell_quote(OCTRAY_EXE);
+    const int status = shell(
+        octray +
+        " render shot.json --frames 0 --width 160 --height 120 --spp 4096 --path scalar"
+        " --threads 1 --progressive --placeholders --progress none -o out/s.exr"
+        " >/dev/null 2>&1 </dev/null & pid=$!; echo $pid > pid.txt; "
+        "i=0; while [ ! -s out/s.exr ] && [ $i -lt 6000 ]; do sleep 0.01; i=$((i+1)); done; "
+        "kill -STOP $pid; cp out/s.exr first-pass.exr; " +
+        octray +
+        " render shot.json --frames 0 --spp 2 --progressive --placeholders --skip-existing"
+        " --progress lines -o out/s.exr >second.txt 2>&1 </dev/null; echo $? >> second.txt; "
+        "kill -KILL $pid; wait $pid; " +
+        octray +
+        " render shot.json --frames 0 --spp 2 --progressive --placeholders --skip-existing"
+        " --progress lines -o out/s.exr >third.txt 2>&1 </dev/null; echo $? >> third.txt");
+    ASSERT_EQ(status, 0);
+    std::ifstream pid_file(dir_ / "pid.txt");
+    std::string pid;
+    pid_file >> pid;
+    ASSERT_TRUE(unfinished(dir_ / "first-pass.exr")) << "the first pass came too late";
+    const std::string owner = owner_of(dir_ / "first-pass.exr");
+    EXPECT_TRUE(contains(owner, ":" + pid + ":")) << owner << " is not process " << pid;
+    std::ifstream second_file(dir_ / "second.txt"), third_file(dir_ / "third.txt");
+    const std::string second((std::istreambuf_iterator<char>(second_file)), {});
+    const std::string third((std::istreambuf_iterator<char>(third_file)), {});
+    EXPECT_TRUE(contains(second, "skipped (claimed by another run)")) << second;
+    EXPECT_TRUE(contains(second, "\n0\n")) << second;
+    EXPECT_TRUE(contains(third, "1 rendered")) << third;
+    EXPECT_TRUE(contains(third, "\n0\n")) << third;
+    EXPECT_FALSE(unfinished(dir_ / "out/s.exr"));
+    EXPECT_TRUE(temporaries("out").empty());
+}
+
 TEST_F(BatchCliTest, EveryFrameCarriesItsAttributes) {
     ASSERT_EQ(run_octray({"render", "shot.json", "--frames", "4", "-o", "a.exr"}, dir_).status,
               0);
@@ -360,6 +495,66 @@ TEST_F(BatchCliTest, AFailedFrameIsReportedAndTheRestGoOn) {
     EXPECT_TRUE(contains(r.output, "1 failed")) << r.output;
     for (int f : {0, 1, 2, 4, 5})
         EXPECT_TRUE(fs::exists(dir_ / ("out/g." + std::to_string(f) + ".exr")));
+    EXPECT_TRUE(temporaries("out").empty());
+}
+
+// A frame is finished only when all its outputs exist: after a full disk kept the EXR but
+// not the preview, the documented retry (--skip-existing) must write the preview.
+TEST_F(BatchCliTest, AMissingPreviewMakesTheFrameRenderAgain) {
+    const auto first = run_octray(
+        {"render", "shot.json", "--frames", "0-1", "-o", "out/p.#.exr", "--png", "out/p.#.png"},
+        dir_);
+    ASSERT_EQ(first.status, 0) << first.output;
+    fs::remove(dir_ / "out/p.1.png");
+    const auto retry =
+        run_octray({"render", "shot.json", "--frames", "0-1", "-o", "out/p.#.exr", "--png",
+                    "out/p.#.png", "--skip-existing", "--progress", "lines"},
+                   dir_);
+    ASSERT_EQ(retry.status, 0) << retry.output;
+    EXPECT_TRUE(contains(retry.output, "-> out/p.0.exr  skipped (exists)")) << retry.output;
+    EXPECT_TRUE(contains(retry.output, "-> out/p.1.exr + out/p.1.png")) << retry.output;
+    EXPECT_TRUE(fs::exists(dir_ / "out/p.1.png"));
+
+    // Runs sharing the directory claim the missing preview, not the finished EXR.
+    fs::remove(dir_ / "out/p.0.png");
+    const auto claimed =
+        run_octray({"render", "shot.json", "--frames", "0-1", "-o", "out/p.#.exr", "--png",
+                    "out/p.#.png", "--placeholders", "--progress", "lines"},
+                   dir_);
+    ASSERT_EQ(claimed.status, 0) << claimed.output;
+    EXPECT_TRUE(contains(claimed.output, "-> out/p.0.exr + out/p.0.png")) << claimed.output;
+    EXPECT_TRUE(contains(claimed.output, "-> out/p.1.exr  skipped (exists)")) << claimed.output;
+    ASSERT_TRUE(fs::exists(dir_ / "out/p.0.png"));
+    EXPECT_GT(fs::file_size(dir_ / "out/p.0.png"), 0u);
+    EXPECT_TRUE(temporaries("out").empty());
+}
+
+// A directory where an output goes is neither a finished frame nor a claim, and is found
+// before the frame renders (the EXR of a frame whose preview path is a directory is not
+// written at all).
+TEST_F(BatchCliTest, ADirectoryAtAnOutputPathFailsTheFrameBeforeItRenders) {
+    fs::create_directories(dir_ / "out/d.3.exr");
+    for (const std::string option : {"--skip-existing", "--placeholders"}) {
+        const auto r = run_octray(
+            {"render", "shot.json", "-o", "out/d.#.exr", option, "--progress", "lines"}, dir_);
+        EXPECT_EQ(r.status, 4) << option << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output,
+                             "cannot write out/d.3.exr: it is a directory; expected "
+                             "an image file (or nothing) there"))
+            << option << "\n"
+            << r.output;
+        EXPECT_TRUE(contains(r.output, "1 failed")) << option << "\n" << r.output;
+    }
+    EXPECT_TRUE(fs::is_directory(dir_ / "out/d.3.exr"));
+
+    fs::create_directories(dir_ / "out/e.3.png");
+    const auto r = run_octray({"render", "shot.json", "-o", "out/e.#.exr", "--png",
+                               "out/e.#.png", "--progress", "lines"},
+                              dir_);
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "cannot write out/e.3.png: it is a directory")) << r.output;
+    EXPECT_TRUE(contains(r.output, "5 rendered")) << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "out/e.3.exr")) << "frame 3 was rendered before failing";
     EXPECT_TRUE(temporaries("out").empty());
 }
 

@@ -278,6 +278,19 @@ TEST_F(CliTest, MissingSceneFileIsASceneError) {
     EXPECT_TRUE(entries().empty());
 }
 
+// A device has no end: `octray render /dev/zero` read forever, growing without bound.
+// Anything but a regular file is a scene error before the first byte is read.
+TEST_F(CliTest, DeviceAsSceneFileIsRefusedBeforeReading) {
+    for (const std::string device : {"/dev/null", "/dev/zero", "/dev/urandom"}) {
+        const RunResult r = octray({"render", device, "-o", "out.exr"});
+        EXPECT_EQ(r.status, 3) << device << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, device + ": cannot read scene file: it is a character "
+                                                "device; expected a regular file"))
+            << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
 TEST_F(CliTest, MissingOutputDirectoryIsAnIoErrorAndLeavesNothing) {
     const RunResult r =
         octray({"render", "random:2,width=8,height=8", "-o", "nope/sub/out.exr"});
