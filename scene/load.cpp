@@ -29,6 +29,7 @@
 
 #include "scene/builtin.h"
 #include "scene/camera.h"
+#include "scene/suggest.h"
 
 namespace octray {
 namespace {
@@ -127,47 +128,11 @@ std::string index_path(const std::string& path, std::size_t i) {
     return path + "[" + std::to_string(i) + "]";
 }
 
-// Edit distance counting a swap of neighbours as one edit (optimal string alignment), so
-// that "widht" is one typo away from "width".
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-    const std::size_t w = b.size() + 1;
-    std::vector<std::size_t> d((a.size() + 1) * w);
-    for (std::size_t i = 0; i <= a.size(); ++i) d[i * w] = i;
-    for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            std::size_t best = std::min(
-                {d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + cost});
-            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
-                best = std::min(best, d[(i - 2) * w + j - 2] + 1);
-            }
-            d[i * w + j] = best;
-        }
-    }
-    return d[a.size() * w + b.size()];
-}
-
-// " (did you mean "x"?)" when one candidate is close, else "".
+// " (did you mean "x"?)" when one candidate is close (scene/suggest.h), else "".
 std::string suggestion(std::string_view word, std::span<const std::string_view> candidates) {
-    // The edit distance costs |word| x |candidate| time and memory; beyond a few dozen
-    // characters a typo is unlikely and two long names would make it quadratic.
-    if (word.size() > kMaxQuotedLength) return "";
-    const std::size_t limit = std::clamp<std::size_t>(word.size() / 3, 1, 2);
-    std::string_view best;
-    std::size_t best_distance = std::numeric_limits<std::size_t>::max();
-    for (std::string_view c : candidates) {
-        // The distance is at least the difference in length.
-        if (c.size() > word.size() + limit || word.size() > c.size() + limit) continue;
-        const std::size_t d = edit_distance(word, c);
-        if (d < best_distance) {
-            best = c;
-            best_distance = d;
-        }
-    }
-    // Up to a third of the word may be wrong (at least one edit, at most two).
-    if (best_distance == 0 || best_distance > limit) return "";
-    return " (did you mean " + quote_text(best) + "?)";
+    const auto best = closest_word(word, candidates);
+    if (!best) return "";
+    return " (did you mean " + quote_text(*best) + "?)";
 }
 
 std::string join_quoted(std::span<const std::string_view> words) {
