@@ -644,6 +644,22 @@ TEST(SceneLoadError, ThinLens) {
                       {"missing required key \"aperture\"", "lens radius"});
 }
 
+// Issue 23: strict JSON means the whole file: a NUL byte does not end the text (the JSON
+// library stops at one), it is an error that says where it is.
+TEST(SceneLoadError, NulBytesAreErrorsWithTheirPosition) {
+    const std::string valid = "{\n  \"camera\": {\"eye\": [0, 0, 5], \"lookat\": [0, 0, 0]}\n}";
+    ASSERT_NO_THROW(parse_scene_json(valid, kFile));
+    expect_text_error(valid + std::string("\0{\"garbage\":", 12), "",
+                      {"NUL byte", "line 3, column 2"});
+    expect_text_error(valid + std::string(1, '\0'), "", {"NUL byte", "line 3, column 2"});
+    std::string middle = valid;
+    middle[13] = '\0';  // the blank after "camera":
+    expect_text_error(middle, "", {"NUL byte", "line 2, column 12"});
+    std::string in_string = valid;
+    in_string.replace(in_string.find("eye"), 1, std::string(1, '\0'));
+    expect_text_error(in_string, "", {"NUL byte", "line 2, column 15"});
+}
+
 TEST(SceneLoadError, OrthographicWidth) {
     Json j = full_scene();
     j["camera"] = {
