@@ -52,6 +52,19 @@ constexpr std::int64_t kFramebufferBytesPerPixel = 12;  // three floats
 constexpr double kUnitTolerance = 1e-6;
 // validate_scene is looser: it only has to catch normals that were never normalised.
 constexpr double kValidateUnitTolerance = 1e-5;
+// Refraction scales directions by the index ratio (or its inverse); far beyond real
+// materials (1 to about 4) the float refraction vector loses its precision and degenerate
+// directions render NaN (issue 23: ior 1e8 did, 1e7 too). 100 leaves a wide margin.
+constexpr float kMinIor = 0.01f;
+constexpr float kMaxIor = 100.0f;
+// A thin lens much wider than its focus distance starts rays so far off the view axis that
+// float precision breaks down: measured on the built-in and golden scenes, 10 x renders
+// normal values, 100 x absurd ones and 300 x infinite or NaN pixels (issue 23: aperture
+// 1e20 rendered 13915 of 14400 pixels NaN).
+constexpr float kMaxApertureRatio = 10.0f;
+// Beyond this the focal point's distance overflows float when squared (a focus distance
+// of 1e20 renders every pixel NaN, even through a pinhole-sized lens).
+constexpr float kMaxFocusDistance = 1e18f;
 
 // ---------------------------------------------------------------------------------------
 // Formatting helpers
@@ -986,6 +999,23 @@ class Validator {
             case CameraType::thinlens:
                 non_negative(c.aperture, "camera.aperture", "a lens radius");
                 positive(c.focus_distance, "camera.focus_distance", "a focus distance");
+                if (c.focus_distance > kMaxFocusDistance) {
+                    fail("camera.focus_distance",
+                         "expected a focus distance of at most " +
+                             format_float(kMaxFocusDistance) +
+                             " (farther, the focal point overflows float), found " +
+                             format_float(c.focus_distance));
+                }
+                if (c.aperture > kMaxApertureRatio * c.focus_distance) {
+                    fail("camera.aperture",
+                         "expected a lens radius of at most 10 x the focus distance (here 10 "
+                         "x " +
+                             format_float(c.focus_distance) + " = " +
+                             format_float(kMaxApertureRatio * c.focus_distance) +
+                             "; a wider lens starts rays so far off the view axis that float "
+                             "precision breaks down), found " +
+                             format_float(c.aperture));
+                }
                 break;
             case CameraType::pinhole:
             case CameraType::fisheye:
@@ -1038,6 +1068,13 @@ class Validator {
             color(m.reflect, child_path(path, "reflect"));
             non_negative(m.transmit, child_path(path, "transmit"), "transmit");
             positive(m.ior, child_path(path, "ior"), "an index of refraction");
+            if (m.ior < kMinIor || m.ior > kMaxIor) {
+                fail(child_path(path, "ior"),
+                     "expected an index of refraction from " + format_float(kMinIor) + " to " +
+                         format_float(kMaxIor) +
+                         " (far beyond that ratio refraction loses float precision), found " +
+                         format_float(m.ior));
+            }
             if (m.checker) {
                 const std::string cpath = child_path(path, "checker");
                 color(m.checker->color, child_path(cpath, "color"));
