@@ -213,6 +213,34 @@ TEST_F(CompareCliTest, BadCommandLinesAreRejected) {
     EXPECT_EQ(r.status, 2) << r.output;
 }
 
+// Issue 23: equal infinities are equal (as idiff has it): a depth AOV whose background is
+// +inf matches itself with --fail 0. Different infinities, or one against a number, fail.
+TEST_F(CompareCliTest, EqualInfinitiesAreEqual) {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    ChannelImage z = make_image(4, 4, {"Z"}, 2.0f);
+    z.at(0, 1, 1) = inf;
+    z.at(0, 3, 2) = -inf;
+    write_test_exr(path("z.exr"), z);
+    write_test_exr(path("z2.exr"), z);
+    RunResult r = compare({"z.exr", "z2.exr", "--fail", "0", "--diff", "d.exr"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(last_line(r.output), "PASS: images are identical");
+    const ChannelImage diff = read_image(path("d.exr"));
+    EXPECT_EQ(diff.at(0, 1, 1), 0.0f);
+    EXPECT_EQ(diff.at(0, 3, 2), 0.0f);
+
+    ChannelImage w = z;
+    w.at(0, 1, 1) = -inf;
+    write_test_exr(path("w.exr"), w);
+    r = compare({"z.exr", "w.exr", "--fail", "0"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(last_line(r.output).find("(1 with NaN or Inf)"), std::string::npos) << r.output;
+    ChannelImage f = z;
+    f.at(0, 1, 1) = 1e30f;
+    write_test_exr(path("f.exr"), f);
+    EXPECT_EQ(compare({"z.exr", "f.exr"}).status, 2);
+}
+
 TEST_F(CompareCliTest, HelpListsTheExitCodes) {
     const RunResult r = compare({"--help"});
     EXPECT_EQ(r.status, 0);
