@@ -14,6 +14,7 @@
 #include "render/image_compare.h"
 #include "render/image_io.h"
 #include "render/image_read.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -93,7 +94,8 @@ std::string compare_exit_code_help() {
            "The last line of the report (or \"reason\" in --json) says why.\n";
 }
 
-CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
+// The largest finite threshold: any double.
+constexpr double kMaxThreshold = std::numeric_limits<double>::max();
 
 }  // namespace
 
@@ -108,32 +110,34 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
 
     CompareOptions& o = args->options;
     cmd->add_option("--fail", o.fail_threshold,
-                    "A pixel fails when any channel differs by more than X")
+                    "A pixel fails when any channel differs by more than X (>= 0, or inf)")
         ->type_name("X")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--failpercent", o.fail_percent,
                     "FAIL when more than P% of the pixels fail, 0..100")
         ->type_name("P")
-        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
-    cmd->add_option("--hardfail", o.hard_fail, "FAIL when any one error exceeds H")
+    cmd->add_option("--hardfail", o.hard_fail,
+                    "FAIL when any one error exceeds H (>= 0, or inf: no hard limit)")
         ->type_name("H")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--warn", o.warn_threshold,
-                    "A pixel warns when any channel differs by more than X")
+                    "A pixel warns when any channel differs by more than X (>= 0, or inf)")
         ->type_name("X")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--warnpercent", o.warn_percent,
                     "WARN when more than P% of the pixels warn, 0..100")
         ->type_name("P")
-        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
-    cmd->add_option("--hardwarn", o.hard_warn, "WARN when any one error exceeds H")
+    cmd->add_option("--hardwarn", o.hard_warn,
+                    "WARN when any one error exceeds H (>= 0, or inf: no hard limit)")
         ->type_name("H")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--channels", o.channels,
                     "Compare only these channels, by name (e.g. R,G,B or diffuse.R);\n"
@@ -149,7 +153,9 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
     cmd->add_flag("--json", args->json, "Print the figures as JSON instead of the report");
     cmd->footer(
         "NaN or Inf in either image is an infinite error: the pixel fails and is counted;\n"
-        "the error figures are over the finite values. PSNR = 20 log10(peak / RMSE), peak =\n"
+        "the error figures are over the finite values. Equal infinities (+inf against\n"
+        "+inf, as a depth AOV's background) are equal. Thresholds are decimal numbers\n"
+        "(or inf); NaN is refused. PSNR = 20 log10(peak / RMSE), peak =\n"
         "max(1, largest value). See render/COMPARE.md.\n\n"
         "Examples:\n"
         "  octray compare ref.exr out.exr\n"

@@ -9,8 +9,10 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -31,6 +33,7 @@
 #include "scene/scene.h"
 #include "scene/scene_error.h"
 #include "tools/batch.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
 #include "tools/render_batch.h"
@@ -383,7 +386,7 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         cmd->add_option("--shard-count", args->shard_count,
                         "The number of shards for --shard auto with JOB_COMPLETION_INDEX")
             ->type_name("N")
-            ->check(quiet(CLI::Range(1, 1 << 20)));
+            ->transform(decimal_integer(1, 1 << 20));
     cmd->add_flag("--skip-existing", args->skip_existing,
                   "Resume: leave frames whose output already exists (outputs are written\n"
                   "atomically, so an existing file is a finished frame; an empty one is a\n"
@@ -419,38 +422,34 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         cmd->add_option("--width", args->width,
                         "Image width in pixels, 1..65536 (overrides the scene)")
             ->type_name("W")
-            ->check(quiet(CLI::Range(1, 65536)));
+            ->transform(decimal_integer(1, 65536));
     args->height_option =
         cmd->add_option("--height", args->height,
                         "Image height in pixels, 1..65536 (overrides the scene)")
             ->type_name("H")
-            ->check(quiet(CLI::Range(1, 65536)));
+            ->transform(decimal_integer(1, 65536));
     args->spp_option =
         cmd->add_option("--spp", args->spp,
                         "Samples per pixel, 1..2^20; square counts are stratified, others\n"
                         "jittered (overrides the scene)")
             ->type_name("N")
-            ->check(quiet(CLI::Range(1, 1 << 20)));
+            ->transform(decimal_integer(1, 1 << 20));
     args->max_depth_option =
         cmd->add_option("--max-depth", args->max_depth,
                         "Reflection/refraction bounces, 0..1000; 0 = primary rays only\n"
                         "(overrides the scene)")
             ->type_name("D")
-            ->check(quiet(CLI::Range(0, 1000)));
+            ->transform(decimal_integer(0, 1000));
     args->seed_option =
         cmd->add_option("--seed", args->seed,
                         "Seed of the sample jitter, 0..2^64-1 (overrides the scene)")
             ->type_name("S")
-            // CLI11 would wrap a negative number around into a huge unsigned one.
-            ->check([](const std::string& text) {
-                return text.find('-') == std::string::npos ? std::string()
-                                                           : "the seed cannot be negative";
-            });
+            ->transform(decimal_integer(0, std::numeric_limits<std::uint64_t>::max()));
     cmd->add_option("--threads", args->threads,
                     "Worker threads, 0..4096; 0 = every core available (the image does not\n"
                     "depend on it)")
         ->type_name("N")
-        ->check(quiet(CLI::Range(0, 4096)))
+        ->transform(decimal_integer(0, 4096))
         ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer);\n"

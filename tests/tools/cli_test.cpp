@@ -324,6 +324,42 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 23: integer options take decimal digits only, as scene files do: no hex, no sign,
+// no blanks, and nothing out of range is clamped.
+TEST_F(CliTest, IntegerOptionsTakeDecimalDigitsOnly) {
+    const std::vector<std::vector<std::string>> bad = {
+        {"render", "random:2", "--seed", "18446744073709551616"},
+        {"render", "random:2", "--seed", "99999999999999999999999"},
+        {"render", "random:2", "--seed", "0x10"},
+        {"render", "random:2", "--seed", "+5"},
+        {"render", "random:2", "--seed", " 5"},
+        {"render", "random:2", "--seed", "5 "},
+        {"render", "random:2", "--width", "0x10"},
+        {"render", "random:2", "--height", "+8"},
+        {"render", "random:2", "--spp", " 4"},
+        {"render", "random:2", "--threads", "1e1"},
+        {"render", "random:2", "--max-depth", "010x"},
+        {"verify", "random:2", "--width", "0x10"},
+        {"verify", "random:2", "--threads", "+1"},
+        {"bench", "no-such-scene.json", "--no-embree", "--reps", "0x2"},
+    };
+    for (const auto& args : bad) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[2] << " " << args[3] << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, args[args.size() - 2])) << r.output;
+        EXPECT_TRUE(contains(r.output, "--help")) << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+
+    const RunResult top = octray({"render", "random:2,width=4,height=4", "--seed",
+                                  "18446744073709551615", "-o", "s.exr"});
+    ASSERT_EQ(top.status, 0) << top.output;
+    Imf::InputFile file(path("s.exr").c_str());
+    const auto* seed = file.header().findTypedAttribute<Imf::StringAttribute>("octray.seed");
+    ASSERT_NE(seed, nullptr);
+    EXPECT_EQ(seed->value(), "18446744073709551615");
+}
+
 // The SIMD packet path (the default) writes the same pixels as the scalar reference, under
 // every --isa; `verify` agrees and `info` names the ISA it uses.
 TEST_F(CliTest, SimdPathMatchesScalarAndVerifyPasses) {

@@ -213,6 +213,40 @@ TEST_F(CompareCliTest, BadCommandLinesAreRejected) {
     EXPECT_EQ(r.status, 2) << r.output;
 }
 
+// Issue 23: a NaN threshold would make every comparison pass (nothing is "> NaN"): it is a
+// usage error for every threshold option.
+TEST_F(CompareCliTest, NanThresholdsAreUsageErrors) {
+    write_pair(0.125f);
+    for (const char* option :
+         {"--fail", "--warn", "--failpercent", "--warnpercent", "--hardfail", "--hardwarn"}) {
+        for (const char* value : {"nan", "NaN", "-nan"}) {
+            const RunResult r = compare({"a.exr", "b.exr", option, value});
+            EXPECT_EQ(r.status, 2) << option << " " << value << "\n" << r.output;
+            EXPECT_NE(r.output.find(option), std::string::npos) << r.output;
+            EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
+        }
+    }
+    const RunResult both = compare({"a.exr", "b.exr", "--fail", "nan", "--warn", "nan"});
+    EXPECT_EQ(both.status, 2) << both.output;
+    EXPECT_NE(both.output.find("--help"), std::string::npos) << both.output;
+}
+
+// Issue 23: inf, the documented default of the hard limits, can be given; thresholds take
+// decimal numbers and inf, nothing else.
+TEST_F(CompareCliTest, InfinityIsAValidThreshold) {
+    write_pair(0.125f);
+    RunResult r = compare({"a.exr", "b.exr", "--failpercent", "2", "--warnpercent", "2",
+                           "--hardfail", "inf", "--hardwarn", "inf"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    r = compare({"a.exr", "b.exr", "--fail", "inf", "--warn", "Infinity"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    for (const char* value : {"-inf", "-1", "0x1p3", "1e999", "", " 1", "1x"}) {
+        r = compare({"a.exr", "b.exr", "--hardfail", value});
+        EXPECT_EQ(r.status, 2) << "'" << value << "'\n" << r.output;
+        EXPECT_NE(r.output.find("--help"), std::string::npos) << value << "\n" << r.output;
+    }
+}
+
 // Issue 23: equal infinities are equal (as idiff has it): a depth AOV whose background is
 // +inf matches itself with --fail 0. Different infinities, or one against a number, fail.
 TEST_F(CompareCliTest, EqualInfinitiesAreEqual) {

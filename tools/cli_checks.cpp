@@ -1,0 +1,125 @@
+// Checks every command shares (tools/cli_checks.h).
+
+#include "tools/cli_checks.h"
+
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <system_error>
+#include <vector>
+
+#include "scene/suggest.h"
+#include "tools/commands.h"
+
+namespace octray::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A value quoted for a message: control bytes as \xNN, cut after 64 characters.
+std::string quote_value(std::string_view text) {
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out = "\"";
+    for (std::size_t i = 0; i < std::min<std::size_t>(text.size(), 64); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x20 || c == 0x7f) {
+            out += "\\x";
+            out += kHex[c >> 4];
+            out += kHex[c & 15];
+        } else {
+            out += static_cast<char>(c);
+        }
+    }
+    if (text.size() > 64) out += "...";
+    return out + "\"";
+}
+
+std::string lowercase(std::string_view text) {
+    std::string out(text);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+}
+
+std::string format_real(double value) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
+}  // namespace
+
+std::optional<std::uint64_t> parse_decimal_integer(std::string_view text) {
+    if (text.empty() ||
+        !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
+        return std::nullopt;
+    std::uint64_t value = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
+    return value;
+}
+
+CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi) {
+    const std::string range = "an integer from " + std::to_string(lo) + " to " +
+                              std::to_string(hi) + " in decimal digits";
+    return CLI::Validator(
+        [range, lo, hi](std::string& text) -> std::string {
+            const auto value = parse_decimal_integer(text);
+            if (!value || *value < lo || *value > hi)
+                return "expected " + range +
+                       " (no sign, blank, 0x prefix, fraction or exponent), found " +
+                       quote_value(text);
+            text = std::to_string(*value);  // what CLI11 converts: canonical decimal
+            return {};
+        },
+        "");
+}
+
+CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
+    std::string range =
+        hi == std::numeric_limits<double>::max()
+            ? "a decimal number >= " + format_real(lo)
+            : "a decimal number from " + format_real(lo) + " to " + format_real(hi);
+    if (allow_infinity) range += ", or inf";
+    return CLI::Validator(
+        [range, lo, hi, allow_infinity](std::string& text) -> std::string {
+            double value = 0.0;
+            const char* first = text.data();
+            const char* last = text.data() + text.size();
+            const auto [end, error] = std::from_chars(first, last, value);
+            const std::string lower = lowercase(text);
+            const bool infinity_word = lower == "inf" || lower == "infinity";
+            if (error != std::errc() || end != last || text.empty() ||
+                (std::isinf(value) && !infinity_word))
+                return "expected " + range + ", found " + quote_value(text);
+            if (std::isnan(value))
+                return "expected " + range + ", found " + quote_value(text) +
+                       " (NaN compares false with everything, so it would pass any pair)";
+            if (std::isinf(value) && (!allow_infinity || value < 0))
+                return "expected " + range + ", found " + quote_value(text);
+            if (std::isfinite(value) && (value < lo || value > hi))
+                return "expected " + range + ", found " + quote_value(text);
+            if (std::isinf(value)) {
+                text = "inf";
+            } else {
+                char exact[64];
+                std::snprintf(exact, sizeof exact, "%a", value);  // exact, for CLI11's strtold
+                text = exact;
+            }
+            return {};
+        },
+        "");
+}
+
+}  // namespace octray::tools
