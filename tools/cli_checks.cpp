@@ -122,4 +122,42 @@ CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
         "");
 }
 
+std::optional<ImageFormat> image_format_of(std::string_view path) {
+    const std::string name = fs::path(path).filename().string();
+    const std::size_t dot = name.rfind('.');
+    if (dot == std::string::npos || dot == 0) return std::nullopt;
+    const std::string extension = lowercase(std::string_view(name).substr(dot));
+    if (extension == ".exr") return ImageFormat::exr;
+    if (extension == ".png") return ImageFormat::png;
+    return std::nullopt;
+}
+
+ImageFormat require_image_format(std::string_view option, const std::string& path,
+                                 bool png_accepted, std::string_view advice) {
+    const auto format = image_format_of(path);
+    if (format && (png_accepted || *format == ImageFormat::exr)) return *format;
+    std::string message = std::string(option) + " " + quote_value(path) +
+                          ": the file name's extension chooses the format, and octray writes " +
+                          (png_accepted ? "OpenEXR (.exr) and 8-bit sRGB PNG (.png) here"
+                                        : "only OpenEXR (.exr) here");
+    if (!advice.empty()) message += "; " + std::string(advice);
+    throw UsageError(message);
+}
+
+std::string directory_identity(const std::string& dir) {
+    const std::string path = dir.empty() ? "." : dir;
+    struct stat info {};
+    if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
+        return "device " + std::to_string(info.st_dev) + ", inode " +
+               std::to_string(info.st_ino) + ": ";
+    std::error_code error;
+    const fs::path absolute = fs::absolute(path, error);
+    return "path " + (error ? fs::path(path) : absolute).lexically_normal().string() + "/";
+}
+
+std::string output_identity(const std::string& path) {
+    const fs::path file(path);
+    return directory_identity(file.parent_path().string()) + file.filename().string();
+}
+
 }  // namespace octray::tools

@@ -1,6 +1,7 @@
 #pragma once
-// Checks every command shares: strict numbers for options, each failure a message saying
-// what was given and what is expected.
+// Checks every command shares: strict numbers for options, output formats chosen by the
+// file name and output files compared by identity. Each failure is a message saying what
+// was given and what is expected.
 
 #include <cstdint>
 #include <optional>
@@ -29,5 +30,30 @@ CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi);
 // case) when `allow_infinity`. NaN, hex floats, signs other than a leading '-', blanks and
 // values that overflow to infinity are refused. Use with CLI::Option::transform.
 CLI::Validator real_number(double lo, double hi, bool allow_infinity);
+
+// ---- Output files --------------------------------------------------------------------
+
+enum class ImageFormat { exr, png };
+
+// The format a file name asks for by its extension, case-insensitively: ".exr" or ".png";
+// nullopt for any other or none.
+std::optional<ImageFormat> image_format_of(std::string_view path);
+
+// The format of an output named by `option` (such as "-o"): its extension's, which must be
+// one of `accepted` (".exr", or ".exr and .png"); else a UsageError that names the file,
+// the formats and `advice`.
+ImageFormat require_image_format(std::string_view option, const std::string& path,
+                                 bool png_accepted, std::string_view advice);
+
+// What a write to `path` replaces (octray writes a temporary and renames it over the
+// target): the directory entry, as the device and inode of the parent directory plus the
+// file name. Two paths with one identity are one file however they are spelled (".",
+// "..", symlinks). When the parent does not exist yet, its lexically normal absolute path
+// stands in for it.
+std::string output_identity(const std::string& path);
+
+// The directory part of output_identity: for `dir` ("" is the current directory), a key
+// such that output_identity(dir / name) == directory_identity(dir) + name.
+std::string directory_identity(const std::string& dir);
 
 }  // namespace octray::tools

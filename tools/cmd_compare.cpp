@@ -45,8 +45,14 @@ void print_json_outcome(const CompareArguments& args, std::string_view verdict, 
 }
 
 void run_compare(const CompareArguments& args) {
-    if (!args.diff.empty() && args.diff == args.heatmap)
-        throw UsageError("--diff and --heatmap name the same file: " + args.diff);
+    if (!args.diff.empty())
+        require_image_format("--diff", args.diff, /*png_accepted=*/false,
+                             "--diff is |A - B| in float; for a PNG picture of the error "
+                             "use --heatmap FILE.png");
+    if (!args.diff.empty() && !args.heatmap.empty() &&
+        output_identity(args.diff) == output_identity(args.heatmap))
+        throw UsageError("--diff and --heatmap name the same file: " + args.diff + " and " +
+                         args.heatmap);
 
     ChannelImage a, b;
     CompareResult result;
@@ -144,8 +150,10 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
                     "default: all, and both images must have the same channel names")
         ->type_name("LIST")
         ->delimiter(',');
-    cmd->add_option("--diff", args->diff, "Write |A - B| of the compared channels as float EXR")
-        ->type_name("FILE");
+    cmd->add_option("--diff", args->diff,
+                    "Write |A - B| of the compared channels as float OpenEXR; FILE must end\n"
+                    "in .exr (any case)")
+        ->type_name("FILE.exr");
     cmd->add_option("--heatmap", args->heatmap,
                     "Write a PNG heatmap of the largest channel error per pixel (magma,\n"
                     "0 to the max error, legend below; NaN/Inf in green)")

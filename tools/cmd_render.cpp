@@ -2,9 +2,11 @@
 // (one still by default; animations, frame ranges, several scenes, shards of a farm job)
 // to EXR (+ PNG previews). The frame loop itself lives in render_batch.cpp.
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
@@ -75,6 +77,7 @@ struct RenderArguments {
     CLI::Option* max_depth_option = nullptr;
     CLI::Option* seed_option = nullptr;
     CLI::Option* shard_count_option = nullptr;
+    CLI::Option* compression_option = nullptr;
 };
 
 struct TileSize {
@@ -169,10 +172,29 @@ std::string default_pattern(bool sequence) {
 void check_output_directory(const fs::path& file) {
     fs::path dir = file.parent_path();
     if (dir.empty()) dir = ".";
-    std::error_code error;
-    if (!fs::is_directory(dir, error))
-        throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
-                      " does not exist");
+    struct stat info {};
+    if (::stat(dir.c_str(), &info) != 0) {
+        const int error = errno;
+        // A file in the way is the reason, not a missing directory: name it.
+        if (error == ENOTDIR) {
+            for (fs::path up = dir.parent_path(); !up.empty(); up = up.parent_path()) {
+                if (::stat(up.c_str(), &info) == 0) {
+                    if (!S_ISDIR(info.st_mode))
+                        throw IoError("cannot write " + file.string() + ": " + up.string() +
+                                      " is a file, not a directory");
+                    break;
+                }
+            }
+        }
+        if (error == ENOENT)
+            throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
+                          " does not exist");
+        throw IoError("cannot write " + file.string() + ": " + dir.string() + ": " +
+                      std::strerror(error));
+    }
+    if (!S_ISDIR(info.st_mode))
+        throw IoError("cannot write " + file.string() + ": " + dir.string() +
+                      " is a file, not a directory");
     if (::access(dir.c_str(), W_OK | X_OK) != 0)
         throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
                       " is not writable");
@@ -216,14 +238,26 @@ std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
         throw UsageError(std::string("output pattern: ") + e.what());
     }
 
-    // Two frames must never share a file (several scenes without {scene}, say).
+    // Two frames must never share a file (several scenes without {scene}, say). Files are
+    // told apart by what a write replaces, the directory entry (device and inode of the
+    // directory plus the name), so no spelling ("./", "..", a symlink) hides a clash.
     std::map<std::string, std::size_t> owner;
+    std::map<std::string, std::string> directories;  // each directory looked up once
+    const auto identity = [&directories](const std::string& file) {
+        const fs::path path(file);
+        const std::string dir = path.parent_path().string();
+        auto it = directories.find(dir);
+        if (it == directories.end())
+            it = directories.emplace(dir, directory_identity(dir)).first;
+        return it->second + path.filename().string();
+    };
     for (std::size_t j = 0; j < jobs.size(); ++j) {
-        if (!jobs[j].png.empty() && fs::path(jobs[j].png) == fs::path(jobs[j].output))
-            throw UsageError("-o and --png name the same file: " + jobs[j].output);
+        if (!jobs[j].png.empty() && identity(jobs[j].png) == identity(jobs[j].output))
+            throw UsageError("-o and --png name the same file: " + jobs[j].output + " and " +
+                             jobs[j].png);
         for (const std::string* file : {&jobs[j].output, &jobs[j].png}) {
             if (file->empty()) continue;
-            const std::string key = fs::absolute(*file).lexically_normal().string();
+            const std::string key = identity(*file);
             const auto [it, inserted] = owner.emplace(key, j);
             if (!inserted) {
                 const BatchJob& other = jobs[it->second];
@@ -238,6 +272,34 @@ std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
         }
     }
     return jobs;
+}
+
+// The format of -o, from its extension: OpenEXR, or the 8-bit sRGB PNG that --png writes.
+// A PNG holds 8-bit R, G, B and no header attributes, so the options that only an EXR can
+// carry are refused with it rather than silently dropped.
+ImageFormat output_format(const RenderArguments& args) {
+    if (args.output.empty()) return ImageFormat::exr;
+    const ImageFormat format =
+        require_image_format("-o", args.output, /*png_accepted=*/true,
+                             "--png FILE.png writes an 8-bit PNG preview next to an EXR -o");
+    if (format == ImageFormat::exr) return format;
+    const std::string png = "-o " + args.output + " writes an 8-bit sRGB PNG";
+    if (!args.png.empty())
+        throw UsageError(png +
+                         " already; --png adds a PNG preview next to an OpenEXR -o "
+                         "(-o FILE.exr --png FILE.png writes both)");
+    if (!args.aov.empty())
+        throw UsageError(png + ", which holds R, G, B only; --aov needs an OpenEXR -o (.exr)");
+    if (args.float32)
+        throw UsageError(png + "; --float sets the channel type of an OpenEXR -o (.exr)");
+    if (args.compression_option->count())
+        throw UsageError(png + "; --compression is the codec of an OpenEXR -o (.exr)");
+    if (args.progressive)
+        throw UsageError(png +
+                         "; --progressive needs an OpenEXR -o (.exr): it marks an unfinished "
+                         "pass in the EXR header (octray.samplesSoFar), which a PNG cannot "
+                         "carry, so a resume could not tell it from a finished frame");
+    return format;
 }
 
 batch::Shard resolve_shard(const RenderArguments& args) {
@@ -276,6 +338,7 @@ void run_render(const RenderArguments& args) {
     if (!compression) throw UsageError("--compression: unknown codec " + args.compression);
     settings.exr = {args.float32, *compression};
     settings.progressive = args.progressive;
+    settings.png_output = output_format(args) == ImageFormat::png;
     settings.skip_existing = args.skip_existing;
     settings.placeholders = args.placeholders;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
@@ -367,9 +430,12 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("SCENE...")
         ->capture_default_str();
     cmd->add_option("-o,--output", args->output,
-                    "Output EXR file or pattern: # runs or {frame:04d} become the frame\n"
-                    "number, {scene} the scene's name [default: {scene}.exr for a still,\n"
-                    "{scene}.####.exr for a sequence, in the current directory]")
+                    "Output file or pattern: # runs or {frame:04d} become the frame\n"
+                    "number, {scene} the scene's name. The extension (any case) picks the\n"
+                    "format: .exr OpenEXR, .png the 8-bit sRGB preview --png writes (no\n"
+                    "--png, --aov, --float, --compression or --progressive with it)\n"
+                    "[default: {scene}.exr for a still, {scene}.####.exr for a sequence,\n"
+                    "in the current directory]")
         ->type_name("PATTERN");
     cmd->add_option("--frames", args->frames,
                     "Frames to render: 5, 1-100, 1-100:2 (every 2nd), lists: 1-10,20,30-40:5\n"
@@ -473,16 +539,19 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->capture_default_str();
     cmd->add_option(
            "--png", args->png,
-           "Also write an 8-bit sRGB PNG preview (clamped to [0,1]); a pattern like -o")
+           "Also write an 8-bit sRGB PNG preview (clamped to [0,1]) next to an OpenEXR\n"
+           "-o; a pattern like -o. Always PNG, whatever the name; it must name another\n"
+           "file than -o")
         ->type_name("FILE");
     cmd->add_flag("--float", args->float32, "Write 32-bit float channels instead of half");
-    cmd->add_option("--compression", args->compression,
-                    "EXR codec: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab\n"
-                    "(pxr24 is lossy for --float; b44*, dwa* are lossy)")
-        ->type_name("C")
-        ->check(quiet(CLI::IsMember(
-            {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})))
-        ->capture_default_str();
+    args->compression_option =
+        cmd->add_option("--compression", args->compression,
+                        "EXR codec: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab\n"
+                        "(pxr24 is lossy for --float; b44*, dwa* are lossy)")
+            ->type_name("C")
+            ->check(quiet(CLI::IsMember(
+                {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})))
+            ->capture_default_str();
     cmd->add_option("--tile", args->tile,
                     "Tile size WxH (or N for NxN) handed to the worker threads; the image\n"
                     "does not depend on it")
@@ -496,6 +565,7 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray render                                  # whitted scene -> whitted.exr\n"
         "  octray render whitted -o whitted.exr --png whitted.png\n"
+        "  octray render whitted -o whitted.png            # only the 8-bit sRGB PNG\n"
         "  octray render random:1024,width=640,height=360 --spp 4 -o random.exr\n"
         "  octray render shot.json --frames 1-100:2,150 -o out/shot.####.exr\n"
         "  octray render a.json b.json -o 'out/{scene}.{frame:04d}.exr' --skip-existing\n"

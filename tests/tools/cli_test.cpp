@@ -20,7 +20,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "run_octray.h"
@@ -112,6 +114,28 @@ bool same_bits(const ExrPixels& a, const ExrPixels& b) {
 
 bool any_nonzero(const ExrPixels& p) {
     return std::any_of(p.rgb.begin(), p.rgb.end(), [](float v) { return v != 0.0f; });
+}
+
+// The first `n` bytes of a file ("" if it cannot be read).
+std::string file_head(const fs::path& file, std::size_t n) {
+    std::ifstream in(file, std::ios::binary);
+    std::string bytes(n, '\0');
+    in.read(bytes.data(), static_cast<std::streamsize>(n));
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
+    return bytes;
+}
+
+std::string file_bytes(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+bool is_png_file(const fs::path& file) {
+    return file_head(file, 8) == std::string("\x89PNG\r\n\x1a\n", 8);
+}
+
+bool is_exr_file(const fs::path& file) {
+    return file_head(file, 4) == std::string("\x76\x2f\x31\x01", 4);
 }
 
 TEST_F(CliTest, VersionPrintsTheVersion) {
@@ -324,6 +348,68 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 23: the extension of -o decides the format (case-insensitive); a PNG output is the
+// --png preview, byte for byte; frame patterns follow the same rule.
+TEST_F(CliTest, OutputFormatFollowsTheExtension) {
+    const std::string spec = "random:4,width=16,height=12";
+    RunResult r = octray({"render", spec, "-o", "a.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_png_file(dir_ / "a.png"));
+    r = octray({"render", spec, "-o", "b.PNG"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_png_file(dir_ / "b.PNG"));
+    r = octray({"render", spec, "-o", "c.Exr"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_exr_file(dir_ / "c.Exr"));
+    r = octray({"render", spec, "-o", "d.exr", "--png", "d.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_exr_file(dir_ / "d.exr"));
+    EXPECT_EQ(file_bytes(dir_ / "a.png"), file_bytes(dir_ / "d.png"));
+    r = octray({"render", spec, "--frames", "0-1", "-o", "f.####.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_png_file(dir_ / "f.0000.png"));
+    EXPECT_TRUE(is_png_file(dir_ / "f.0001.png"));
+    EXPECT_EQ(entries(), (std::vector<std::string>{"a.png", "b.PNG", "c.Exr", "d.exr", "d.png",
+                                                   "f.0000.png", "f.0001.png"}));
+}
+
+TEST_F(CliTest, UnknownOutputExtensionIsAUsageErrorNamingTheFormats) {
+    const std::string spec = "random:4,width=16,height=12";
+    for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+             {"render", spec, "-o", "out.jpg"},
+             {"render", spec, "-o", "out"},
+             {"render", spec, "-o", "out.exr.bak"},
+             {"render", spec, "--frames", "0-1", "-o", "f.####.tif"},
+         }) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[3] << "\n" << r.output;
+        for (const char* part : {".exr", ".png", "--png", "--help"})
+            EXPECT_TRUE(contains(r.output, part)) << part << "\n" << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
+// A PNG output holds 8-bit RGB only: what only an EXR can hold is refused, not dropped.
+TEST_F(CliTest, PngOutputRefusesWhatOnlyAnExrHolds) {
+    const std::string spec = "random:4,width=16,height=12";
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"--png", "b.png"}, "--png"},
+        {{"--aov", "depth"}, "--aov"},
+        {{"--float"}, "--float"},
+        {{"--compression", "piz"}, "--compression"},
+        {{"--progressive"}, "--progressive"},
+    };
+    for (const auto& [extra, option] : cases) {
+        std::vector<std::string> args = {"render", spec, "-o", "a.png"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << option << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, option)) << option << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "PNG")) << option << "\n" << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
 // Issue 23: integer options take decimal digits only, as scene files do: no hex, no sign,
 // no blanks, and nothing out of range is clamped.
 TEST_F(CliTest, IntegerOptionsTakeDecimalDigitsOnly) {
@@ -358,6 +444,41 @@ TEST_F(CliTest, IntegerOptionsTakeDecimalDigitsOnly) {
     const auto* seed = file.header().findTypedAttribute<Imf::StringAttribute>("octray.seed");
     ASSERT_NE(seed, nullptr);
     EXPECT_EQ(seed->value(), "18446744073709551615");
+}
+
+// Issue 23: -o and --png are the same file when they name one directory entry, however
+// spelled (here through a symlink to "." and ".."); the check compares identities.
+TEST_F(CliTest, OutputsAreComparedByIdentityNotSpelling) {
+    fs::create_directory(dir_ / "sub");
+    fs::create_directory_symlink(".", dir_ / "sub" / "self");
+    const std::string spec = "random:2,width=8,height=8";
+    for (const char* png : {"sub/self/../s3.exr", "./s3.exr", "sub/../s3.exr"}) {
+        const RunResult r = octray({"render", spec, "-o", "s3.exr", "--png", png});
+        EXPECT_EQ(r.status, 2) << png << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "same file")) << r.output;
+        EXPECT_FALSE(fs::exists(dir_ / "s3.exr")) << png;
+    }
+    // Different names in one directory are different files.
+    const RunResult ok = octray({"render", spec, "-o", "s3.exr", "--png", "sub/self/s3.png"});
+    EXPECT_EQ(ok.status, 0) << ok.output;
+    EXPECT_TRUE(is_exr_file(dir_ / "s3.exr"));
+    EXPECT_TRUE(is_png_file(dir_ / "sub" / "s3.png"));
+}
+
+// Issue 23: an output below a regular file says so, rather than "does not exist".
+TEST_F(CliTest, OutputBelowAFileSaysTheParentIsAFile) {
+    { std::ofstream(dir_ / "plain") << "not a directory\n"; }
+    for (const char* out : {"plain/out.exr", "plain/deeper/out.exr"}) {
+        const RunResult r = octray({"render", "random:2,width=8,height=8", "-o", out});
+        EXPECT_EQ(r.status, 4) << out << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "plain is a file, not a directory")) << r.output;
+        EXPECT_FALSE(contains(r.output, "does not exist")) << r.output;
+    }
+    const RunResult png = octray(
+        {"render", "random:2,width=8,height=8", "-o", "out.exr", "--png", "plain/p.png"});
+    EXPECT_EQ(png.status, 4) << png.output;
+    EXPECT_TRUE(contains(png.output, "plain is a file, not a directory")) << png.output;
+    EXPECT_EQ(entries(), std::vector<std::string>{"plain"});
 }
 
 // The SIMD packet path (the default) writes the same pixels as the scalar reference, under

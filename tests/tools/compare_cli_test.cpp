@@ -275,6 +275,24 @@ TEST_F(CompareCliTest, EqualInfinitiesAreEqual) {
     EXPECT_EQ(compare({"z.exr", "f.exr"}).status, 2);
 }
 
+// Issue 23: --diff writes float OpenEXR, chosen by the extension like every output; any
+// other extension is a usage error naming the formats.
+TEST_F(CompareCliTest, DiffOutputMustBeAnExr) {
+    write_pair(0.0f);
+    for (const char* name : {"d.png", "d.tif", "d"}) {
+        const RunResult r = compare({"a.exr", "b.exr", "--diff", name});
+        EXPECT_EQ(r.status, 2) << name << "\n" << r.output;
+        EXPECT_NE(r.output.find(".exr"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("--heatmap"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
+        EXPECT_FALSE(testing::fs::exists(dir_ / name)) << name;
+    }
+    const RunResult r = compare({"a.exr", "b.exr", "--diff", "D.EXR"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(read_image(path("D.EXR")).channel_names,
+              (std::vector<std::string>{"R", "G", "B"}));
+}
+
 TEST_F(CompareCliTest, HelpListsTheExitCodes) {
     const RunResult r = compare({"--help"});
     EXPECT_EQ(r.status, 0);
