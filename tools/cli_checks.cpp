@@ -160,4 +160,69 @@ std::string output_identity(const std::string& path) {
     return directory_identity(file.parent_path().string()) + file.filename().string();
 }
 
+std::string mistyped_argument_hint(const CLI::App& app) {
+    // The command the arguments were given to: the deepest one that parsed.
+    const CLI::App* command = &app;
+    std::vector<std::string> unknown = app.remaining();
+    for (;;) {
+        const auto parsed = command->get_subcommands();
+        if (parsed.empty()) break;
+        command = parsed.front();
+        const std::vector<std::string> more = command->remaining();
+        unknown.insert(unknown.end(), more.begin(), more.end());
+    }
+    std::vector<std::string> names;
+    for (const CLI::Option* option : command->get_options()) {
+        for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+        for (const std::string& name : option->get_snames()) names.push_back("-" + name);
+    }
+    const bool top = command == &app;
+    if (top) {
+        for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+            names.push_back(sub->get_name());
+    }
+    const std::vector<std::string_view> candidates(names.begin(), names.end());
+    for (const std::string& argument : unknown) {
+        const bool option = argument.size() > 1 && argument.front() == '-';
+        if (!option && !top) continue;  // a stray value, not a name
+        const std::string_view word =
+            std::string_view(argument).substr(0, option ? argument.find('=') : argument.npos);
+        const auto best = closest_word(word, candidates);
+        if (!best) continue;
+        return std::string("unknown ") + (option ? "option " : "command ") + quote_value(word) +
+               " (did you mean " + quote_value(*best) + "?)";
+    }
+    return {};
+}
+
+namespace {
+
+// Why standard output failed, when a failed write left no errno behind (stdio drops what it
+// could not write): a pipe whose reading end is closed shows POLLERR on its writing end.
+int standard_output_error() {
+    struct stat info {};
+    if (::fstat(STDOUT_FILENO, &info) == 0 && S_ISFIFO(info.st_mode)) {
+        pollfd p{STDOUT_FILENO, POLLOUT, 0};
+        if (::poll(&p, 1, 0) == 1 && (p.revents & POLLERR) != 0) return EPIPE;
+    }
+    return 0;
+}
+
+}  // namespace
+
+int finish_standard_output(int status) {
+    std::cout.flush();
+    bool failed = !std::cout || std::ferror(stdout) != 0;
+    int error = 0;
+    if (std::fflush(stdout) != 0) {
+        failed = true;
+        error = errno;
+    }
+    if (!failed || status != kExitSuccess) return status;
+    if (error == 0) error = standard_output_error();
+    std::cerr << "octray: I/O error: cannot write to standard output: "
+              << (error != 0 ? std::strerror(error) : "write error") << '\n';
+    return kExitIo;
+}
+
 }  // namespace octray::tools

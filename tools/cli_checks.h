@@ -1,7 +1,8 @@
 #pragma once
 // Checks every command shares: strict numbers for options, output formats chosen by the
-// file name and output files compared by identity. Each failure is a message saying what
-// was given and what is expected.
+// file name, output files compared by identity, "did you mean" for mistyped options, and
+// standard output that cannot be written. Each failure is a message saying what was given
+// and what is expected.
 
 #include <cstdint>
 #include <optional>
@@ -55,5 +56,17 @@ std::string output_identity(const std::string& path);
 // The directory part of output_identity: for `dir` ("" is the current directory), a key
 // such that output_identity(dir / name) == directory_identity(dir) + name.
 std::string directory_identity(const std::string& dir);
+
+// ---- Command-line errors and standard output -------------------------------------------
+
+// After a failed parse: "unknown option "--threds" (did you mean "--threads"?)" for the
+// first argument CLI11 could not place that is close to an option of the command it was
+// given to (or to a command name), else "".
+std::string mistyped_argument_hint(const CLI::App& app);
+
+// Flushes standard output. A write that failed (a closed pipe: EPIPE, since octray ignores
+// SIGPIPE; a full disk) is reported on stderr as an I/O error and turns a success into
+// kExitIo; any other status stays.
+int finish_standard_output(int status);
 
 }  // namespace octray::tools

@@ -3,6 +3,8 @@
 // and the exit codes are idiff's; render/COMPARE.md defines them.
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstring>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -85,7 +87,9 @@ void run_compare(const CompareArguments& args) {
                       << result.overall.max_abs_error << ")\n";
         std::cout << format_compare_report(result, args.options, args.a, args.b) << std::flush;
     }
-    if (!std::cout) throw IoError("cannot write the report to standard output");
+    if (!std::cout)
+        throw IoError(std::string("cannot write the report to standard output: ") +
+                      std::strerror(errno));
     if (result.verdict != Verdict::pass) throw CommandExit{static_cast<int>(result.verdict)};
 }
 
@@ -96,7 +100,7 @@ std::string compare_exit_code_help() {
            "  2  FAIL: over the fail limits (also a bad command line, reported on stderr)\n"
            "  3  the images cannot be compared: size, data window or channel mismatch\n"
            "  4  file error: an input is missing, unreadable, not an image, truncated or\n"
-           "     corrupt, or --diff / --heatmap cannot be written\n"
+           "     corrupt, or --diff / --heatmap / standard output cannot be written\n"
            "The last line of the report (or \"reason\" in --json) says why.\n";
 }
 

@@ -9,6 +9,7 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <png.h>
 #include <sys/wait.h>
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -136,6 +138,43 @@ bool is_png_file(const fs::path& file) {
 
 bool is_exr_file(const fs::path& file) {
     return file_head(file, 4) == std::string("\x76\x2f\x31\x01", 4);
+}
+
+struct ClosedStdoutRun {
+    int wait_status = 0;
+    std::string stderr_text;
+};
+
+// Runs `octray <args...>` in `cwd` with its standard output a pipe whose reading end is
+// already closed (as `octray ... | head -0` leaves it), SIGPIPE at its default action.
+ClosedStdoutRun run_with_closed_stdout(const std::vector<std::string>& args,
+                                       const fs::path& cwd) {
+    ClosedStdoutRun result;
+    int fds[2];
+    if (::pipe(fds) != 0) return result;
+    ::close(fds[0]);
+    const fs::path err = cwd / ".stderr.txt";
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        std::signal(SIGPIPE, SIG_DFL);
+        if (::chdir(cwd.c_str()) != 0) ::_exit(120);
+        ::dup2(fds[1], STDOUT_FILENO);
+        const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ::dup2(err_fd, STDERR_FILENO);
+        std::vector<char*> argv;
+        std::string exe = OCTRAY_EXE;
+        argv.push_back(exe.data());
+        std::vector<std::string> copies = args;
+        for (std::string& a : copies) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        ::execv(exe.c_str(), argv.data());
+        ::_exit(121);
+    }
+    ::close(fds[1]);
+    ::waitpid(pid, &result.wait_status, 0);
+    result.stderr_text = file_bytes(err);
+    fs::remove(err);
+    return result;
 }
 
 TEST_F(CliTest, VersionPrintsTheVersion) {
@@ -410,6 +449,35 @@ TEST_F(CliTest, PngOutputRefusesWhatOnlyAnExrHolds) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 23: a mistyped option (or command) names the one probably meant, in every command.
+TEST_F(CliTest, MistypedOptionsSuggestTheClosestOne) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", "--threds", "2"}, "--threads"},
+        {{"render", "--threds=2"}, "--threads"},
+        {{"render", "random:2", "--sed", "1"}, "--seed"},
+        {{"scene", "whitted", "--ouput", "x.json"}, "--output"},
+        {{"compare", "a.exr", "b.exr", "--hardfial", "1"}, "--hardfail"},
+        {{"verify", "--wdth", "8"}, "--width"},
+        {{"bench", "--no-embre"}, "--no-embree"},
+        {{"info", "--hepl"}, "--help"},
+        {{"assemble", "a.exr", "--ouptut", "x.exr"}, "--output"},
+        {{"rendr", "whitted"}, "render"},
+        {{"--verison"}, "--version"},
+    };
+    for (const auto& [args, meant] : cases) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[0] << " " << args[1] << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "did you mean \"" + meant + "\"?")) << args[0] << "\n"
+                                                                           << r.output;
+        EXPECT_TRUE(contains(r.output, "--help")) << r.output;
+    }
+    // Nothing close: no guess.
+    const RunResult far = octray({"render", "--frobnicate"});
+    EXPECT_EQ(far.status, 2) << far.output;
+    EXPECT_FALSE(contains(far.output, "did you mean")) << far.output;
+    EXPECT_TRUE(entries().empty());
+}
+
 // Issue 23: integer options take decimal digits only, as scene files do: no hex, no sign,
 // no blanks, and nothing out of range is clamped.
 TEST_F(CliTest, IntegerOptionsTakeDecimalDigitsOnly) {
@@ -479,6 +547,26 @@ TEST_F(CliTest, OutputBelowAFileSaysTheParentIsAFile) {
     EXPECT_EQ(png.status, 4) << png.output;
     EXPECT_TRUE(contains(png.output, "plain is a file, not a directory")) << png.output;
     EXPECT_EQ(entries(), std::vector<std::string>{"plain"});
+}
+
+// Issue 23: a closed standard output (`octray ... | head -0`) is an I/O error, exit 4 with
+// the reason, not death by SIGPIPE (141 in a shell).
+TEST_F(CliTest, ClosedStandardOutputIsAnIoError) {
+    for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+             {"scene", "whitted"},
+             {"info"},
+             {"render", "random:2,width=8,height=8", "-o", "r.exr", "--progress", "lines"},
+         }) {
+        const ClosedStdoutRun r = run_with_closed_stdout(args, dir_);
+        EXPECT_FALSE(WIFSIGNALED(r.wait_status))
+            << args[0] << " killed by signal " << WTERMSIG(r.wait_status);
+        ASSERT_TRUE(WIFEXITED(r.wait_status)) << args[0];
+        EXPECT_EQ(WEXITSTATUS(r.wait_status), 4) << args[0] << "\n" << r.stderr_text;
+        EXPECT_TRUE(contains(r.stderr_text, "standard output")) << r.stderr_text;
+        EXPECT_TRUE(contains(r.stderr_text, "Broken pipe")) << r.stderr_text;
+    }
+    // The render itself was done: only its report could not be written.
+    EXPECT_TRUE(is_exr_file(dir_ / "r.exr"));
 }
 
 // The SIMD packet path (the default) writes the same pixels as the scalar reference, under
