@@ -537,11 +537,10 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("MODE")
         ->check(quiet(CLI::IsMember({"auto", "bvh", "none"})))
         ->capture_default_str();
-    cmd->add_option(
-           "--png", args->png,
-           "Also write an 8-bit sRGB PNG preview (clamped to [0,1]) next to an OpenEXR\n"
-           "-o; a pattern like -o. Always PNG, whatever the name; it must name another\n"
-           "file than -o")
+    cmd->add_option("--png", args->png,
+                    "Also write an 8-bit sRGB PNG preview (clamped to [0,1]) next to an\n"
+                    "OpenEXR -o; a pattern like -o. Always PNG, whatever the name; it must\n"
+                    "name another file than -o")
         ->type_name("FILE");
     cmd->add_flag("--float", args->float32, "Write 32-bit float channels instead of half");
     args->compression_option =
