@@ -337,12 +337,20 @@ double exact_root(const Object& object, const Ray& ray) {
     const double ox = static_cast<double>(ray.origin.x) - object.center.x;
     const double oy = static_cast<double>(ray.origin.y) - object.center.y;
     const double oz = static_cast<double>(ray.origin.z) - object.center.z;
+    // The renderers' robust form (render/reference.cpp, intersect_sphere) in double: in
+    // double even the textbook b^2 - a c' would cancel for spheres far enough away.
     const double a = dx * dx + dy * dy + dz * dz, b = ox * dx + oy * dy + oz * dz;
-    const double radius = object.radius;
-    const double disc = b * b - a * (ox * ox + oy * oy + oz * oz - radius * radius);
-    if (disc < 0.0) return std::nan("");
-    const double t_near = (-b - std::sqrt(disc)) / a;
-    return t_near > ray.t_min ? t_near : (-b + std::sqrt(disc)) / a;
+    const double radius = object.radius, r2 = radius * radius;
+    const double bt = b / a;
+    const double lx = ox - bt * dx, ly = oy - bt * dy, lz = oz - bt * dz;
+    const double disc = a * (r2 - (lx * lx + ly * ly + lz * lz));
+    if (!(disc >= 0.0)) return std::nan("");
+    const double root = std::sqrt(disc);
+    const double q = b >= 0.0 ? -b - root : -b + root;
+    const double t_q = q / a;
+    const double t_c = q != 0.0 ? (ox * ox + oy * oy + oz * oz - r2) / q : t_q;
+    const double t_near = std::min(t_q, t_c), t_far = std::max(t_q, t_c);
+    return t_near > ray.t_min ? t_near : t_far;
 }
 
 OracleHits oracle_hits_double(const Scene& scene, const RaySet& rays, const OracleHits& like) {

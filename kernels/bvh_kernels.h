@@ -19,16 +19,19 @@
 // operands, same order), and a hit replaces the current one when it is nearer or equally
 // near with a lower file index: the brute-force result (the first listed object wins a
 // tie) whatever the visiting order. Box tests only decide which spheres are tested, so
-// they must never cull a sphere the brute-force quadratic would report. That quadratic
-// rounds: with u = 2^-24, its discriminant b² - (V·V)(O'·O' - r²) is off by at most
-// ~19u (V·V)(|O'|² + r²), and the point at a root it reports lies within
-// sqrt(r² + 19u(|O'|² + r²)) of the center instead of r (for a tiny sphere far from the
-// ray's origin that is far more than r: the brute force "hits" a fuzzy sphere of radius
-// ~sqrt(19u)|O'|). So every box is widened, per ray, by
-//   sqrt(r_min² + 32u(D² + r_max²)) - r_min + 64u(D + max|O|)
+// they must never cull a sphere the brute-force test would report. That test rounds. With
+// u = 2^-24, the robust form (sphere_quadratic) computes l = O' - (b/a)V to within ~9u|O'|,
+// so a lane with disc >= 0 has its ray pass within r + 10u|O'| of the center, and the
+// roots q/a, c'/q put the point within a few u|O'| of that ray's chord (c'/q loses digits
+// only for an origin within ~1e-4 r of the surface moving tangentially, where both true
+// roots are ~0 and the origin lies in the box anyway). So every box is widened, per ray, by
+//   32u D + 64u(D + max|O|)
 // where D is the distance from the ray origin to the farthest corner of the root box
-// (bounding |O'| for every sphere), r_min / r_max the scene's extreme radii, and the last
-// term covers the rounding of the slab test itself (FMA: it decides visits, not values).
+// (bounding |O'| for every sphere): the first term the sphere test's rounding, with room
+// to spare, the second the rounding of the slab test itself (FMA: it decides visits, not
+// values) and of O - c. (The textbook form used before was far worse: a fuzzy sphere of
+// radius ~sqrt(19u)|O'| around a tiny sphere far away, and a widening of
+// sqrt(r_min^2 + 32u(D^2 + r_max^2)) - r_min, up to half a radius on random:1048576.)
 // The tests (tests/kernels/bvh_traversal_test.cpp) check hit for hit against brute force
 // on degenerate scenes (radii from 1e-6 to 1e3, coincident spheres, spheres far apart).
 
@@ -80,12 +83,9 @@ F bvh_margin(const SceneView& s, const V3<F>& o) {
     const F ex = far_extent(o.x, s.bvh_lo[0], s.bvh_hi[0]);
     const F ey = far_extent(o.y, s.bvh_lo[1], s.bvh_hi[1]);
     const F ez = far_extent(o.z, s.bvh_lo[2], s.bvh_hi[2]);
-    const F d2 = ex * ex + ey * ey + ez * ez;
-    const F fuzz = F(kBvhFuzz) * (d2 + F(s.bvh_max_r2));
-    const F r_min(sqrtf(s.bvh_min_r2));
+    const F d = xsimd::sqrt(ex * ex + ey * ey + ez * ez);
     const F o_max = xsimd::max(xsimd::max(xsimd::abs(o.x), xsimd::abs(o.y)), xsimd::abs(o.z));
-    const F m = (xsimd::sqrt(F(s.bvh_min_r2) + fuzz) - r_min) +
-                F(kBvhSlack) * (xsimd::sqrt(d2) + o_max);
+    const F m = F(kBvhFuzz) * d + F(kBvhSlack) * (d + o_max);
     return m * F(1.0f + 0x1.0p-10f);  // the rounding of this very computation
 }
 
@@ -211,8 +211,8 @@ struct BvhRay {
 };
 
 // A ray against spheres i ... i + W - 1 of a leaf (lanes at ... of its `count`): the
-// brute-force arithmetic of packet_kernels.h, operation for operation, so the BVH finds
-// the same t as brute force. `live`: lanes holding a sphere with real roots.
+// brute-force arithmetic of packet_kernels.h (sphere_quadratic, sphere_roots), so the BVH
+// finds the same t as brute force. `live`: lanes holding a sphere with real roots.
 template <class F>
 struct LeafRoots {
     typename F::batch_bool_type live;
@@ -225,14 +225,12 @@ LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t 
     const F zero(0.0f);
     const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
                   F::load_unaligned(s.bvh_cz + i)};
-    const V3<F> oc = sub(ray.o, c);
-    const F b = dot(oc, ray.d);
-    const F cc = dot(oc, oc) - F::load_unaligned(s.bvh_r2 + i);
-    const F disc = b * b - ray.a * cc;
-    const auto live = live_lanes<F>(at, count) && disc >= zero;
+    const SphereQuadratic<F> quad =
+        sphere_quadratic(sub(ray.o, c), ray.d, ray.a, F::load_unaligned(s.bvh_r2 + i));
+    const auto live = live_lanes<F>(at, count) && quad.disc >= zero;
     if (xsimd::none(live)) return {live, zero, zero};
-    const F root = xsimd::sqrt(disc);
-    return {live, (-b - root) / ray.a, (-b + root) / ray.a};
+    const SphereRoots<F> roots = sphere_roots(quad, ray.a);
+    return {live, roots.t_near, roots.t_far};
 }
 
 // Children of `n` in `bits`, nearest first by `entry`: the nearest is returned, the rest
@@ -635,21 +633,16 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
         for (std::uint32_t i = first; i < end; ++i) {
             const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
             const F r2(s.bvh_r2[i]);
-            F b[K], disc[K];
+            SphereQuadratic<F> quad[K];
             auto any_root = zero != zero;
             for (std::uint32_t k = 0; k < K; ++k) {
-                const V3<F> oc = sub(o[k], c);
-                b[k] = dot(oc, d[k]);
-                const F cc = dot(oc, oc) - r2;
-                disc[k] = b[k] * b[k] - a[k] * cc;
-                any_root = any_root || disc[k] >= zero;
+                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                any_root = any_root || quad[k].disc >= zero;
             }
             if (xsimd::none(any_root)) continue;
             const F id(static_cast<float>(s.bvh_object[i]));
             for (std::uint32_t k = 0; k < K; ++k) {
-                const F root = xsimd::sqrt(disc[k]);
-                const F t_near = (-b[k] - root) / a[k];
-                const F t_far = (-b[k] + root) / a[k];
+                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
                 const F t = xsimd::select(t_near > tmin, t_near, t_far);
                 const auto hit =
                     t > tmin && (t < best_t[k] || (t == best_t[k] && id < best_id[k]));
@@ -706,14 +699,9 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
             const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
             const F r2(s.bvh_r2[i]);
             for (std::uint32_t k = 0; k < K; ++k) {
-                const V3<F> oc = sub(o[k], c);
-                const F b = dot(oc, d[k]);
-                const F cc = dot(oc, oc) - r2;
-                const F disc = b * b - a[k] * cc;
-                if (xsimd::none(disc >= zero)) continue;
-                const F root = xsimd::sqrt(disc);
-                const F t_near = (-b - root) / a[k];
-                const F t_far = (-b + root) / a[k];
+                const SphereQuadratic<F> quad = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                if (xsimd::none(quad.disc >= zero)) continue;
+                const auto [t_near, t_far] = sphere_roots(quad, a[k]);
                 const auto hit =
                     (t_near > zero && t_near < t_max[k]) || (t_far > zero && t_far < t_max[k]);
                 done |= (mask_bits<F>(hit) << (k * W)) & mask;

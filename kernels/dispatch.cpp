@@ -106,7 +106,6 @@ kernels::SceneView make_scene_view(const CompiledScene& c) {
     v.object_is_plane = o.is_plane.data(), v.object_material = o.material.data();
     v.object_checker = o.checker.data();
     v.object_cx = o.cx.data(), v.object_cy = o.cy.data(), v.object_cz = o.cz.data();
-    v.object_radius = o.radius.data();
     v.object_nx = o.nx.data(), v.object_ny = o.ny.data(), v.object_nz = o.nz.data();
     v.object_t1x = o.t1x.data(), v.object_t1y = o.t1y.data(), v.object_t1z = o.t1z.data();
     v.object_t2x = o.t2x.data(), v.object_t2y = o.t2y.data(), v.object_t2z = o.t2z.data();
@@ -159,7 +158,6 @@ kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& 
     v.bvh_cx = bvh.cx.data(), v.bvh_cy = bvh.cy.data(), v.bvh_cz = bvh.cz.data();
     v.bvh_r2 = bvh.r2.data(), v.bvh_object = bvh.object.data();
     for (int a = 0; a < 3; ++a) v.bvh_lo[a] = bvh.lo[a], v.bvh_hi[a] = bvh.hi[a];
-    v.bvh_min_r2 = bvh.min_r2, v.bvh_max_r2 = bvh.max_r2;
     v.bvh_packet_min_lanes = packet_min_lanes;
     v.bvh_shadow_sort_min_spheres = kBvhShadowSortMinSpheres;
     return v;

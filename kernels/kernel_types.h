@@ -41,7 +41,7 @@ struct SceneView {
     // Per object (file index): what shading needs.
     std::uint32_t object_count;
     const std::uint32_t *object_is_plane, *object_material, *object_checker;
-    const float *object_cx, *object_cy, *object_cz, *object_radius;
+    const float *object_cx, *object_cy, *object_cz;
     const float *object_nx, *object_ny, *object_nz;
     const float *object_t1x, *object_t1y, *object_t1z, *object_t2x, *object_t2y, *object_t2z;
 
@@ -75,10 +75,8 @@ struct SceneView {
     const BvhNode8* bvh_nodes;
     const float *bvh_cx, *bvh_cy, *bvh_cz, *bvh_r2;
     const std::uint32_t* bvh_object;
-    // The root's box and the extreme squared radii: the traversal's rounding margin
-    // (kernels/README.md, "The BVH").
+    // The root's box: the traversal's rounding margin (kernels/README.md, "The BVH").
     float bvh_lo[3], bvh_hi[3];
-    float bvh_min_r2, bvh_max_r2;
     // A packet with fewer live lanes than this goes on ray by ray (single-ray traversal);
     // 0 or 1: packets all the way, 9: single rays only.
     std::uint32_t bvh_packet_min_lanes;

@@ -107,6 +107,44 @@ void store3(const V3<F>& v, float* x, float* y, float* z, std::uint32_t i) {
     v.z.store_aligned(z + i);
 }
 
+// Ray-sphere in the form that keeps its digits for small, distant spheres (reference:
+// intersect_sphere, which derives it; Ray Tracing Gems ch. 7). Two steps, so that a loop
+// can skip the roots when no lane has any: sphere_quadratic gives b = O'.V,
+// c' = O'.O' - r^2 and disc = a (r^2 - l.l) with l = O' - (b/a) V; sphere_roots the two
+// roots, sorted, from q = -b - sign(b) sqrt(disc): q/a and c'/q (q/a alone when q = 0).
+// A negative or NaN discriminant gives NaN roots: every comparison with them fails.
+// Forced inline: GCC kept them as calls in the leaf loops (4 % of a frame, perf).
+template <class F>
+struct SphereQuadratic {
+    F b, c, disc;
+};
+
+template <class F>
+[[gnu::always_inline]] inline SphereQuadratic<F> sphere_quadratic(const V3<F>& oc,
+                                                                  const V3<F>& d, const F& a,
+                                                                  const F& r2) {
+    const F b = dot(oc, d);
+    const V3<F> l = sub(oc, mul(d, b / a));
+    return {b, dot(oc, oc) - r2, a * (r2 - dot(l, l))};
+}
+
+template <class F>
+struct SphereRoots {
+    F t_near, t_far;
+};
+
+template <class F>
+[[gnu::always_inline]] inline SphereRoots<F> sphere_roots(const SphereQuadratic<F>& s,
+                                                          const F& a) {
+    const F zero(0.0f);
+    const F root = xsimd::sqrt(s.disc);
+    const F q = xsimd::select(s.b >= zero, -s.b - root, -s.b + root);
+    const F t_q = q / a;
+    const F t_c = xsimd::select(q != zero, s.c / q, t_q);
+    const auto swap = t_c < t_q;
+    return {xsimd::select(swap, t_c, t_q), xsimd::select(swap, t_q, t_c)};
+}
+
 // Lanes [base, base + size) that lie below `count`.
 template <class F>
 auto live_lanes(std::uint32_t base, std::uint32_t count) {
@@ -435,23 +473,16 @@ void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t co
         for (std::uint32_t i = 0; i < s.sphere_count; ++i) {
             const V3<F> c{F(s.sphere_cx[i]), F(s.sphere_cy[i]), F(s.sphere_cz[i])};
             const F r2(s.sphere_r2[i]);
-            F b[K], disc[K];
+            SphereQuadratic<F> quad[K];
             M any_root = F(0.0f) != F(0.0f);  // all false
             for (std::uint32_t k = 0; k < K; ++k) {
-                // O' = O - c, b = O'.V, c' = O'.O' - r^2, disc = b^2 - (V.V) c'
-                const V3<F> oc = sub(o[k], c);
-                b[k] = dot(oc, d[k]);
-                const F cc = dot(oc, oc) - r2;
-                disc[k] = b[k] * b[k] - a[k] * cc;
-                any_root = any_root || disc[k] >= F(0.0f);
+                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                any_root = any_root || quad[k].disc >= F(0.0f);
             }
             if (xsimd::none(any_root)) continue;
             const F id(static_cast<float>(s.sphere_object[i]));
             for (std::uint32_t k = 0; k < K; ++k) {
-                // A negative discriminant makes the root NaN: every comparison fails.
-                const F root = xsimd::sqrt(disc[k]);
-                const F t_near = (-b[k] - root) / a[k];
-                const F t_far = (-b[k] + root) / a[k];
+                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
                 const M near_ok = t_near > tmin && t_near < best_t[k];
                 const M far_ok = t_far > tmin && t_far < best_t[k];
                 const M hit = near_ok || far_ok;
@@ -502,20 +533,15 @@ void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t cou
         for (std::uint32_t i = 0; i < s.sphere_count && !all_done(); ++i) {
             const V3<F> c{F(s.sphere_cx[i]), F(s.sphere_cy[i]), F(s.sphere_cz[i])};
             const F r2(s.sphere_r2[i]);
-            F b[K], disc[K];
+            SphereQuadratic<F> quad[K];
             M any_root = zero != zero;
             for (std::uint32_t k = 0; k < K; ++k) {
-                const V3<F> oc = sub(o[k], c);
-                b[k] = dot(oc, d[k]);
-                const F cc = dot(oc, oc) - r2;
-                disc[k] = b[k] * b[k] - a[k] * cc;
-                any_root = any_root || (disc[k] >= zero && !done[k]);
+                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                any_root = any_root || (quad[k].disc >= zero && !done[k]);
             }
             if (xsimd::none(any_root)) continue;
             for (std::uint32_t k = 0; k < K; ++k) {
-                const F root = xsimd::sqrt(disc[k]);
-                const F t_near = (-b[k] - root) / a[k];
-                const F t_far = (-b[k] + root) / a[k];
+                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
                 done[k] = done[k] || (t_near > zero && t_near < t_max[k]) ||
                           (t_far > zero && t_far < t_max[k]);
             }
@@ -579,18 +605,20 @@ ShadeCounts shade(const SceneView& s, const ShadeInput& in, const ShadeOutput& o
             continue;
         }
 
-        // Hit point and geometric normal: sphere (P - c) / r, plane N.
+        // Hit point and geometric normal (reference: ReferenceTracer::intersect): sphere
+        // normalize(P - c), or -V^ for a hit at the very center; plane N.
         const F t = F::load_aligned(in.hits.t + base);
         const V3<F> p = add(o, mul(d, t));
         const M is_plane = gather<F>(s.object_is_plane, ids) != zero;
         const V3<F> center{gather<F>(s.object_cx, ids), gather<F>(s.object_cy, ids),
                            gather<F>(s.object_cz, ids)};
-        const F radius = gather<F>(s.object_radius, ids);
         const V3<F> plane_n{gather<F>(s.object_nx, ids), gather<F>(s.object_ny, ids),
                             gather<F>(s.object_nz, ids)};
-        const V3<F> normal = select(is_plane, plane_n, div(sub(p, center), radius));
-
         const V3<F> v_hat = normalize(d);
+        const V3<F> pc = sub(p, center);
+        const V3<F> sphere_n = select(dot(pc, pc) > zero, normalize(pc), neg(v_hat));
+        const V3<F> normal = select(is_plane, plane_n, sphere_n);
+
         const F n_dot_d = dot(normal, d);
         // The normal facing the incoming ray; refraction uses the unflipped one.
         const V3<F> n = select(n_dot_d > zero, neg(normal), normal);

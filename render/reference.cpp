@@ -24,21 +24,47 @@ constexpr float kMinRayWeight = 1e-3f;
 // A plane whose normal is this close to perpendicular to the ray is missed.
 constexpr float kPlaneParallelEpsilon = 1e-12f;
 
-// Ray-sphere (rendering model, "Sphere"): with O' = O - c, b = O'.V, c' = O'.O' - r^2,
-// disc = b^2 - (V.V) c'; the nearer root in (t_min, t_max) counts, a double root too.
+// Ray-sphere (rendering model, "Sphere"), in the form that keeps its digits for small,
+// distant spheres (Haines, Guenther, Akenine-Moeller, "Precision Improvements for
+// Ray/Sphere Intersection", Ray Tracing Gems, 2019, ch. 7). With O' = O - c, a = V.V,
+// b = O'.V, c' = O'.O' - r^2:
+// - the textbook discriminant b^2 - a c' subtracts two numbers of size |O'|^2 to get one
+//   of size r^2, and for a sphere far away all its digits are rounding. The same value is
+//   a (r^2 - l.l), with l = O' - (b/a) V the vector from the center to the point of the
+//   ray nearest it: l.l is of size r^2 where it matters, so nothing cancels;
+// - of the roots (-b -+ sqrt(disc))/a, the one where -b and -+sqrt(disc) have the same sign
+//   adds without cancellation: q = -b - sign(b) sqrt(disc) gives q/a, and the other root
+//   is c'/q (the roots' product is c'/a). q = 0 only when b = 0 and disc = 0, the double
+//   root 0 (= q/a).
+// The nearer root in (t_min, t_max) counts, a double root (tangent ray) too.
 std::optional<float> intersect_sphere(const Object& s, const Ray& ray) {
     const Vec3 oc = ray.origin - s.center;
-    const float b = dot(oc, ray.direction);
-    const float c = dot(oc, oc) - s.radius * s.radius;
     const float a = dot(ray.direction, ray.direction);
-    const float disc = b * b - a * c;
-    if (disc < 0.0f) return std::nullopt;
+    const float b = dot(oc, ray.direction);
+    const float r2 = s.radius * s.radius;
+    const Vec3 l = oc - ray.direction * (b / a);
+    const float disc = a * (r2 - dot(l, l));
+    if (!(disc >= 0.0f)) return std::nullopt;
     const float root = std::sqrt(disc);
-    const float t_near = (-b - root) / a;
+    const float q = b >= 0.0f ? -b - root : -b + root;
+    const float t_q = q / a;
+    const float t_c = q != 0.0f ? (dot(oc, oc) - r2) / q : t_q;
+    const bool swap = t_c < t_q;
+    const float t_near = swap ? t_c : t_q;
     if (ray.live(t_near)) return t_near;
-    const float t_far = (-b + root) / a;
+    const float t_far = swap ? t_q : t_c;
     if (ray.live(t_far)) return t_far;
     return std::nullopt;
+}
+
+// The model's sphere normal (P - c)/r, computed as normalize(P - c): the same direction,
+// and unit length even when rounding put the hit off the surface. It was (P - c)/r: for a
+// tiny sphere far away the textbook discriminant put hits at many radii from the center,
+// and a normal of length 40 raised the Phong term max(0, R.W)^n to 1e30. A hit at the very
+// center (a radius below the rounding of P) gets the normal facing the ray.
+Vec3 sphere_normal(Vec3 point, const Object& s, const Ray& ray) {
+    const Vec3 pc = point - s.center;
+    return dot(pc, pc) > 0.0f ? normalize(pc) : -normalize(ray.direction);
 }
 
 // Ray-plane: t = ((P0 - O).N) / (V.N), computed as (d - O.N) / (V.N) with d = P0.N, the
@@ -139,8 +165,7 @@ std::optional<SurfaceHit> ReferenceTracer::intersect(const Ray& ray) const {
     if (!best) return best;
     const Object& o = scene_.objects[best->object];
     best->point = ray.at(best->t);
-    best->normal =
-        o.type == ObjectType::sphere ? (best->point - o.center) / o.radius : o.normal;
+    best->normal = o.type == ObjectType::sphere ? sphere_normal(best->point, o, ray) : o.normal;
     return best;
 }
 

@@ -726,11 +726,6 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
                       });
 
     for (int a = 0; a < 3; ++a) bvh.lo[a] = root.lo_at(a), bvh.hi[a] = root.hi_at(a);
-    bvh.min_r2 = kInf, bvh.max_r2 = 0.0f;
-    for (std::uint32_t i = 0; i < n; ++i) {
-        bvh.min_r2 = std::min(bvh.min_r2, spheres.r2[i]);
-        bvh.max_r2 = std::max(bvh.max_r2, spheres.r2[i]);
-    }
     bvh.build_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;

@@ -32,10 +32,9 @@ struct SphereBvh {
     UninitializedVector<std::uint32_t, Pages::huge> object;  // the file index, as in
                                                              // CompiledSpheres
 
-    // The root's box (of the spheres, not their centers) and the extreme squared radii:
-    // the kernels derive their rounding margin from them.
+    // The root's box (of the spheres, not their centers): the kernels derive their
+    // rounding margin from it.
     float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    float min_r2 = 0.0f, max_r2 = 0.0f;
 
     std::uint32_t leaf_count = 0;
     std::uint32_t depth = 0;  // levels of 8-wide nodes (root alone: 1)

@@ -81,7 +81,6 @@ CompiledScene compile_scene(const Scene& scene) {
             p.object.push_back(k);
             const TangentBasis tb = checker_basis(obj.normal);
             o.cx.push_back(0.0f), o.cy.push_back(0.0f), o.cz.push_back(0.0f);
-            o.radius.push_back(1.0f);
             o.nx.push_back(obj.normal.x), o.ny.push_back(obj.normal.y);
             o.nz.push_back(obj.normal.z);
             o.t1x.push_back(tb.t1.x), o.t1y.push_back(tb.t1.y), o.t1z.push_back(tb.t1.z);
@@ -96,7 +95,6 @@ CompiledScene compile_scene(const Scene& scene) {
             s.object.push_back(k);
             o.cx.push_back(obj.center.x), o.cy.push_back(obj.center.y);
             o.cz.push_back(obj.center.z);
-            o.radius.push_back(obj.radius);
             o.nx.push_back(0.0f), o.ny.push_back(0.0f), o.nz.push_back(0.0f);
             o.t1x.push_back(0.0f), o.t1y.push_back(0.0f), o.t1z.push_back(0.0f);
             o.t2x.push_back(0.0f), o.t2y.push_back(0.0f), o.t2z.push_back(0.0f);
@@ -120,7 +118,6 @@ CompiledScene compile_scene(const Scene& scene) {
     for (auto* v : {&o.cx, &o.cy, &o.cz, &o.nx, &o.ny, &o.nz, &o.t1x, &o.t1y, &o.t1z, &o.t2x,
                     &o.t2y, &o.t2z})
         pad(*v, o.padded_count, 0.0f);
-    pad(o.radius, o.padded_count, 1.0f);
 
     // Materials.
     CompiledMaterials& m = out.materials;

@@ -30,7 +30,7 @@ struct CompiledSpheres {
     std::uint32_t padded_count = 0;
     AlignedVector<float> cx, cy, cz;
     AlignedVector<float> r2;      // radius * radius, as the reference computes it
-    AlignedVector<float> radius;  // the normal divides by the radius
+    AlignedVector<float> radius;  // for the BVH builder's boxes and the Embree baseline
     AlignedVector<std::uint32_t> material, object;
 };
 
@@ -43,15 +43,15 @@ struct CompiledPlanes {
 };
 
 // Everything shading needs per object, indexed by the object's index in the file (the id
-// a hit carries). Spheres have radius > 0 and a zero normal; planes radius 1 and center 0,
-// so that evaluating both normal formulas for every lane never divides by zero.
+// a hit carries). Spheres have a zero normal, planes center 0: shading evaluates both
+// normal formulas for every lane and selects.
 struct CompiledObjects {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;
     AlignedVector<std::uint32_t> is_plane;  // 0 sphere, 1 plane
     AlignedVector<std::uint32_t> material;
     AlignedVector<std::uint32_t> checker;  // 1: a plane whose material has a checker
-    AlignedVector<float> cx, cy, cz, radius;
+    AlignedVector<float> cx, cy, cz;
     AlignedVector<float> nx, ny, nz;
     AlignedVector<float> t1x, t1y, t1z, t2x, t2y, t2z;  // checker tangent basis (planes)
 };

@@ -325,6 +325,18 @@ TEST_F(BatchCliTest, EveryFrameCarriesItsAttributes) {
               sha256_hex(bytes));
 }
 
+// A built-in is identified by its spec string as given: hashing it is free, where the JSON
+// of random:1048576 took seconds to write and hash.
+TEST_F(BatchCliTest, ABuiltInsDigestIsItsSpecString) {
+    const std::string spec = "random:4,width=16,height=12,seed=3";
+    ASSERT_EQ(run_octray({"render", spec, "-o", "b.exr"}, dir_).status, 0);
+    Imf::InputFile file((dir_ / "b.exr").c_str());
+    const auto* digest =
+        file.header().findTypedAttribute<Imf::StringAttribute>("octray.sceneSha256");
+    ASSERT_NE(digest, nullptr);
+    EXPECT_EQ(digest->value(), sha256_hex(spec));
+}
+
 TEST_F(BatchCliTest, SeveralScenesNeedSceneInThePattern) {
     const auto clash = run_octray(
         {"render", "shot.json", "random:4,width=16,height=12", "-o", "out/x.exr"}, dir_);
