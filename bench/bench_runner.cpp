@@ -388,7 +388,14 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
         // octray's): the median build time is reported, the last builds are kept.
         std::vector<double> embree_builds, octray_builds;
 #if OCTRAY_HAVE_EMBREE
-        std::unique_ptr<EmbreeScene> embree;
+        // Embree's best configuration (user geometry: its build is the one timed), and its
+        // built-in sphere primitive, built once.
+        std::unique_ptr<EmbreeScene> embree, embree_point;
+        if (ctx.embree_available && ray_sets)
+            arena.execute([&] {
+                embree_point = std::make_unique<EmbreeScene>(scene, compiled, o.threads,
+                                                             EmbreeGeometry::sphere_point);
+            });
 #endif
         SphereBvh bvh;
         for (int build = 0; build < kBuildReps; ++build) {
@@ -396,7 +403,8 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
             if (ctx.embree_available && ray_sets) {
                 embree.reset();
                 arena.execute([&] {
-                    embree = std::make_unique<EmbreeScene>(scene, compiled, o.threads);
+                    embree = std::make_unique<EmbreeScene>(scene, compiled, o.threads,
+                                                           EmbreeGeometry::user);
                 });
                 embree_builds.push_back(embree->build_seconds());
             }
@@ -531,13 +539,18 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                 if (embree) {
                     OracleHits truth;
                     arena.execute([&] { truth = oracle_hits_double(scene, set, oracle); });
-                    for (EmbreeMode mode : {EmbreeMode::packet8, EmbreeMode::single}) {
-                        BenchRow row = base_row(w, v);
-                        row.system = "embree";
-                        row.mode = embree_mode_name(mode);
-                        row.isa = "embree";
-                        measure(std::move(row), embree_tracer(arena, *embree, mode), truth,
-                                kToleranceRule, false);
+                    for (const EmbreeScene* e : {embree.get(), embree_point.get()}) {
+                        const bool user = e->geometry() == EmbreeGeometry::user;
+                        for (EmbreeMode mode :
+                             {EmbreeMode::packet16, EmbreeMode::packet8, EmbreeMode::single}) {
+                            if (!user && mode == EmbreeMode::packet16) continue;
+                            BenchRow row = base_row(w, v);
+                            row.system = "embree";
+                            row.mode = embree_mode_name(mode);
+                            row.isa = embree_geometry_name(e->geometry());
+                            measure(std::move(row), embree_tracer(arena, *e, mode), truth,
+                                    kToleranceRule, false);
+                        }
                     }
                 }
 #endif

@@ -1,5 +1,6 @@
 // Embree 3 baseline (compiled only when CMake finds Embree): the octray scene rebuilt as
-// Embree geometry, tracing the bench's ray sets in single-ray and 8-wide packet modes.
+// Embree geometry, tracing the bench's ray sets one ray at a time or in 8- and 16-wide
+// packets.
 
 #include "bench/embree_baseline.h"
 
@@ -13,10 +14,24 @@
 #include <string>
 #include <vector>
 
+#include "bench/embree_user_spheres.h"
+
 namespace octray::bench {
 
 const char* embree_mode_name(EmbreeMode mode) {
-    return mode == EmbreeMode::single ? "single" : "packet8";
+    switch (mode) {
+        case EmbreeMode::single:
+            return "single";
+        case EmbreeMode::packet8:
+            return "packet8";
+        case EmbreeMode::packet16:
+            return "packet16";
+    }
+    return "?";
+}
+
+const char* embree_geometry_name(EmbreeGeometry geometry) {
+    return geometry == EmbreeGeometry::user ? "user" : "sphere_point";
 }
 
 namespace {
@@ -35,25 +50,45 @@ void throw_error(RTCDevice device, const char* what) {
 }  // namespace
 
 struct EmbreeScene::Impl {
+    EmbreeGeometry geometry = EmbreeGeometry::user;
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    // Per geometry ID: primitive ID -> object file index.
+    RTCScene plane_scene = nullptr;  // user: the planes, instanced into `scene`
+    EmbreeSphereData spheres{};      // user: what the sphere callbacks read
+    // Per geometry ID of `scene`: primitive ID -> object file index; a hit through the
+    // planes' instance: primitive ID -> object file index.
     std::vector<std::vector<std::int32_t>> object_of;
+    std::vector<std::int32_t> instanced_plane_object;
     double build_seconds = 0.0;
     std::string last_error;
     // Bytes allocated minus bytes freed through the device (memory monitor callback).
     std::atomic<std::int64_t> live_bytes{0};
     std::int64_t bytes_after_build = 0;
 
-    std::int32_t object(unsigned geom_id, unsigned prim_id) const {
+    std::int32_t object(unsigned geom_id, unsigned prim_id, unsigned inst_id) const {
         if (geom_id == RTC_INVALID_GEOMETRY_ID) return kernels::kNoHit;
+        if (inst_id != RTC_INVALID_GEOMETRY_ID) return instanced_plane_object[prim_id];
         return object_of[geom_id][prim_id];
+    }
+
+    void attach(RTCScene target, RTCGeometry g, std::vector<std::int32_t> objects) {
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(target, g);
+        rtcReleaseGeometry(g);
+        if (target != scene) {
+            instanced_plane_object = std::move(objects);
+            return;
+        }
+        if (object_of.size() <= id) object_of.resize(id + 1);
+        object_of[id] = std::move(objects);
     }
 };
 
-EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads)
+EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads,
+                         EmbreeGeometry geometry)
     : impl_(std::make_unique<Impl>()) {
     Impl& im = *impl_;
+    im.geometry = geometry;
     const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
     im.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (!im.device) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -73,9 +108,34 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
     im.scene = rtcNewScene(im.device);
     rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
 
-    // Spheres: one SPHERE_POINT geometry, (x, y, z, r) per sphere, in file order.
     const CompiledSpheres& s = compiled.spheres;
-    if (s.count > 0) {
+    if (s.count > 0 && geometry == EmbreeGeometry::user) {
+        // Spheres: one user geometry, a primitive per sphere (the compiled order), boxes
+        // c -+ r widened by a few ulps so that rounding never clips a sphere.
+        RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_USER);
+        if (!g) throw_error(im.device, "rtcNewGeometry(USER)");
+        im.spheres = {s.cx.data(), s.cy.data(), s.cz.data(), s.r2.data()};
+        rtcSetGeometryUserPrimitiveCount(g, s.count);
+        rtcSetGeometryUserData(g, &im.spheres);
+        rtcSetGeometryBoundsFunction(
+            g,
+            [](const RTCBoundsFunctionArguments* args) {
+                const auto& d = *static_cast<const EmbreeSphereData*>(args->geometryUserPtr);
+                const unsigned i = args->primID;
+                const float r = std::sqrt(d.r2[i]) * (1.0f + 0x1.0p-20f);
+                const auto lo = [r](float c) { return (c - r) - std::fabs(c) * 0x1.0p-22f; };
+                const auto hi = [r](float c) { return (c + r) + std::fabs(c) * 0x1.0p-22f; };
+                *args->bounds_o = {lo(d.cx[i]), lo(d.cy[i]), lo(d.cz[i]), 0.0f,
+                                   hi(d.cx[i]), hi(d.cy[i]), hi(d.cz[i]), 0.0f};
+            },
+            nullptr);
+        const EmbreeSphereCallbacks& callbacks = embree_sphere_callbacks();
+        rtcSetGeometryIntersectFunction(g, callbacks.intersect);
+        rtcSetGeometryOccludedFunction(g, callbacks.occluded);
+        im.attach(im.scene, g,
+                  std::vector<std::int32_t>(s.object.begin(), s.object.begin() + s.count));
+    } else if (s.count > 0) {
+        // Spheres: one SPHERE_POINT geometry, (x, y, z, r) per sphere, in file order.
         RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
         if (!g) throw_error(im.device, "rtcNewGeometry(SPHERE_POINT)");
         auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -86,14 +146,11 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
             v[4 * i + 3] = s.radius[i];
             objects[i] = static_cast<std::int32_t>(s.object[i]);
         }
-        rtcCommitGeometry(g);
-        const unsigned id = rtcAttachGeometry(im.scene, g);
-        rtcReleaseGeometry(g);
-        if (im.object_of.size() <= id) im.object_of.resize(id + 1);
-        im.object_of[id] = std::move(objects);
+        im.attach(im.scene, g, std::move(objects));
     }
 
-    // Planes: one QUAD geometry, a square per plane spanned by the checker basis.
+    // Planes: one QUAD geometry, a square per plane spanned by the checker basis; with user
+    // geometry in a scene of its own, instanced with the identity.
     const CompiledPlanes& p = compiled.planes;
     if (p.count > 0) {
         RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_QUAD);
@@ -132,11 +189,20 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
             }
             objects[i] = static_cast<std::int32_t>(p.object[i]);
         }
-        rtcCommitGeometry(g);
-        const unsigned id = rtcAttachGeometry(im.scene, g);
-        rtcReleaseGeometry(g);
-        if (im.object_of.size() <= id) im.object_of.resize(id + 1);
-        im.object_of[id] = std::move(objects);
+        if (geometry == EmbreeGeometry::user) {
+            im.plane_scene = rtcNewScene(im.device);
+            rtcSetSceneBuildQuality(im.plane_scene, RTC_BUILD_QUALITY_HIGH);
+            im.attach(im.plane_scene, g, std::move(objects));
+            rtcCommitScene(im.plane_scene);
+            RTCGeometry instance = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
+            if (!instance) throw_error(im.device, "rtcNewGeometry(INSTANCE)");
+            rtcSetGeometryInstancedScene(instance, im.plane_scene);
+            const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+            rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
+            im.attach(im.scene, instance, {});
+        } else {
+            im.attach(im.scene, g, std::move(objects));
+        }
     }
 
     const auto start = std::chrono::steady_clock::now();
@@ -150,6 +216,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
 
 EmbreeScene::~EmbreeScene() {
     if (impl_->scene) rtcReleaseScene(impl_->scene);
+    if (impl_->plane_scene) rtcReleaseScene(impl_->plane_scene);
     if (impl_->device) rtcReleaseDevice(impl_->device);
 }
 
@@ -159,12 +226,18 @@ std::int64_t EmbreeScene::memory_bytes() const { return impl_->bytes_after_build
 
 std::string EmbreeScene::version() { return RTC_VERSION_STRING; }
 
+EmbreeGeometry EmbreeScene::geometry() const { return impl_->geometry; }
+
 std::string EmbreeScene::device_info() const {
     const auto prop = [&](RTCDeviceProperty p) {
         return rtcGetDeviceProperty(impl_->device, p);
     };
     std::string s = "embree " + version();
     s += prop(RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? ", native ray8" : ", emulated ray8";
+    s += prop(RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? ", native ray16"
+                                                          : ", emulated ray16";
+    s += std::string(", user-geometry spheres: ") + embree_sphere_callbacks().name +
+         " callbacks";
     s += prop(RTC_DEVICE_PROPERTY_TASKING_SYSTEM) == 1 ? ", TBB tasking" : ", own tasking";
     return s;
 }
@@ -190,17 +263,21 @@ void set_ray(RTCRay& r, const RaySet& rays, std::uint32_t i) {
     r.flags = 0;
 }
 
-// Lanes [first, first + 8) of the set into an 8-wide packet; lanes past `end` are off.
-void set_ray8(RTCRay8& r, int (&valid)[8], const RaySet& rays, std::uint32_t first,
-              std::uint32_t end) {
-    for (std::uint32_t k = 0; k < 8; ++k) {
-        const std::uint32_t i = first + k;
+// Lanes [first, first + K) of the set into a K-wide packet; lanes past `end` are off.
+template <int K, class RayK>
+void set_ray_packet(RayK& r, int (&valid)[K], const RaySet& rays, std::uint32_t first,
+                    std::uint32_t end) {
+    for (int k = 0; k < K; ++k) {
+        const std::uint32_t i = first + static_cast<std::uint32_t>(k);
+        // Rays past the set's padding are never read: the lane is off and keeps a harmless
+        // copy of the first ray.
+        const std::uint32_t at = i < rays.ox.size() ? i : first;
         valid[k] = i < end ? -1 : 0;
-        r.org_x[k] = rays.ox[i], r.org_y[k] = rays.oy[i], r.org_z[k] = rays.oz[i];
+        r.org_x[k] = rays.ox[at], r.org_y[k] = rays.oy[at], r.org_z[k] = rays.oz[at];
         r.tnear[k] = rays.t_min;
-        r.dir_x[k] = rays.dx[i], r.dir_y[k] = rays.dy[i], r.dir_z[k] = rays.dz[i];
+        r.dir_x[k] = rays.dx[at], r.dir_y[k] = rays.dy[at], r.dir_z[k] = rays.dz[at];
         r.time[k] = 0.0f;
-        r.tfar[k] = rays.t_max[i];
+        r.tfar[k] = rays.t_max[at];
         r.mask[k] = 0xFFFFFFFFu;
         r.id[k] = i;
         r.flags[k] = 0;
@@ -209,38 +286,88 @@ void set_ray8(RTCRay8& r, int (&valid)[8], const RaySet& rays, std::uint32_t fir
 
 }  // namespace
 
+// K-wide packets: rtcIntersect8 / rtcIntersect16 and their occluded twins.
+template <int K, class RayHitK, class RayK>
+struct PacketCalls;
+template <>
+struct PacketCalls<8, RTCRayHit8, RTCRay8> {
+    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RTCRayHit8* r) {
+        rtcIntersect8(v, s, c, r);
+    }
+    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, RTCRay8* r) {
+        rtcOccluded8(v, s, c, r);
+    }
+};
+template <>
+struct PacketCalls<16, RTCRayHit16, RTCRay16> {
+    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RTCRayHit16* r) {
+        rtcIntersect16(v, s, c, r);
+    }
+    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, RTCRay16* r) {
+        rtcOccluded16(v, s, c, r);
+    }
+};
+
+template <int K, class RayHitK, class RayK>
+void intersect_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context,
+                       const RaySet& rays, std::uint32_t first, std::uint32_t end,
+                       HitSet& hits) {
+    alignas(64) RayHitK rh;
+    alignas(64) int valid[K];
+    for (std::uint32_t base = first; base < end; base += K) {
+        set_ray_packet<K>(rh.ray, valid, rays, base, end);
+        for (int k = 0; k < K; ++k) {
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        PacketCalls<K, RayHitK, RayK>::intersect(valid, im.scene, &context, &rh);
+        for (std::uint32_t k = 0; k < K && base + k < end; ++k) {
+            const std::int32_t object =
+                im.object(rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k]);
+            hits.object[base + k] = object;
+            hits.t[base + k] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar[k];
+        }
+    }
+}
+
+template <int K, class RayHitK, class RayK>
+void occluded_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context,
+                      const RaySet& rays, std::uint32_t first, std::uint32_t end,
+                      HitSet& hits) {
+    alignas(64) RayK r;
+    alignas(64) int valid[K];
+    for (std::uint32_t base = first; base < end; base += K) {
+        set_ray_packet<K>(r, valid, rays, base, end);
+        PacketCalls<K, RayHitK, RayK>::occluded(valid, im.scene, &context, &r);
+        for (std::uint32_t k = 0; k < K && base + k < end; ++k)
+            hits.object[base + k] = r.tfar[k] < 0.0f ? kOccluded : kernels::kNoHit;
+    }
+}
+
 void EmbreeScene::intersect(EmbreeMode mode, const RaySet& rays, std::uint32_t first,
                             std::uint32_t n, HitSet& hits, bool coherent) const {
     const Impl& im = *impl_;
     RTCIntersectContext context = make_context(coherent);
     const std::uint32_t end = first + n;
-    if (mode == EmbreeMode::single) {
-        for (std::uint32_t i = first; i < end; ++i) {
-            RTCRayHit rh;
-            set_ray(rh.ray, rays, i);
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(im.scene, &context, &rh);
-            const std::int32_t object = im.object(rh.hit.geomID, rh.hit.primID);
-            hits.object[i] = object;
-            hits.t[i] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar;
-        }
-        return;
+    switch (mode) {
+        case EmbreeMode::packet8:
+            return intersect_packets<8, RTCRayHit8, RTCRay8>(im, context, rays, first, end,
+                                                             hits);
+        case EmbreeMode::packet16:
+            return intersect_packets<16, RTCRayHit16, RTCRay16>(im, context, rays, first, end,
+                                                                hits);
+        case EmbreeMode::single:
+            break;
     }
-    alignas(32) RTCRayHit8 rh;
-    alignas(32) int valid[8];
-    for (std::uint32_t base = first; base < end; base += 8) {
-        set_ray8(rh.ray, valid, rays, base, end);
-        for (int k = 0; k < 8; ++k) {
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
-        rtcIntersect8(valid, im.scene, &context, &rh);
-        for (std::uint32_t k = 0; k < 8 && base + k < end; ++k) {
-            const std::int32_t object = im.object(rh.hit.geomID[k], rh.hit.primID[k]);
-            hits.object[base + k] = object;
-            hits.t[base + k] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar[k];
-        }
+    for (std::uint32_t i = first; i < end; ++i) {
+        RTCRayHit rh;
+        set_ray(rh.ray, rays, i);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(im.scene, &context, &rh);
+        const std::int32_t object = im.object(rh.hit.geomID, rh.hit.primID, rh.hit.instID[0]);
+        hits.object[i] = object;
+        hits.t[i] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar;
     }
 }
 
@@ -250,22 +377,21 @@ void EmbreeScene::occluded(EmbreeMode mode, const RaySet& rays, std::uint32_t fi
     RTCIntersectContext context = make_context(coherent);
     const std::uint32_t end = first + n;
     // An occluded ray comes back with tfar = -inf.
-    if (mode == EmbreeMode::single) {
-        for (std::uint32_t i = first; i < end; ++i) {
-            RTCRay r;
-            set_ray(r, rays, i);
-            rtcOccluded1(im.scene, &context, &r);
-            hits.object[i] = r.tfar < 0.0f ? kOccluded : kernels::kNoHit;
-        }
-        return;
+    switch (mode) {
+        case EmbreeMode::packet8:
+            return occluded_packets<8, RTCRayHit8, RTCRay8>(im, context, rays, first, end,
+                                                            hits);
+        case EmbreeMode::packet16:
+            return occluded_packets<16, RTCRayHit16, RTCRay16>(im, context, rays, first, end,
+                                                               hits);
+        case EmbreeMode::single:
+            break;
     }
-    alignas(32) RTCRay8 r;
-    alignas(32) int valid[8];
-    for (std::uint32_t base = first; base < end; base += 8) {
-        set_ray8(r, valid, rays, base, end);
-        rtcOccluded8(valid, im.scene, &context, &r);
-        for (std::uint32_t k = 0; k < 8 && base + k < end; ++k)
-            hits.object[base + k] = r.tfar[k] < 0.0f ? kOccluded : kernels::kNoHit;
+    for (std::uint32_t i = first; i < end; ++i) {
+        RTCRay r;
+        set_ray(r, rays, i);
+        rtcOccluded1(im.scene, &context, &r);
+        hits.object[i] = r.tfar < 0.0f ? kOccluded : kernels::kNoHit;
     }
 }
 

@@ -1,7 +1,15 @@
 #pragma once
-// Embree 3 as the baseline of `octray bench`: the identical scene (spheres as
-// RTC_GEOMETRY_TYPE_SPHERE_POINT, each plane as one large quad) tracing the identical rays,
-// read from the same SoA arrays (bench/ray_sets.h), into the same hit arrays.
+// Embree 3 as the baseline of `octray bench`: the identical scene tracing the identical
+// rays, read from the same SoA arrays (bench/ray_sets.h), into the same hit arrays. Two
+// configurations (EmbreeGeometry):
+// - user: what an expert Embree user builds for spheres. Each sphere is a user primitive
+//   whose callbacks test it against the whole packet at once with the robust sphere form
+//   (bench/embree_user_spheres.h); the planes (each one large quad) live in a scene of
+//   their own, instanced with the identity, so that their huge boxes stay out of the
+//   spheres' BVH. Traced with rtcIntersect16/8/1.
+// - sphere_point: Embree's built-in sphere primitive, RTC_GEOMETRY_TYPE_SPHERE_POINT, and
+//   the quads in the same scene. Embree 3 routes that primitive through its curve ("hair")
+//   code (BVH8 with oriented boxes), which is far slower; kept for comparison.
 //
 // Compiled only when CMake finds Embree (OCTRAY_HAVE_EMBREE == 1); the declarations are
 // always visible so that callers can be written once and test embree_compiled().
@@ -29,11 +37,16 @@
 namespace octray::bench {
 
 enum class EmbreeMode {
-    single,   // rtcIntersect1 / rtcOccluded1, one ray at a time
-    packet8,  // rtcIntersect8 / rtcOccluded8 over 8 consecutive rays of the set
+    single,    // rtcIntersect1 / rtcOccluded1, one ray at a time
+    packet8,   // rtcIntersect8 / rtcOccluded8 over 8 consecutive rays of the set
+    packet16,  // rtcIntersect16 / rtcOccluded16 over 16 consecutive rays
 };
 
+enum class EmbreeGeometry { user, sphere_point };
+
 const char* embree_mode_name(EmbreeMode mode);
+// "user" or "sphere_point": the bench's `isa` column for Embree rows.
+const char* embree_geometry_name(EmbreeGeometry geometry);
 
 constexpr bool embree_compiled() { return OCTRAY_HAVE_EMBREE != 0; }
 
@@ -42,13 +55,16 @@ class EmbreeScene {
     // Builds the device and the scene (BVH build quality high: the scene is static).
     // `threads` (0: all) caps Embree's own TBB use. Throws std::runtime_error with
     // Embree's message on failure.
-    EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads);
+    // `compiled` must outlive this object (user geometry reads its sphere arrays).
+    EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads,
+                EmbreeGeometry geometry);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
     // Closest hits of rays [first, first + n) on (rays.t_min, t_max): t and the object's
-    // file index, kNoHit for a miss. For packet8, first is a multiple of 8.
+    // file index, kNoHit for a miss. For packet8 and packet16, first is a multiple of 8
+    // (the rays past first + n in a packet are switched off).
     // Coherent sets the coherent-ray hint (RTC_INTERSECT_CONTEXT_FLAG_COHERENT).
     void intersect(EmbreeMode mode, const RaySet& rays, std::uint32_t first, std::uint32_t n,
                    HitSet& hits, bool coherent) const;
@@ -67,9 +83,11 @@ class EmbreeScene {
     // "3.13.5", and what the device reports (native packet support, ISA-relevant flags).
     static std::string version();
     std::string device_info() const;
+    EmbreeGeometry geometry() const;
+
+    struct Impl;  // embree_baseline.cpp's
 
   private:
-    struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 
