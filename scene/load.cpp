@@ -1,4 +1,4 @@
-// JSON scene files (shared/spec/scene-format.md) into the authored Scene, and the semantic
+// JSON scene files (docs/scene-format.md) into the authored Scene, and the semantic
 // checks every scene passes before it is rendered. Defaults and the exact rules are in
 // scene/README.md; every message names the file, the JSON path and what was expected.
 

@@ -1,4 +1,4 @@
-// JSON scene loading: every key of shared/spec/scene-format.md, the defaults of
+// JSON scene loading: every key of docs/scene-format.md, the defaults of
 // scene/README.md, and every error with its file, JSON path and expectation.
 
 #include "scene/load.h"
