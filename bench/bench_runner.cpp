@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "bench/embree_baseline.h"
+#include "bench/embree_frames.h"
 #include "core/version.h"
 #include "kernels/dispatch.h"
 #include "render/image_io.h"
@@ -261,10 +262,8 @@ Scene load_bench_scene(const std::string& spec, int width, int height) {
     return scene;
 }
 
-// The packet render of the scene at the validation size equals the reference render,
-// image and ray counts.
-std::string validate_render(const std::string& spec, const BenchOptions& o, Isa isa,
-                            Accel accel, bool& valid) {
+// The scene at the validation size of whole renders.
+Scene validation_scene(const std::string& spec, const BenchOptions& o) {
     int width = std::min(o.width, o.validate_width),
         height = std::min(o.height, o.validate_height);
     // The reference render is brute force: shrink the image on large scenes (same budget
@@ -275,7 +274,14 @@ std::string validate_render(const std::string& spec, const BenchOptions& o, Isa 
     while (static_cast<std::uint64_t>(width) * height * objects > kOracleBudget &&
            width * height > 256)
         width = std::max(1, width / 2), height = std::max(1, height / 2);
-    const Scene small = load_bench_scene(spec, width, height);
+    return load_bench_scene(spec, width, height);
+}
+
+// The packet render of the scene at the validation size equals the reference render,
+// image and ray counts.
+std::string validate_render(const std::string& spec, const BenchOptions& o, Isa isa,
+                            Accel accel, bool& valid) {
+    const Scene small = validation_scene(spec, o);
     RenderOptions ro;
     ro.threads = o.threads;
     ro.accel = accel;
@@ -287,6 +293,47 @@ std::string validate_render(const std::string& spec, const BenchOptions& o, Isa 
            std::to_string(small.image.width) + "x" + std::to_string(small.image.height) +
            ", ray counts " + (ref.rays.total() == simd.rays.total() ? "equal" : "differ");
 }
+
+#if OCTRAY_HAVE_EMBREE
+// An Embree frame (bench/embree_frames.h) at the validation size against the reference
+// render: the same model on the same rays, so only Embree's roots, which round
+// differently, may move a pixel (a shadow ray that grazes a sphere can flip a whole light
+// term: sphereflake:4 at 320x180 has 0.56 % of its pixels off by more than 0.01, at
+// 54.7 dB). Valid at PSNR >= kEmbreeFrameMinPsnr with at most kEmbreeFrameMaxOff of the
+// pixels off by more than 0.01 in some channel, and the same number of primary rays.
+constexpr double kEmbreeFrameMinPsnr = 45.0;
+constexpr double kEmbreeFrameMaxOff = 0.01;
+std::string validate_embree_render(const Scene& small, const EmbreeFrames& frames,
+                                   const BenchOptions& o, bool& valid) {
+    RenderOptions ro;
+    ro.threads = o.threads;
+    const RenderResult ref = render_reference(small, ro);
+    const RenderResult e = frames.render(compile_scene(small), ro);
+    double squared = 0.0, peak = 0.0;
+    std::size_t off = 0;
+    const std::size_t n = ref.image.pixel_count();
+    for (std::size_t k = 0; k < n; ++k) {
+        const Rgb a = ref.image.data()[k], b = e.image.data()[k];
+        const double d[3] = {double(a.r) - b.r, double(a.g) - b.g, double(a.b) - b.b};
+        squared += d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        peak = std::max({peak, double(a.r), double(a.g), double(a.b)});
+        off += std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])}) > 0.01 ? 1 : 0;
+    }
+    const double mse = squared / (3.0 * static_cast<double>(std::max<std::size_t>(n, 1)));
+    const double psnr = mse > 0.0
+                            ? 10.0 * std::log10(std::max(peak, 1.0) * std::max(peak, 1.0) / mse)
+                            : std::numeric_limits<double>::infinity();
+    const double off_fraction =
+        static_cast<double>(off) / static_cast<double>(std::max<std::size_t>(n, 1));
+    valid = psnr >= kEmbreeFrameMinPsnr && off_fraction <= kEmbreeFrameMaxOff &&
+            ref.rays.primary == e.rays.primary;
+    return std::string(valid ? "valid" : "INVALID") + ": Embree frame vs the reference at " +
+           std::to_string(small.image.width) + "x" + std::to_string(small.image.height) +
+           format(": PSNR %.1f dB", psnr) +
+           format(", %.4f%% of pixels off by > 0.01", 100.0 * off_fraction) + ", rays " +
+           std::to_string(e.rays.total()) + " vs " + std::to_string(ref.rays.total());
+}
+#endif
 
 struct Variant {
     PixelOrder order;
@@ -391,7 +438,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
         // Embree's best configuration (user geometry: its build is the one timed), and its
         // built-in sphere primitive, built once.
         std::unique_ptr<EmbreeScene> embree, embree_point;
-        if (ctx.embree_available && ray_sets)
+        if (ctx.embree_available && (ray_sets || wants(Workload::whitted)))
             arena.execute([&] {
                 embree_point = std::make_unique<EmbreeScene>(scene, compiled, o.threads,
                                                              EmbreeGeometry::sphere_point);
@@ -400,7 +447,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
         SphereBvh bvh;
         for (int build = 0; build < kBuildReps; ++build) {
 #if OCTRAY_HAVE_EMBREE
-            if (ctx.embree_available && ray_sets) {
+            if (ctx.embree_available && (ray_sets || wants(Workload::whitted))) {
                 embree.reset();
                 arena.execute([&] {
                     embree = std::make_unique<EmbreeScene>(scene, compiled, o.threads,
@@ -652,6 +699,49 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                             report.rows.push_back(std::move(row));
                         }
                 }
+#if OCTRAY_HAVE_EMBREE
+                // The same frames with Embree answering the hit queries (user geometry,
+                // 16- and 8-wide packets of each generation's rays).
+                if (embree) {
+                    const Scene small = validation_scene(spec, o);
+                    for (EmbreeMode mode : {EmbreeMode::packet16, EmbreeMode::packet8}) {
+                        const EmbreeFrames frames(*embree, mode, isas.back());
+                        BenchRow row =
+                            base_row(Workload::whitted, Variant{PixelOrder::tiled, tile});
+                        row.system = "embree";
+                        row.mode = embree_mode_name(mode);
+                        row.isa = embree_geometry_name(embree->geometry());
+                        bool ok = false;
+                        row.validation = validate_embree_render(small, frames, o, ok);
+                        row.valid = ok;
+                        RenderOptions ro;
+                        ro.threads = ctx.threads;
+                        ro.tile_width = tile.width;
+                        ro.tile_height = tile.height;
+                        RenderResult last;
+                        for (int i = 0; i < std::max(1, o.warmup); ++i)
+                            last = frames.render(compiled, ro);
+                        for (int i = 0; i < o.reps; ++i) {
+                            last = frames.render(compiled, ro);
+                            row.seconds.push_back(last.seconds);
+                        }
+                        row.counts = last.rays;
+                        row.rays = last.rays.total();
+                        row.hit_fraction = std::nan("");
+                        row.timing = summarize(row.seconds, row.rays);
+                        row.frames_per_second = row.timing.seconds_median > 0.0
+                                                    ? 1.0 / row.timing.seconds_median
+                                                    : 0.0;
+                        log_line(log, "  whitted embree " + row.mode + " " + row.isa +
+                                          " tile " + row.tile + ": " +
+                                          format("%.3f frames/s", row.frames_per_second) +
+                                          ", " +
+                                          format("%.2f Mrays/s", row.timing.mrays_median) +
+                                          (row.valid ? "" : " (" + row.validation + ")"));
+                        report.rows.push_back(std::move(row));
+                    }
+                }
+#endif
             }
         }
         report.scenes.push_back(std::move(info));

@@ -252,147 +252,171 @@ RTCIntersectContext make_context(bool coherent) {
     return context;
 }
 
-void set_ray(RTCRay& r, const RaySet& rays, std::uint32_t i) {
-    r.org_x = rays.ox[i], r.org_y = rays.oy[i], r.org_z = rays.oz[i];
-    r.tnear = rays.t_min;
-    r.dir_x = rays.dx[i], r.dir_y = rays.dy[i], r.dir_z = rays.dz[i];
-    r.time = 0.0f;
-    r.tfar = rays.t_max[i];
-    r.mask = 0xFFFFFFFFu;
-    r.id = i;
-    r.flags = 0;
-}
-
-// Lanes [first, first + K) of the set into a K-wide packet; lanes past `end` are off.
+// Lanes [first, first + K) into a K-wide packet. Lanes past `end` are off and carry a
+// harmless ray (origin 0, direction +z, empty interval): Embree 3.13's emulated 16-wide
+// calls assert that every ray of an 8-wide half is valid, off lanes included, and the
+// kernels' streams hold garbage past their count.
 template <int K, class RayK>
-void set_ray_packet(RayK& r, int (&valid)[K], const RaySet& rays, std::uint32_t first,
-                    std::uint32_t end) {
+void set_ray_packet(RayK& r, int (&valid)[K], const EmbreeScene::RayArrays& rays,
+                    std::uint32_t first, std::uint32_t end) {
     for (int k = 0; k < K; ++k) {
         const std::uint32_t i = first + static_cast<std::uint32_t>(k);
-        // Rays past the set's padding are never read: the lane is off and keeps a harmless
-        // copy of the first ray.
-        const std::uint32_t at = i < rays.ox.size() ? i : first;
-        valid[k] = i < end ? -1 : 0;
-        r.org_x[k] = rays.ox[at], r.org_y[k] = rays.oy[at], r.org_z[k] = rays.oz[at];
+        const bool on = i < end;
+        valid[k] = on ? -1 : 0;
+        r.org_x[k] = on ? rays.ox[i] : 0.0f;
+        r.org_y[k] = on ? rays.oy[i] : 0.0f;
+        r.org_z[k] = on ? rays.oz[i] : 0.0f;
         r.tnear[k] = rays.t_min;
-        r.dir_x[k] = rays.dx[at], r.dir_y[k] = rays.dy[at], r.dir_z[k] = rays.dz[at];
+        r.dir_x[k] = on ? rays.dx[i] : 0.0f;
+        r.dir_y[k] = on ? rays.dy[i] : 0.0f;
+        r.dir_z[k] = on ? rays.dz[i] : 1.0f;
         r.time[k] = 0.0f;
-        r.tfar[k] = rays.t_max[at];
+        r.tfar[k] = !on ? rays.t_min : rays.t_max ? rays.t_max[i] : kInfinity;
         r.mask[k] = 0xFFFFFFFFu;
         r.id[k] = i;
         r.flags[k] = 0;
     }
 }
 
-}  // namespace
+void set_ray(RTCRay& r, const EmbreeScene::RayArrays& rays, std::uint32_t i) {
+    r.org_x = rays.ox[i], r.org_y = rays.oy[i], r.org_z = rays.oz[i];
+    r.tnear = rays.t_min;
+    r.dir_x = rays.dx[i], r.dir_y = rays.dy[i], r.dir_z = rays.dz[i];
+    r.time = 0.0f;
+    r.tfar = rays.t_max ? rays.t_max[i] : kInfinity;
+    r.mask = 0xFFFFFFFFu;
+    r.id = i;
+    r.flags = 0;
+}
+
+EmbreeScene::RayArrays arrays_of(const RaySet& rays, std::uint32_t first) {
+    return {rays.ox.data() + first,    rays.oy.data() + first,
+            rays.oz.data() + first,    rays.dx.data() + first,
+            rays.dy.data() + first,    rays.dz.data() + first,
+            rays.t_max.data() + first, rays.t_min};
+}
 
 // K-wide packets: rtcIntersect8 / rtcIntersect16 and their occluded twins.
-template <int K, class RayHitK, class RayK>
-struct PacketCalls;
+template <int K>
+struct Packet;
 template <>
-struct PacketCalls<8, RTCRayHit8, RTCRay8> {
-    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RTCRayHit8* r) {
+struct Packet<8> {
+    using RayHit = RTCRayHit8;
+    using Ray = RTCRay8;
+    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) {
         rtcIntersect8(v, s, c, r);
     }
-    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, RTCRay8* r) {
+    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) {
         rtcOccluded8(v, s, c, r);
     }
 };
 template <>
-struct PacketCalls<16, RTCRayHit16, RTCRay16> {
-    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RTCRayHit16* r) {
+struct Packet<16> {
+    using RayHit = RTCRayHit16;
+    using Ray = RTCRay16;
+    static void intersect(const int* v, RTCScene s, RTCIntersectContext* c, RayHit* r) {
         rtcIntersect16(v, s, c, r);
     }
-    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, RTCRay16* r) {
+    static void occluded(const int* v, RTCScene s, RTCIntersectContext* c, Ray* r) {
         rtcOccluded16(v, s, c, r);
     }
 };
 
-template <int K, class RayHitK, class RayK>
+}  // namespace
+
+template <int K>
 void intersect_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context,
-                       const RaySet& rays, std::uint32_t first, std::uint32_t end,
-                       HitSet& hits) {
-    alignas(64) RayHitK rh;
+                       const EmbreeScene::RayArrays& rays, std::uint32_t count, float* t,
+                       std::int32_t* object) {
+    alignas(64) typename Packet<K>::RayHit rh;
     alignas(64) int valid[K];
-    for (std::uint32_t base = first; base < end; base += K) {
-        set_ray_packet<K>(rh.ray, valid, rays, base, end);
+    for (std::uint32_t base = 0; base < count; base += K) {
+        set_ray_packet<K>(rh.ray, valid, rays, base, count);
         for (int k = 0; k < K; ++k) {
             rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
             rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
-        PacketCalls<K, RayHitK, RayK>::intersect(valid, im.scene, &context, &rh);
-        for (std::uint32_t k = 0; k < K && base + k < end; ++k) {
-            const std::int32_t object =
+        Packet<K>::intersect(valid, im.scene, &context, &rh);
+        for (std::uint32_t k = 0; k < K && base + k < count; ++k) {
+            const std::int32_t o =
                 im.object(rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k]);
-            hits.object[base + k] = object;
-            hits.t[base + k] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar[k];
+            object[base + k] = o;
+            t[base + k] = o == kernels::kNoHit ? kInfinity : rh.ray.tfar[k];
         }
     }
 }
 
-template <int K, class RayHitK, class RayK>
+template <int K>
 void occluded_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context,
-                      const RaySet& rays, std::uint32_t first, std::uint32_t end,
-                      HitSet& hits) {
-    alignas(64) RayK r;
+                      const EmbreeScene::RayArrays& rays, std::uint32_t count,
+                      std::uint32_t* occluded) {
+    alignas(64) typename Packet<K>::Ray r;
     alignas(64) int valid[K];
-    for (std::uint32_t base = first; base < end; base += K) {
-        set_ray_packet<K>(r, valid, rays, base, end);
-        PacketCalls<K, RayHitK, RayK>::occluded(valid, im.scene, &context, &r);
-        for (std::uint32_t k = 0; k < K && base + k < end; ++k)
-            hits.object[base + k] = r.tfar[k] < 0.0f ? kOccluded : kernels::kNoHit;
+    for (std::uint32_t base = 0; base < count; base += K) {
+        set_ray_packet<K>(r, valid, rays, base, count);
+        Packet<K>::occluded(valid, im.scene, &context, &r);
+        for (std::uint32_t k = 0; k < K && base + k < count; ++k)
+            occluded[base + k] = r.tfar[k] < 0.0f ? 1u : 0u;  // occluded: tfar = -inf
     }
 }
 
-void EmbreeScene::intersect(EmbreeMode mode, const RaySet& rays, std::uint32_t first,
-                            std::uint32_t n, HitSet& hits, bool coherent) const {
+void EmbreeScene::intersect(EmbreeMode mode, const RayArrays& rays, std::uint32_t count,
+                            float* t, std::int32_t* object, bool coherent) const {
     const Impl& im = *impl_;
     RTCIntersectContext context = make_context(coherent);
-    const std::uint32_t end = first + n;
     switch (mode) {
         case EmbreeMode::packet8:
-            return intersect_packets<8, RTCRayHit8, RTCRay8>(im, context, rays, first, end,
-                                                             hits);
+            return intersect_packets<8>(im, context, rays, count, t, object);
         case EmbreeMode::packet16:
-            return intersect_packets<16, RTCRayHit16, RTCRay16>(im, context, rays, first, end,
-                                                                hits);
+            return intersect_packets<16>(im, context, rays, count, t, object);
         case EmbreeMode::single:
             break;
     }
-    for (std::uint32_t i = first; i < end; ++i) {
+    for (std::uint32_t i = 0; i < count; ++i) {
         RTCRayHit rh;
         set_ray(rh.ray, rays, i);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(im.scene, &context, &rh);
-        const std::int32_t object = im.object(rh.hit.geomID, rh.hit.primID, rh.hit.instID[0]);
-        hits.object[i] = object;
-        hits.t[i] = object == kernels::kNoHit ? kInfinity : rh.ray.tfar;
+        object[i] = im.object(rh.hit.geomID, rh.hit.primID, rh.hit.instID[0]);
+        t[i] = object[i] == kernels::kNoHit ? kInfinity : rh.ray.tfar;
     }
+}
+
+void EmbreeScene::occluded(EmbreeMode mode, const RayArrays& rays, std::uint32_t count,
+                           std::uint32_t* occluded, bool coherent) const {
+    const Impl& im = *impl_;
+    RTCIntersectContext context = make_context(coherent);
+    switch (mode) {
+        case EmbreeMode::packet8:
+            return occluded_packets<8>(im, context, rays, count, occluded);
+        case EmbreeMode::packet16:
+            return occluded_packets<16>(im, context, rays, count, occluded);
+        case EmbreeMode::single:
+            break;
+    }
+    for (std::uint32_t i = 0; i < count; ++i) {
+        RTCRay r;
+        set_ray(r, rays, i);
+        rtcOccluded1(im.scene, &context, &r);
+        occluded[i] = r.tfar < 0.0f ? 1u : 0u;
+    }
+}
+
+void EmbreeScene::intersect(EmbreeMode mode, const RaySet& rays, std::uint32_t first,
+                            std::uint32_t n, HitSet& hits, bool coherent) const {
+    intersect(mode, arrays_of(rays, first), n, hits.t.data() + first,
+              hits.object.data() + first, coherent);
 }
 
 void EmbreeScene::occluded(EmbreeMode mode, const RaySet& rays, std::uint32_t first,
                            std::uint32_t n, HitSet& hits, bool coherent) const {
-    const Impl& im = *impl_;
-    RTCIntersectContext context = make_context(coherent);
-    const std::uint32_t end = first + n;
-    // An occluded ray comes back with tfar = -inf.
-    switch (mode) {
-        case EmbreeMode::packet8:
-            return occluded_packets<8, RTCRayHit8, RTCRay8>(im, context, rays, first, end,
-                                                            hits);
-        case EmbreeMode::packet16:
-            return occluded_packets<16, RTCRayHit16, RTCRay16>(im, context, rays, first, end,
-                                                               hits);
-        case EmbreeMode::single:
-            break;
-    }
-    for (std::uint32_t i = first; i < end; ++i) {
-        RTCRay r;
-        set_ray(r, rays, i);
-        rtcOccluded1(im.scene, &context, &r);
-        hits.object[i] = r.tfar < 0.0f ? kOccluded : kernels::kNoHit;
-    }
+    // The 0/1 flags land in the object column itself (4 bytes each), then become ids: no
+    // allocation inside the timed loop.
+    std::int32_t* object = hits.object.data() + first;
+    occluded(mode, arrays_of(rays, first), n, reinterpret_cast<std::uint32_t*>(object),
+             coherent);
+    for (std::uint32_t i = 0; i < n; ++i) object[i] = object[i] ? kOccluded : kernels::kNoHit;
 }
 
 }  // namespace octray::bench

@@ -73,6 +73,19 @@ class EmbreeScene {
     void occluded(EmbreeMode mode, const RaySet& rays, std::uint32_t first, std::uint32_t n,
                   HitSet& hits, bool coherent) const;
 
+    // The same on plain arrays (the kernels' streams, bench/embree_frames.h): rays
+    // [0, count) with origin, direction and t_max (null: +inf), on (t_min, t_max); nothing
+    // past `count` is read. Closest hits write
+    // t (+inf for a miss) and the file index (kNoHit); any hits write 1 (occluded) or 0.
+    struct RayArrays {
+        const float *ox, *oy, *oz, *dx, *dy, *dz, *t_max;
+        float t_min;
+    };
+    void intersect(EmbreeMode mode, const RayArrays& rays, std::uint32_t count, float* t,
+                   std::int32_t* object, bool coherent) const;
+    void occluded(EmbreeMode mode, const RayArrays& rays, std::uint32_t count,
+                  std::uint32_t* occluded, bool coherent) const;
+
     // Seconds rtcCommitScene took (the BVH build), in the calling thread's TBB arena.
     double build_seconds() const;
 

@@ -395,8 +395,12 @@ class PacketTracer {
 }  // namespace
 
 RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options, Isa isa) {
+    return render_packet(scene, options, kernel_table(resolve_isa(isa)));
+}
+
+RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options,
+                           const kernels::KernelTable& table) {
     const auto start = std::chrono::steady_clock::now();
-    const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
     RenderResult result;
     // The crop and the sample range (render/crop.h), checked before any work. Tiles are
     // laid from the crop's corner; a pixel's value depends on neither.

@@ -5,6 +5,7 @@
 // by `octray verify` and tests/render/packet_renderer_test.cpp.
 
 #include "kernels/isa.h"
+#include "kernels/kernel_table.h"
 #include "render/types.h"
 #include "scene/compile.h"
 #include "scene/scene.h"
@@ -22,5 +23,10 @@ RenderResult render_packet(const Scene& scene, const RenderOptions& options = {}
 // The same from a scene compiled once (benchmarks, animations); seconds is render only.
 RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options = {},
                            Isa isa = Isa::automatic);
+
+// The same with a kernel table of the caller's: `octray bench` renders whole frames whose
+// closest_hit and any_hit trace with Embree (bench/embree_frames.h), the rest octray's.
+RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options,
+                           const kernels::KernelTable& table);
 
 }  // namespace octray

@@ -14,8 +14,10 @@
 #include <string>
 
 #include "bench/embree_baseline.h"
+#include "bench/embree_frames.h"
 #include "bench/ray_sets.h"
 #include "kernels/dispatch.h"
+#include "render/reference.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 
@@ -83,6 +85,38 @@ TEST_P(EmbreeAgreement, PrimaryRaysAgreeWithOctray) {
             EXPECT_EQ(t_mismatch, 0u) << t_mismatch << " of " << both
                                       << " both-hit rays differ in t by more than 1e-4";
         }
+#endif
+}
+
+// Whole frames with Embree answering the hit queries (bench/embree_frames.h): the image
+// is the reference's but where Embree's roots round differently, and both trace the same
+// primary rays. One EmbreeFrames at a time.
+TEST_P(EmbreeAgreement, WholeFramesMatchTheReference) {
+#if !OCTRAY_HAVE_EMBREE
+    GTEST_SKIP() << "Embree 3 was not found by CMake (or OCTRAY_WITH_EMBREE is OFF)";
+#else
+    const Scene scene = load_scene(std::string(GetParam()) + ",width=96,height=64");
+    const CompiledScene compiled = compile_scene(scene);
+    const EmbreeScene embree(scene, compiled, 1, EmbreeGeometry::user);
+    const RenderResult ref = render_reference(scene, {});
+    for (EmbreeMode mode : {EmbreeMode::packet16, EmbreeMode::packet8}) {
+        SCOPED_TRACE(embree_mode_name(mode));
+        const EmbreeFrames frames(embree, mode, Isa::automatic);
+        EXPECT_THROW(EmbreeFrames(embree, mode, Isa::automatic), std::logic_error);
+        const RenderResult e = frames.render(compiled, {});
+        ASSERT_EQ(e.image.pixel_count(), ref.image.pixel_count());
+        EXPECT_EQ(e.rays.primary, ref.rays.primary);
+        double squared = 0.0;
+        for (std::size_t k = 0; k < ref.image.pixel_count(); ++k) {
+            const Rgb a = ref.image.data()[k], b = e.image.data()[k];
+            ASSERT_TRUE(is_finite(b)) << "pixel " << k;
+            squared += (double(a.r) - b.r) * (double(a.r) - b.r) +
+                       (double(a.g) - b.g) * (double(a.g) - b.g) +
+                       (double(a.b) - b.b) * (double(a.b) - b.b);
+        }
+        const double mse = squared / (3.0 * static_cast<double>(ref.image.pixel_count()));
+        EXPECT_LE(mse, 1e-5) << "PSNR (peak 1) " << 10.0 * std::log10(1.0 / mse) << " dB";
+    }
 #endif
 }
 
