@@ -127,7 +127,8 @@ class Scene {
 
     // Throws Error(ErrorKind::scene) naming the first problem.
     void validate() const;
-    // The scene as JSON that Scene::from_json reads back to an identical scene.
+    // The scene as JSON that Scene::from_json reads back to an identical scene (the format
+    // of docs/scene-format.md). Validates first: throws Error(ErrorKind::scene).
     std::string to_json() const;
 
   private:
