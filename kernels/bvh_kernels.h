@@ -146,7 +146,7 @@ inline std::uint32_t leaf_count(std::uint32_t ref) {
 
 // Starts loading a leaf's spheres (the first cache line of each of the four arrays). A
 // packet pops the leaves it pushes soon after; without this, in a large scene, the first
-// load of each array waits for memory (bench/README.md, "Packets from one origin; leaf
+// load of each array waits for memory (docs/performance-log.md, "Packets from one origin; leaf
 // prefetches").
 inline void prefetch_leaf(const SceneView& s, std::uint32_t ref) {
     const std::uint32_t first = leaf_first(ref);
@@ -423,7 +423,7 @@ void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep,
 // enters takes all the packet's lanes; the bundle's own t_far (the farthest closest hit so
 // far) still culls the children behind every lane's hit. Rays from many origins
 // (reflections, shadows) spread the bundle's offsets and keep the per-lane tests
-// (bench/README.md, "Packets from one origin; leaf prefetches").
+// (docs/performance-log.md, "Packets from one origin; leaf prefetches").
 template <class F>
 struct PacketFrustum {
     using Plane = const float (BvhNode8::*)[kBvhWidth];
@@ -841,7 +841,7 @@ void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
     // Packets of neighbouring pixels' shadow rays start on surfaces at any depth and may
     // head for different lights, and their traversals share little. Sorted by direction
     // octant and origin cell, rays from one neighbourhood towards one light travel
-    // together (bench/README.md: shadow rays 7-13 % faster on random:65536,
+    // together (docs/performance-log.md: shadow rays 7-13 % faster on random:65536,
     // random:1048576 and sphereflake:5). Each ray's answer is exact whatever its packet,
     // so the order changes no result. The sort is a counting sort of words holding the key
     // (18 bits) above the ray's index in the batch (12 bits), two passes of 9 bits.

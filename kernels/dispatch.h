@@ -49,12 +49,12 @@ const kernels::KernelTable& kernel_table(Isa isa);
 kernels::SceneView make_scene_view(const CompiledScene& scene);
 
 // Packets with fewer live lanes than this continue ray by ray in the BVH (measured:
-// bench/README.md, "The packet → single-ray switch").
+// docs/performance-log.md, "The packet → single-ray switch").
 inline constexpr std::uint32_t kBvhPacketMinLanes = 2;
 
 // From this many spheres on, the BVH's any-hit regroups shadow rays into packets of
 // neighbouring origins and one direction octant: below, the sort costs more than it saves
-// (measured: bench/README.md, "BVH: millions of spheres against Embree").
+// (measured: docs/performance-log.md, "BVH: millions of spheres against Embree").
 inline constexpr std::uint32_t kBvhShadowSortMinSpheres = 32768;
 
 // The same with the spheres' BVH built from `scene` (scene/bvh.h); both must outlive the

@@ -162,6 +162,7 @@ ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
         bool finite = true;
         for (const auto& [index_a, index_b] : result.channel_indices) {
             const float va = a.plane(index_a)[i], vb = b.plane(index_b)[i];
+            if (std::isinf(va) && va == vb) continue;  // equal infinities: no error
             if (!std::isfinite(va) || !std::isfinite(vb)) {
                 finite = false;
                 break;

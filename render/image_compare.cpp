@@ -220,6 +220,11 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
 
         for (std::size_t i = 0; i < pixels; ++i) {
             const float va = plane_a[i], vb = plane_b[i];
+            if (std::isinf(va) && va == vb) {
+                // Equal infinities are equal (as in idiff): a depth AOV's +inf background
+                // matches itself. Neither an error nor counted in the NaN/Inf census.
+                continue;
+            }
             if (!std::isfinite(va) || !std::isfinite(vb)) {
                 // Policy (COMPARE.md): NaN or Inf in either image is an infinite error. It
                 // fails and warns the pixel and is counted, but stays out of the sums, which
@@ -310,8 +315,10 @@ ChannelImage difference_image(const ChannelImage& a, const ChannelImage& b,
         const float* plane_b = b.plane(result.channel_indices[k].second);
         float* out = diff.plane(static_cast<int>(k));
         for (std::size_t i = 0; i < pixels; ++i)
-            out[i] = static_cast<float>(
-                std::fabs(static_cast<double>(plane_a[i]) - static_cast<double>(plane_b[i])));
+            out[i] = std::isinf(plane_a[i]) && plane_a[i] == plane_b[i]
+                         ? 0.0f  // equal infinities are equal
+                         : static_cast<float>(std::fabs(static_cast<double>(plane_a[i]) -
+                                                        static_cast<double>(plane_b[i])));
     }
     return diff;
 }

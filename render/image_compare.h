@@ -71,7 +71,8 @@ struct ErrorStats {
     double fail_percent = 0.0;  // of all the image's pixels
     double warn_percent = 0.0;
     // Pixels where A or B holds NaN or Inf (in this channel; for "all", in any). They
-    // count as failing and warning pixels too.
+    // count as failing and warning pixels too. Equal infinities (+Inf against +Inf, -Inf
+    // against -Inf) are equal values, counted nowhere here.
     std::uint64_t nonfinite_pixels = 0;
     std::uint64_t nan_a = 0, inf_a = 0, nan_b = 0, inf_b = 0;  // values, not pixels
     std::optional<PixelSample> first_nonfinite;                // in scan order
@@ -95,7 +96,8 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                              const CompareOptions& options = {});
 
 // |A - B| for each compared channel (NaN where either value is NaN, Inf for an Inf against
-// a finite value), named as the channels compared.
+// a finite value or the other infinity, 0 for equal infinities), named as the channels
+// compared.
 ChannelImage difference_image(const ChannelImage& a, const ChannelImage& b,
                               const CompareResult& result);
 

@@ -1,4 +1,4 @@
-// The scalar reference renderer. Each function follows shared/spec/rendering-model.md
+// The scalar reference renderer. Each function follows docs/rendering-model.md
 // step by step; render/README.md lists the few choices the model leaves open.
 
 #include "render/reference.h"

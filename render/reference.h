@@ -1,6 +1,6 @@
 #pragma once
 // The scalar reference renderer: one ray at a time, written for clarity. It implements
-// shared/spec/rendering-model.md literally and is the oracle the SIMD path is judged by.
+// docs/rendering-model.md literally and is the oracle the SIMD path is judged by.
 // It is built on core/ and scene/ only, never on kernels/, so it stays an independent check.
 
 #include <cstdint>

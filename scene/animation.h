@@ -1,5 +1,5 @@
 #pragma once
-// Key-frame animation of the camera and of named spheres (shared/spec/scene-format.md,
+// Key-frame animation of the camera and of named spheres (docs/scene-format.md,
 // "Animation"), and the still scene a frame renders. Rules chosen where the spec is
 // silent are in scene/README.md ("Animation").
 //

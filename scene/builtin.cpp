@@ -1,4 +1,4 @@
-// The built-in scenes of shared/spec/scene-format.md: whitted, random:N, sphereflake:L,
+// The built-in scenes of docs/scene-format.md: whitted, random:N, sphereflake:L,
 // and the ",key=value" overrides after them. Geometry, camera and lights of each are
 // documented in scene/README.md.
 
@@ -223,7 +223,7 @@ Scene make_whitted() {
 }
 
 // ---------------------------------------------------------------------------------------
-// random:N — exactly as shared/spec/scene-format.md specifies it.
+// random:N — exactly as docs/scene-format.md specifies it.
 
 Scene make_random(std::uint64_t count, std::uint64_t seed) {
     Scene s;

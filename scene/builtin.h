@@ -1,5 +1,5 @@
 #pragma once
-// The built-in scenes of shared/spec/scene-format.md.
+// The built-in scenes of docs/scene-format.md.
 
 #include <optional>
 #include <string>

@@ -1,4 +1,4 @@
-// JSON scene files (shared/spec/scene-format.md) into the authored Scene, and the semantic
+// JSON scene files (docs/scene-format.md) into the authored Scene, and the semantic
 // checks every scene passes before it is rendered. Defaults and the exact rules are in
 // scene/README.md; every message names the file, the JSON path and what was expected.
 
@@ -31,6 +31,7 @@
 
 #include "scene/builtin.h"
 #include "scene/camera.h"
+#include "scene/suggest.h"
 
 namespace octray {
 namespace {
@@ -53,6 +54,19 @@ constexpr std::int64_t kFramebufferBytesPerPixel = 12;  // three floats
 constexpr double kUnitTolerance = 1e-6;
 // validate_scene is looser: it only has to catch normals that were never normalised.
 constexpr double kValidateUnitTolerance = 1e-5;
+// Refraction scales directions by the index ratio (or its inverse); far beyond real
+// materials (1 to about 4) the float refraction vector loses its precision and degenerate
+// directions render NaN (issue 23: ior 1e8 did, 1e7 too). 100 leaves a wide margin.
+constexpr float kMinIor = 0.01f;
+constexpr float kMaxIor = 100.0f;
+// A thin lens much wider than its focus distance starts rays so far off the view axis that
+// float precision breaks down: measured on the built-in and golden scenes, 10 x renders
+// normal values, 100 x absurd ones and 300 x infinite or NaN pixels (issue 23: aperture
+// 1e20 rendered 13915 of 14400 pixels NaN).
+constexpr float kMaxApertureRatio = 10.0f;
+// Beyond this the focal point's distance overflows float when squared (a focus distance
+// of 1e20 renders every pixel NaN, even through a pinhole-sized lens).
+constexpr float kMaxFocusDistance = 1e18f;
 
 // ---------------------------------------------------------------------------------------
 // Formatting helpers
@@ -129,47 +143,11 @@ std::string index_path(const std::string& path, std::size_t i) {
     return path + "[" + std::to_string(i) + "]";
 }
 
-// Edit distance counting a swap of neighbours as one edit (optimal string alignment), so
-// that "widht" is one typo away from "width".
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-    const std::size_t w = b.size() + 1;
-    std::vector<std::size_t> d((a.size() + 1) * w);
-    for (std::size_t i = 0; i <= a.size(); ++i) d[i * w] = i;
-    for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            std::size_t best = std::min(
-                {d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + cost});
-            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
-                best = std::min(best, d[(i - 2) * w + j - 2] + 1);
-            }
-            d[i * w + j] = best;
-        }
-    }
-    return d[a.size() * w + b.size()];
-}
-
-// " (did you mean "x"?)" when one candidate is close, else "".
+// " (did you mean "x"?)" when one candidate is close (scene/suggest.h), else "".
 std::string suggestion(std::string_view word, std::span<const std::string_view> candidates) {
-    // The edit distance costs |word| x |candidate| time and memory; beyond a few dozen
-    // characters a typo is unlikely and two long names would make it quadratic.
-    if (word.size() > kMaxQuotedLength) return "";
-    const std::size_t limit = std::clamp<std::size_t>(word.size() / 3, 1, 2);
-    std::string_view best;
-    std::size_t best_distance = std::numeric_limits<std::size_t>::max();
-    for (std::string_view c : candidates) {
-        // The distance is at least the difference in length.
-        if (c.size() > word.size() + limit || word.size() > c.size() + limit) continue;
-        const std::size_t d = edit_distance(word, c);
-        if (d < best_distance) {
-            best = c;
-            best_distance = d;
-        }
-    }
-    // Up to a third of the word may be wrong (at least one edit, at most two).
-    if (best_distance == 0 || best_distance > limit) return "";
-    return " (did you mean " + quote_text(best) + "?)";
+    const auto best = closest_word(word, candidates);
+    if (!best) return "";
+    return " (did you mean " + quote_text(*best) + "?)";
 }
 
 std::string join_quoted(std::span<const std::string_view> words) {
@@ -1023,6 +1001,23 @@ class Validator {
             case CameraType::thinlens:
                 non_negative(c.aperture, "camera.aperture", "a lens radius");
                 positive(c.focus_distance, "camera.focus_distance", "a focus distance");
+                if (c.focus_distance > kMaxFocusDistance) {
+                    fail("camera.focus_distance",
+                         "expected a focus distance of at most " +
+                             format_float(kMaxFocusDistance) +
+                             " (farther, the focal point overflows float), found " +
+                             format_float(c.focus_distance));
+                }
+                if (c.aperture > kMaxApertureRatio * c.focus_distance) {
+                    fail("camera.aperture",
+                         "expected a lens radius of at most 10 x the focus distance (here 10 "
+                         "x " +
+                             format_float(c.focus_distance) + " = " +
+                             format_float(kMaxApertureRatio * c.focus_distance) +
+                             "; a wider lens starts rays so far off the view axis that float "
+                             "precision breaks down), found " +
+                             format_float(c.aperture));
+                }
                 break;
             case CameraType::pinhole:
             case CameraType::fisheye:
@@ -1075,6 +1070,13 @@ class Validator {
             color(m.reflect, child_path(path, "reflect"));
             non_negative(m.transmit, child_path(path, "transmit"), "transmit");
             positive(m.ior, child_path(path, "ior"), "an index of refraction");
+            if (m.ior < kMinIor || m.ior > kMaxIor) {
+                fail(child_path(path, "ior"),
+                     "expected an index of refraction from " + format_float(kMinIor) + " to " +
+                         format_float(kMaxIor) +
+                         " (far beyond that ratio refraction loses float precision), found " +
+                         format_float(m.ior));
+            }
             if (m.checker) {
                 const std::string cpath = child_path(path, "checker");
                 color(m.checker->color, child_path(cpath, "color"));
@@ -1321,6 +1323,22 @@ class Validator {
 }  // namespace
 
 Scene parse_scene_json(std::string_view json_text, const std::string& source) {
+    // The JSON library ends its input at a NUL byte, which would let anything after one
+    // pass unread; strict JSON means the whole file, and JSON text never holds a NUL.
+    if (const std::size_t nul = json_text.find('\0'); nul != std::string_view::npos) {
+        std::size_t line = 1, line_start = 0;
+        for (std::size_t i = 0; i < nul; ++i) {
+            if (json_text[i] == '\n') {
+                ++line;
+                line_start = i + 1;
+            }
+        }
+        throw SceneError(source, "",
+                         "invalid JSON at line " + std::to_string(line) + ", column " +
+                             std::to_string(nul - line_start + 1) +
+                             ": a NUL byte (\\0); expected JSON text, which has none (a "
+                             "NUL inside a string is written \\u0000)");
+    }
     DomBuilder builder(json_text);
     const bool ok = Json::sax_parse(json_text, &builder, Json::input_format_t::json,
                                     /*strict=*/true, /*ignore_comments=*/false);

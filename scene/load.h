@@ -1,5 +1,5 @@
 #pragma once
-// Scenes from the command line: a JSON file (shared/spec/scene-format.md) or a built-in
+// Scenes from the command line: a JSON file (docs/scene-format.md) or a built-in
 // generator spec ("whitted", "random:1024,width=640", "sphereflake:4").
 
 #include <string>

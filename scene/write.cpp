@@ -1,4 +1,4 @@
-// A Scene back to the JSON of shared/spec/scene-format.md, such that parse_scene_json
+// A Scene back to the JSON of docs/scene-format.md, such that parse_scene_json
 // returns the identical Scene: every field written, floats exact, materials in order.
 
 #include <array>

@@ -7,8 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "core/image.h"
 #include "render/assemble.h"
 #include "render/image_io.h"
+#include "render/image_read.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -19,10 +22,46 @@ struct AssembleArguments {
     std::string output;
 };
 
+// The assembled R, G, B as the 8-bit sRGB preview `render --png` writes.
+AssembleSummary assemble_png(const std::vector<std::string>& part_paths,
+                             const std::string& output) {
+    std::vector<ExrImage> parts;
+    parts.reserve(part_paths.size());
+    for (const std::string& path : part_paths) parts.push_back(read_exr_image(path));
+    const ExrImage full = assemble_parts(parts, part_paths);
+    const ExrChannel* rgb[3] = {full.find_channel("R"), full.find_channel("G"),
+                                full.find_channel("B")};
+    if (!rgb[0] || !rgb[1] || !rgb[2])
+        throw UsageError("-o " + output +
+                         ": a PNG holds R, G, B, and the parts have no R, G and B channels; "
+                         "write an OpenEXR (.exr) instead");
+    const int width = full.data_window.width(), height = full.data_window.height();
+    Image image(width, height);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const std::size_t k =
+                static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                static_cast<std::size_t>(x);
+            image.at(x, y) = Rgb{rgb[0]->value(k), rgb[1]->value(k), rgb[2]->value(k)};
+        }
+    }
+    write_png_preview(output, image);
+    AssembleSummary summary;
+    summary.display_window = full.display_window;
+    summary.parts = parts.size();
+    for (const char* name : {"R", "G", "B"})
+        summary.channels.push_back(std::string(name) + " (8-bit sRGB)");
+    return summary;
+}
+
 void run_assemble(const AssembleArguments& args) {
+    const ImageFormat format =
+        require_image_format("-o", args.output, /*png_accepted=*/true,
+                             "a .png is the 8-bit sRGB preview of the assembled R, G, B");
     AssembleSummary summary;
     try {
-        summary = assemble_files(args.parts, args.output);
+        summary = format == ImageFormat::png ? assemble_png(args.parts, args.output)
+                                             : assemble_files(args.parts, args.output);
     } catch (const AssembleError& e) {
         // The parts named on the command line do not make one image: a usage error.
         throw UsageError(std::string("assemble: ") + e.what());
@@ -51,7 +90,9 @@ void add_assemble_command(CLI::App& app, CommandRunner& run) {
         ->type_name("PART.exr")
         ->required();
     cmd->add_option("-o,--output", args->output,
-                    "The full image (data window = display window), written atomically")
+                    "The full image (data window = display window), written atomically; the\n"
+                    "extension (any case) picks the format: .exr OpenEXR, every channel;\n"
+                    ".png the 8-bit sRGB preview of R, G, B (as render --png writes it)")
         ->type_name("FILE")
         ->required();
     cmd->footer(

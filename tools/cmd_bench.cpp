@@ -2,7 +2,9 @@
 // Thin: parse, call bench/bench_runner.h, report.
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -10,6 +12,7 @@
 #include "bench/bench_runner.h"
 #include "bench/embree_baseline.h"
 #include "kernels/dispatch.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -114,6 +117,9 @@ void run_bench_command(const BenchArguments& a) {
     }
 }
 
+// The integer options are ints.
+constexpr std::uint64_t kMaxInt = std::numeric_limits<int>::max();
+
 }  // namespace
 
 void add_bench_command(CLI::App& app, CommandRunner& run) {
@@ -131,15 +137,15 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         ->delimiter(',')
         ->type_name("LIST");
     cmd->add_option("--threads", a->threads, "Threads for both systems [default: all cores]")
-        ->check(CLI::NonNegativeNumber);
+        ->transform(decimal_integer(0, kMaxInt));
     cmd->add_option("--reps", a->reps, "Timed repetitions per row [default: 5]")
-        ->check(CLI::PositiveNumber);
+        ->transform(decimal_integer(1, kMaxInt));
     cmd->add_option("--warmup", a->warmup, "Untimed runs before them [default: 1]")
-        ->check(CLI::PositiveNumber);
+        ->transform(decimal_integer(1, kMaxInt));
     cmd->add_option("--width", a->width, "Frame width [default: 1920]")
-        ->check(CLI::PositiveNumber);
+        ->transform(decimal_integer(1, kMaxInt));
     cmd->add_option("--height", a->height, "Frame height [default: 1080]")
-        ->check(CLI::PositiveNumber);
+        ->transform(decimal_integer(1, kMaxInt));
     cmd->add_option("--json", a->json, "Also write the report as JSON")->type_name("FILE");
     cmd->add_option(
            "--tile", a->tiles,
@@ -174,11 +180,12 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                         std::to_string(kBvhPacketMinLanes) + "]")
         ->delimiter(',')
         ->type_name("LIST")
-        ->check(CLI::Range(0, 9));
+        ->transform(decimal_integer(0, 9));
     cmd->add_option(
-        "--validate-rays", a->validate_rays,
-        "Rays per set checked against the oracles (octray rows: the scalar reference, bit "
-        "for bit; Embree rows: double precision, within 1e-4), 0 for all [default: 65536]");
+           "--validate-rays", a->validate_rays,
+           "Rays per set checked against the oracles (octray rows: the scalar reference, bit "
+           "for bit; Embree rows: double precision, within 1e-4), 0 for all [default: 65536]")
+        ->transform(decimal_integer(0, std::numeric_limits<std::uint32_t>::max()));
     cmd->add_flag("--no-embree", a->no_embree, "Measure octray alone");
     cmd->footer(
         "Examples:\n"

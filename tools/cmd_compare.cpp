@@ -3,6 +3,8 @@
 // and the exit codes are idiff's; render/COMPARE.md defines them.
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstring>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -14,6 +16,7 @@
 #include "render/image_compare.h"
 #include "render/image_io.h"
 #include "render/image_read.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -44,8 +47,14 @@ void print_json_outcome(const CompareArguments& args, std::string_view verdict, 
 }
 
 void run_compare(const CompareArguments& args) {
-    if (!args.diff.empty() && args.diff == args.heatmap)
-        throw UsageError("--diff and --heatmap name the same file: " + args.diff);
+    if (!args.diff.empty())
+        require_image_format("--diff", args.diff, /*png_accepted=*/false,
+                             "--diff is |A - B| in float; for a PNG picture of the error "
+                             "use --heatmap FILE.png");
+    if (!args.diff.empty() && !args.heatmap.empty() &&
+        output_identity(args.diff) == output_identity(args.heatmap))
+        throw UsageError("--diff and --heatmap name the same file: " + args.diff + " and " +
+                         args.heatmap);
 
     ChannelImage a, b;
     CompareResult result;
@@ -78,7 +87,9 @@ void run_compare(const CompareArguments& args) {
                       << result.overall.max_abs_error << ")\n";
         std::cout << format_compare_report(result, args.options, args.a, args.b) << std::flush;
     }
-    if (!std::cout) throw IoError("cannot write the report to standard output");
+    if (!std::cout)
+        throw IoError(std::string("cannot write the report to standard output: ") +
+                      std::strerror(errno));
     if (result.verdict != Verdict::pass) throw CommandExit{static_cast<int>(result.verdict)};
 }
 
@@ -89,11 +100,12 @@ std::string compare_exit_code_help() {
            "  2  FAIL: over the fail limits (also a bad command line, reported on stderr)\n"
            "  3  the images cannot be compared: size, data window or channel mismatch\n"
            "  4  file error: an input is missing, unreadable, not an image, truncated or\n"
-           "     corrupt, or --diff / --heatmap cannot be written\n"
+           "     corrupt, or --diff / --heatmap / standard output cannot be written\n"
            "The last line of the report (or \"reason\" in --json) says why.\n";
 }
 
-CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
+// The largest finite threshold: any double.
+constexpr double kMaxThreshold = std::numeric_limits<double>::max();
 
 }  // namespace
 
@@ -108,40 +120,44 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
 
     CompareOptions& o = args->options;
     cmd->add_option("--fail", o.fail_threshold,
-                    "A pixel fails when any channel differs by more than X")
+                    "A pixel fails when any channel differs by more than X (>= 0, or inf)")
         ->type_name("X")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--failpercent", o.fail_percent,
                     "FAIL when more than P% of the pixels fail, 0..100")
         ->type_name("P")
-        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
-    cmd->add_option("--hardfail", o.hard_fail, "FAIL when any one error exceeds H")
+    cmd->add_option("--hardfail", o.hard_fail,
+                    "FAIL when any one error exceeds H (>= 0, or inf: no hard limit)")
         ->type_name("H")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--warn", o.warn_threshold,
-                    "A pixel warns when any channel differs by more than X")
+                    "A pixel warns when any channel differs by more than X (>= 0, or inf)")
         ->type_name("X")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--warnpercent", o.warn_percent,
                     "WARN when more than P% of the pixels warn, 0..100")
         ->type_name("P")
-        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
-    cmd->add_option("--hardwarn", o.hard_warn, "WARN when any one error exceeds H")
+    cmd->add_option("--hardwarn", o.hard_warn,
+                    "WARN when any one error exceeds H (>= 0, or inf: no hard limit)")
         ->type_name("H")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--channels", o.channels,
                     "Compare only these channels, by name (e.g. R,G,B or diffuse.R);\n"
                     "default: all, and both images must have the same channel names")
         ->type_name("LIST")
         ->delimiter(',');
-    cmd->add_option("--diff", args->diff, "Write |A - B| of the compared channels as float EXR")
-        ->type_name("FILE");
+    cmd->add_option("--diff", args->diff,
+                    "Write |A - B| of the compared channels as float OpenEXR; FILE must end\n"
+                    "in .exr (any case)")
+        ->type_name("FILE.exr");
     cmd->add_option("--heatmap", args->heatmap,
                     "Write a PNG heatmap of the largest channel error per pixel (magma,\n"
                     "0 to the max error, legend below; NaN/Inf in green)")
@@ -149,7 +165,9 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
     cmd->add_flag("--json", args->json, "Print the figures as JSON instead of the report");
     cmd->footer(
         "NaN or Inf in either image is an infinite error: the pixel fails and is counted;\n"
-        "the error figures are over the finite values. PSNR = 20 log10(peak / RMSE), peak =\n"
+        "the error figures are over the finite values. Equal infinities (+inf against\n"
+        "+inf, as a depth AOV's background) are equal. Thresholds are decimal numbers\n"
+        "(or inf); NaN is refused. PSNR = 20 log10(peak / RMSE), peak =\n"
         "max(1, largest value). See render/COMPARE.md.\n\n"
         "Examples:\n"
         "  octray compare ref.exr out.exr\n"

@@ -2,15 +2,19 @@
 // (one still by default; animations, frame ranges, several scenes, shards of a farm job)
 // to EXR (+ PNG previews). The frame loop itself lives in render_batch.cpp.
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -31,6 +35,7 @@
 #include "scene/scene.h"
 #include "scene/scene_error.h"
 #include "tools/batch.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
 #include "tools/render_batch.h"
@@ -72,6 +77,7 @@ struct RenderArguments {
     CLI::Option* max_depth_option = nullptr;
     CLI::Option* seed_option = nullptr;
     CLI::Option* shard_count_option = nullptr;
+    CLI::Option* compression_option = nullptr;
 };
 
 struct TileSize {
@@ -163,10 +169,29 @@ std::string default_pattern(bool sequence) {
 void check_output_directory(const fs::path& file) {
     fs::path dir = file.parent_path();
     if (dir.empty()) dir = ".";
-    std::error_code error;
-    if (!fs::is_directory(dir, error))
-        throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
-                      " does not exist");
+    struct stat info {};
+    if (::stat(dir.c_str(), &info) != 0) {
+        const int error = errno;
+        // A file in the way is the reason, not a missing directory: name it.
+        if (error == ENOTDIR) {
+            for (fs::path up = dir.parent_path(); !up.empty(); up = up.parent_path()) {
+                if (::stat(up.c_str(), &info) == 0) {
+                    if (!S_ISDIR(info.st_mode))
+                        throw IoError("cannot write " + file.string() + ": " + up.string() +
+                                      " is a file, not a directory");
+                    break;
+                }
+            }
+        }
+        if (error == ENOENT)
+            throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
+                          " does not exist");
+        throw IoError("cannot write " + file.string() + ": " + dir.string() + ": " +
+                      std::strerror(error));
+    }
+    if (!S_ISDIR(info.st_mode))
+        throw IoError("cannot write " + file.string() + ": " + dir.string() +
+                      " is a file, not a directory");
     if (::access(dir.c_str(), W_OK | X_OK) != 0)
         throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
                       " is not writable");
@@ -210,14 +235,26 @@ std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
         throw UsageError(std::string("output pattern: ") + e.what());
     }
 
-    // Two frames must never share a file (several scenes without {scene}, say).
+    // Two frames must never share a file (several scenes without {scene}, say). Files are
+    // told apart by what a write replaces, the directory entry (device and inode of the
+    // directory plus the name), so no spelling ("./", "..", a symlink) hides a clash.
     std::map<std::string, std::size_t> owner;
+    std::map<std::string, std::string> directories;  // each directory looked up once
+    const auto identity = [&directories](const std::string& file) {
+        const fs::path path(file);
+        const std::string dir = path.parent_path().string();
+        auto it = directories.find(dir);
+        if (it == directories.end())
+            it = directories.emplace(dir, directory_identity(dir)).first;
+        return it->second + path.filename().string();
+    };
     for (std::size_t j = 0; j < jobs.size(); ++j) {
-        if (!jobs[j].png.empty() && fs::path(jobs[j].png) == fs::path(jobs[j].output))
-            throw UsageError("-o and --png name the same file: " + jobs[j].output);
+        if (!jobs[j].png.empty() && identity(jobs[j].png) == identity(jobs[j].output))
+            throw UsageError("-o and --png name the same file: " + jobs[j].output + " and " +
+                             jobs[j].png);
         for (const std::string* file : {&jobs[j].output, &jobs[j].png}) {
             if (file->empty()) continue;
-            const std::string key = fs::absolute(*file).lexically_normal().string();
+            const std::string key = identity(*file);
             const auto [it, inserted] = owner.emplace(key, j);
             if (!inserted) {
                 const BatchJob& other = jobs[it->second];
@@ -232,6 +269,34 @@ std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
         }
     }
     return jobs;
+}
+
+// The format of -o, from its extension: OpenEXR, or the 8-bit sRGB PNG that --png writes.
+// A PNG holds 8-bit R, G, B and no header attributes, so the options that only an EXR can
+// carry are refused with it rather than silently dropped.
+ImageFormat output_format(const RenderArguments& args) {
+    if (args.output.empty()) return ImageFormat::exr;
+    const ImageFormat format =
+        require_image_format("-o", args.output, /*png_accepted=*/true,
+                             "--png FILE.png writes an 8-bit PNG preview next to an EXR -o");
+    if (format == ImageFormat::exr) return format;
+    const std::string png = "-o " + args.output + " writes an 8-bit sRGB PNG";
+    if (!args.png.empty())
+        throw UsageError(png +
+                         " already; --png adds a PNG preview next to an OpenEXR -o "
+                         "(-o FILE.exr --png FILE.png writes both)");
+    if (!args.aov.empty())
+        throw UsageError(png + ", which holds R, G, B only; --aov needs an OpenEXR -o (.exr)");
+    if (args.float32)
+        throw UsageError(png + "; --float sets the channel type of an OpenEXR -o (.exr)");
+    if (args.compression_option->count())
+        throw UsageError(png + "; --compression is the codec of an OpenEXR -o (.exr)");
+    if (args.progressive)
+        throw UsageError(png +
+                         "; --progressive needs an OpenEXR -o (.exr): it marks an unfinished "
+                         "pass in the EXR header (octray.samplesSoFar), which a PNG cannot "
+                         "carry, so a resume could not tell it from a finished frame");
+    return format;
 }
 
 batch::Shard resolve_shard(const RenderArguments& args) {
@@ -270,6 +335,7 @@ void run_render(const RenderArguments& args) {
     if (!compression) throw UsageError("--compression: unknown codec " + args.compression);
     settings.exr = {args.float32, *compression};
     settings.progressive = args.progressive;
+    settings.png_output = output_format(args) == ImageFormat::png;
     settings.skip_existing = args.skip_existing;
     settings.placeholders = args.placeholders;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
@@ -393,9 +459,12 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("SCENE...")
         ->capture_default_str();
     cmd->add_option("-o,--output", args->output,
-                    "Output EXR file or pattern: # runs or {frame:04d} become the frame\n"
-                    "number, {scene} the scene's name [default: {scene}.exr for a still,\n"
-                    "{scene}.####.exr for a sequence, in the current directory]")
+                    "Output file or pattern: # runs or {frame:04d} become the frame\n"
+                    "number, {scene} the scene's name. The extension (any case) picks the\n"
+                    "format: .exr OpenEXR, .png the 8-bit sRGB preview --png writes (no\n"
+                    "--png, --aov, --float, --compression or --progressive with it)\n"
+                    "[default: {scene}.exr for a still, {scene}.####.exr for a sequence,\n"
+                    "in the current directory]")
         ->type_name("PATTERN");
     cmd->add_option("--frames", args->frames,
                     "Frames to render: 5, 1-100, 1-100:2 (every 2nd), lists: 1-10,20,30-40:5\n"
@@ -412,7 +481,7 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         cmd->add_option("--shard-count", args->shard_count,
                         "The number of shards for --shard auto with JOB_COMPLETION_INDEX")
             ->type_name("N")
-            ->check(quiet(CLI::Range(1, 1 << 20)));
+            ->transform(decimal_integer(1, 1 << 20));
     cmd->add_flag("--skip-existing", args->skip_existing,
                   "Resume: leave frames whose outputs (the EXR and the --png preview) all\n"
                   "exist (outputs are written atomically, so an existing file is finished;\n"
@@ -451,38 +520,34 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         cmd->add_option("--width", args->width,
                         "Image width in pixels, 1..65536 (overrides the scene)")
             ->type_name("W")
-            ->check(quiet(CLI::Range(1, 65536)));
+            ->transform(decimal_integer(1, 65536));
     args->height_option =
         cmd->add_option("--height", args->height,
                         "Image height in pixels, 1..65536 (overrides the scene)")
             ->type_name("H")
-            ->check(quiet(CLI::Range(1, 65536)));
+            ->transform(decimal_integer(1, 65536));
     args->spp_option =
         cmd->add_option("--spp", args->spp,
                         "Samples per pixel, 1..2^20; square counts are stratified, others\n"
                         "jittered (overrides the scene)")
             ->type_name("N")
-            ->check(quiet(CLI::Range(1, 1 << 20)));
+            ->transform(decimal_integer(1, 1 << 20));
     args->max_depth_option =
         cmd->add_option("--max-depth", args->max_depth,
                         "Reflection/refraction bounces, 0..1000; 0 = primary rays only\n"
                         "(overrides the scene)")
             ->type_name("D")
-            ->check(quiet(CLI::Range(0, 1000)));
+            ->transform(decimal_integer(0, 1000));
     args->seed_option =
         cmd->add_option("--seed", args->seed,
                         "Seed of the sample jitter, 0..2^64-1 (overrides the scene)")
             ->type_name("S")
-            // CLI11 would wrap a negative number around into a huge unsigned one.
-            ->check([](const std::string& text) {
-                return text.find('-') == std::string::npos ? std::string()
-                                                           : "the seed cannot be negative";
-            });
+            ->transform(decimal_integer(0, std::numeric_limits<std::uint64_t>::max()));
     cmd->add_option("--threads", args->threads,
                     "Worker threads, 0..4096; 0 = every core available (the image does not\n"
                     "depend on it)")
         ->type_name("N")
-        ->check(quiet(CLI::Range(0, 4096)))
+        ->transform(decimal_integer(0, 4096))
         ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer);\n"
@@ -504,18 +569,20 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("MODE")
         ->check(quiet(CLI::IsMember({"auto", "bvh", "none"})))
         ->capture_default_str();
-    cmd->add_option(
-           "--png", args->png,
-           "Also write an 8-bit sRGB PNG preview (clamped to [0,1]); a pattern like -o")
+    cmd->add_option("--png", args->png,
+                    "Also write an 8-bit sRGB PNG preview (clamped to [0,1]) next to an\n"
+                    "OpenEXR -o; a pattern like -o. Always PNG, whatever the name; it must\n"
+                    "name another file than -o")
         ->type_name("FILE");
     cmd->add_flag("--float", args->float32, "Write 32-bit float channels instead of half");
-    cmd->add_option("--compression", args->compression,
-                    "EXR codec: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab\n"
-                    "(pxr24 is lossy for --float; b44*, dwa* are lossy)")
-        ->type_name("C")
-        ->check(quiet(CLI::IsMember(
-            {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})))
-        ->capture_default_str();
+    args->compression_option =
+        cmd->add_option("--compression", args->compression,
+                        "EXR codec: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab\n"
+                        "(pxr24 is lossy for --float; b44*, dwa* are lossy)")
+            ->type_name("C")
+            ->check(quiet(CLI::IsMember(
+                {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})))
+            ->capture_default_str();
     cmd->add_option("--tile", args->tile,
                     "Tile size WxH (or N for NxN) handed to the worker threads; the image\n"
                     "does not depend on it")
@@ -529,6 +596,7 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray render                                  # whitted scene -> whitted.exr\n"
         "  octray render whitted -o whitted.exr --png whitted.png\n"
+        "  octray render whitted -o whitted.png            # only the 8-bit sRGB PNG\n"
         "  octray render random:1024,width=640,height=360 --spp 4 -o random.exr\n"
         "  octray render shot.json --frames 1-100:2,150 -o out/shot.####.exr\n"
         "  octray render a.json b.json -o 'out/{scene}.{frame:04d}.exr' --skip-existing\n"

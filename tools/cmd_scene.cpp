@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -34,7 +35,9 @@ void run_scene(const SceneArguments& args) {
     if (json.empty() || json.back() != '\n') json += '\n';
     if (args.output.empty()) {
         std::cout << json << std::flush;
-        if (!std::cout) throw IoError("cannot write the scene to standard output");
+        if (!std::cout)
+            throw IoError(std::string("cannot write the scene to standard output: ") +
+                          std::strerror(errno));
         return;
     }
     write_file_atomically(args.output, [&](const std::string& tmp) { write_text(tmp, json); });

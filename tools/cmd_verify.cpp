@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -14,6 +15,7 @@
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/load.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -110,16 +112,16 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         ->capture_default_str();
     cmd->add_option("--width", args->width, "Image width (overrides the scene)")
         ->type_name("W")
-        ->check(quiet(CLI::Range(1, 65536)));
+        ->transform(decimal_integer(1, 65536));
     cmd->add_option("--height", args->height, "Image height (overrides the scene)")
         ->type_name("H")
-        ->check(quiet(CLI::Range(1, 65536)));
+        ->transform(decimal_integer(1, 65536));
     cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")
         ->type_name("N")
-        ->check(quiet(CLI::Range(1, 1 << 20)));
+        ->transform(decimal_integer(1, 1 << 20));
     cmd->add_option("--threads", args->threads, "Worker threads; 0 = every core")
         ->type_name("N")
-        ->check(quiet(CLI::Range(0, 4096)))
+        ->transform(decimal_integer(0, 4096))
         ->capture_default_str();
     cmd->add_option("--isa", args->isa, "ISA of the simd path: auto, avx2, sse4.1, sse2")
         ->type_name("ISA")
@@ -128,16 +130,16 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option("--fail", args->fail,
                     "A pixel fails when any channel differs by more than X")
         ->type_name("X")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();
     cmd->add_option("--failpercent", args->fail_percent,
                     "FAIL when more than P% of the pixels fail, 0..100")
         ->type_name("P")
-        ->check(quiet(CLI::Range(0.0, 100.0)))
+        ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
     cmd->add_option("--hardfail", args->hard_fail, "FAIL when any one error exceeds H")
         ->type_name("H")
-        ->check(quiet(CLI::NonNegativeNumber))
+        ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();
     cmd->footer(
         "Examples:\n"

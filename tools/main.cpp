@@ -10,6 +10,7 @@
 #include "core/version.h"
 #include "render/image_io.h"
 #include "scene/scene_error.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -20,7 +21,8 @@ std::string exit_code_help() {
            "  1  unexpected internal error (a bug, or out of memory)\n"
            "  2  usage error: unknown option, bad value, bad combination of options\n"
            "  3  scene error: the scene file or built-in spec cannot be loaded or is invalid\n"
-           "  4  I/O error: an output file cannot be written (nothing partial is left)\n";
+           "  4  I/O error: an output file cannot be written (nothing partial is left),\n"
+           "     or standard output cannot be (a closed pipe: EPIPE, not death by SIGPIPE)\n";
 }
 
 int run_command(const std::function<void()>& action) {
@@ -58,6 +60,10 @@ int main(int argc, char** argv) {
     // A write past `ulimit -f` then fails with EFBIG, reported as an I/O error with its
     // temporary removed, instead of SIGXFSZ killing the process mid-file.
     std::signal(SIGXFSZ, SIG_IGN);
+    // Likewise a write to a closed pipe (`octray ... | head -1`) fails with EPIPE and is
+    // reported as an I/O error (finish_standard_output), instead of SIGPIPE killing the
+    // process with status 141.
+    std::signal(SIGPIPE, SIG_IGN);
 
     CLI::App app{"octray renders Whitted-style ray-traced images (OpenEXR, with PNG previews).",
                  "octray"};
@@ -91,14 +97,24 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
+        // A mistyped option or command: name the one probably meant, as git and cargo do
+        // (the scene loader's "did you mean", scene/suggest.h).
+        if (e.get_exit_code() != 0) {
+            const std::string hint = mistyped_argument_hint(app);
+            if (!hint.empty()) {
+                std::cerr << "octray: error: " << hint
+                          << "\nRun with --help for more information.\n";
+                return kExitUsage;
+            }
+        }
         // app.exit prints --help / --version output (status 0) or the parse error with a
         // "Run with --help" hint; CLI11's own error numbers all mean "usage error" here.
         const int status = app.exit(e);
-        return status == 0 ? kExitSuccess : kExitUsage;
+        return finish_standard_output(status == 0 ? kExitSuccess : kExitUsage);
     }
     if (!run.action) {
         std::cerr << "octray: error: no command given\nRun with --help for more information.\n";
         return kExitUsage;
     }
-    return run_command(run.action);
+    return finish_standard_output(run_command(run.action));
 }

@@ -225,6 +225,10 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
 void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job,
                                 const Scene& posed, const RenderResult& result,
                                 const AovImages& aovs, int samples_so_far) const {
+    if (settings_.png_output) {
+        write_png_preview(job.output, result.image);
+        return;
+    }
     ExrImage exr = make_exr_image(result, settings_.exr,
                                   attributes(scene, posed, job.frame, result, samples_so_far));
     if (aovs.set.any())

@@ -43,6 +43,8 @@ struct BatchSettings {
     ExrWriteOptions exr;
     AovSet aovs;
     bool progressive = false;
+    // -o names PNG files: each job's output is the 8-bit sRGB preview, its png empty.
+    bool png_output = false;
     bool skip_existing = false;
     bool placeholders = false;
     ProgressMode progress = ProgressMode::lines;

@@ -3,6 +3,8 @@
 # Debian 12 with 2 cores:
 #   1. install what is missing (tools/setup.sh, apt),
 #   2. release preset (g++ 12, -Wall -Wextra -Werror, Embree): build, run the whole suite,
+#      then install that build into a temporary prefix and build and run examples/embed
+#      against the installed package (tests/install/run.sh),
 #   3. asan preset (clang, ASan + UBSan, Embree off so that configuration is built and
 #      tested too): build, run the whole suite again plus every libFuzzer target for
 #      OCTRAY_FUZZ_SECONDS (30) each,
@@ -18,6 +20,8 @@ cmake --preset release
 cmake --build --preset release -j2
 ctest --preset release
 echo "tools/test.sh: release done at $((SECONDS - start)) s"
+tests/install/run.sh build/release
+echo "tools/test.sh: install + examples/embed done at $((SECONDS - start)) s"
 
 cmake --preset asan
 cmake --build --preset asan -j2

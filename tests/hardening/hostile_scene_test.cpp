@@ -240,5 +240,23 @@ TEST(HostileScene, MirrorInsideMirrorEndsByDepthOrByWeight) {
     }
 }
 
+// Issue 23: the scene limits on the index of refraction (0.01 ... 100) and on the thin
+// lens (radius up to 10 x the focus distance) are where rendering stays finite: scenes at
+// the limits render finite pixels on both paths (beyond them NaN or Inf appeared).
+TEST(HostileScene, ValuesAtTheRefractionAndLensLimitsRenderFinitely) {
+    for (const float ior : {100.0f, 0.01f}) {
+        Scene s = glass_and_mirrors(8);
+        for (NamedMaterial& m : s.materials)
+            if (m.material.transmit > 0.0f) m.material.ior = ior;
+        render_both(s, "ior " + std::to_string(ior));
+    }
+    Scene lens = glass_and_mirrors(5);
+    lens.image.spp = 4;
+    lens.camera.type = CameraType::thinlens;
+    lens.camera.focus_distance = 5.0f;
+    lens.camera.aperture = 50.0f;
+    render_both(lens, "thinlens aperture 10 x focus distance");
+}
+
 }  // namespace
 }  // namespace octray

@@ -1,4 +1,4 @@
-// The built-in scenes of shared/spec/scene-format.md: splitmix64 and random:N to the
+// The built-in scenes of docs/scene-format.md: splitmix64 and random:N to the
 // letter, sphereflake geometry, the whitted scene's framing, and the ",key=value" options.
 
 #include "scene/builtin.h"

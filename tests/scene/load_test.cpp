@@ -1,4 +1,4 @@
-// JSON scene loading: every key of shared/spec/scene-format.md, the defaults of
+// JSON scene loading: every key of docs/scene-format.md, the defaults of
 // scene/README.md, and every error with its file, JSON path and expectation.
 
 #include "scene/load.h"
@@ -643,6 +643,63 @@ TEST(SceneLoadError, ThinLens) {
     j["camera"]["focus_distance"] = 1;
     expect_json_error(j, "camera.aperture",
                       {"missing required key \"aperture\"", "lens radius"});
+}
+
+// Issue 23: refraction divides by the index or multiplies by it; beyond a ratio of 100 the
+// float refraction vector loses its precision and renders NaN pixels (ior 1e8 did). The
+// scene is refused with the limit stated instead.
+TEST(SceneLoadError, IndexOfRefractionHasStatedLimits) {
+    for (const double ior : {1e8, 1e20, 100.5, 0.005, 1e-8}) {
+        Json j = full_scene();
+        j["materials"]["glass"]["ior"] = ior;
+        expect_json_error(j, "materials.glass.ior",
+                          {"expected an index of refraction from 0.01 to 100", "found "});
+    }
+    for (const double ior : {100.0, 0.01, 1.0}) {
+        Json j = full_scene();
+        j["materials"]["glass"]["ior"] = ior;
+        EXPECT_NO_THROW(parse(j)) << ior;
+    }
+}
+
+// Issue 23: a thin lens far wider than its focus distance breaks float precision (aperture
+// 1e20 rendered 13915 of 14400 pixels NaN), as does a focal point beyond 1e18: refused,
+// the limits stated.
+TEST(SceneLoadError, ThinLensHasStatedLimits) {
+    Json j = full_scene();
+    // The focus distance defaults to |lookat - eye| = 5: the lens radius may be up to 50.
+    j["camera"] = {
+        {"type", "thinlens"}, {"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}, {"aperture", 1e20}};
+    expect_json_error(j, "camera.aperture",
+                      {"expected a lens radius of at most 10 x the focus distance",
+                       "10 x 5 = 50", "found 1e+20"});
+    j["camera"]["aperture"] = 50.5;
+    expect_json_error(j, "camera.aperture", {"10 x 5 = 50", "found 50.5"});
+    j["camera"]["aperture"] = 50;
+    EXPECT_NO_THROW(parse(j));
+    j["camera"]["focus_distance"] = 1e20;
+    j["camera"]["aperture"] = 0;
+    expect_json_error(j, "camera.focus_distance",
+                      {"expected a focus distance of at most 1e+18", "found 1e+20"});
+    j["camera"]["focus_distance"] = 1e18;
+    j["camera"]["aperture"] = 1e19;
+    EXPECT_NO_THROW(parse(j));
+}
+
+// Issue 23: strict JSON means the whole file: a NUL byte does not end the text (the JSON
+// library stops at one), it is an error that says where it is.
+TEST(SceneLoadError, NulBytesAreErrorsWithTheirPosition) {
+    const std::string valid = "{\n  \"camera\": {\"eye\": [0, 0, 5], \"lookat\": [0, 0, 0]}\n}";
+    ASSERT_NO_THROW(parse_scene_json(valid, kFile));
+    expect_text_error(valid + std::string("\0{\"garbage\":", 12), "",
+                      {"NUL byte", "line 3, column 2"});
+    expect_text_error(valid + std::string(1, '\0'), "", {"NUL byte", "line 3, column 2"});
+    std::string middle = valid;
+    middle[13] = '\0';  // the blank after "camera":
+    expect_text_error(middle, "", {"NUL byte", "line 2, column 12"});
+    std::string in_string = valid;
+    in_string.replace(in_string.find("eye"), 1, std::string(1, '\0'));
+    expect_text_error(in_string, "", {"NUL byte", "line 2, column 15"});
 }
 
 TEST(SceneLoadError, OrthographicWidth) {

@@ -173,5 +173,28 @@ TEST_F(AssembleCliTest, UsageErrorsAndHelp) {
     EXPECT_NE(r.output.find("Exit codes"), std::string::npos) << r.output;
 }
 
+// Issue 23: the extension of -o decides the format: .exr as before, .png the 8-bit sRGB
+// preview of the assembled R, G, B; anything else is a usage error naming both.
+TEST_F(AssembleCliTest, OutputFormatFollowsTheExtension) {
+    write_part("a.exr", PixelRect{0, 0, 10, 14});
+    write_part("b.exr", PixelRect{10, 0, 24, 14});
+    for (const char* name : {"out.jpg", "out", "out.exr.part"}) {
+        const RunResult r = assemble({"a.exr", "b.exr", "-o", name});
+        EXPECT_EQ(r.status, 2) << name << "\n" << r.output;
+        EXPECT_NE(r.output.find(".exr"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find(".png"), std::string::npos) << r.output;
+        EXPECT_FALSE(fs::exists(dir_ / name)) << name;
+    }
+    RunResult r = assemble({"a.exr", "b.exr", "-o", "OUT.EXR"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(read_exr_image(path("OUT.EXR")).data_window, (PixelRect{0, 0, 24, 14}));
+    r = assemble({"a.exr", "b.exr", "-o", "out.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    const ChannelImage png = read_image(path("out.png"));
+    EXPECT_EQ(png.format, "PNG 8-bit");
+    EXPECT_EQ(png.width, 24);
+    EXPECT_EQ(png.height, 14);
+}
+
 }  // namespace
 }  // namespace octray

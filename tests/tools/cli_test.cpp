@@ -9,6 +9,7 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <png.h>
 #include <sys/wait.h>
@@ -16,11 +17,14 @@
 
 #include <algorithm>
 #include <array>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "run_octray.h"
@@ -112,6 +116,65 @@ bool same_bits(const ExrPixels& a, const ExrPixels& b) {
 
 bool any_nonzero(const ExrPixels& p) {
     return std::any_of(p.rgb.begin(), p.rgb.end(), [](float v) { return v != 0.0f; });
+}
+
+// The first `n` bytes of a file ("" if it cannot be read).
+std::string file_head(const fs::path& file, std::size_t n) {
+    std::ifstream in(file, std::ios::binary);
+    std::string bytes(n, '\0');
+    in.read(bytes.data(), static_cast<std::streamsize>(n));
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
+    return bytes;
+}
+
+std::string file_bytes(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+bool is_png_file(const fs::path& file) {
+    return file_head(file, 8) == std::string("\x89PNG\r\n\x1a\n", 8);
+}
+
+bool is_exr_file(const fs::path& file) {
+    return file_head(file, 4) == std::string("\x76\x2f\x31\x01", 4);
+}
+
+struct ClosedStdoutRun {
+    int wait_status = 0;
+    std::string stderr_text;
+};
+
+// Runs `octray <args...>` in `cwd` with its standard output a pipe whose reading end is
+// already closed (as `octray ... | head -0` leaves it), SIGPIPE at its default action.
+ClosedStdoutRun run_with_closed_stdout(const std::vector<std::string>& args,
+                                       const fs::path& cwd) {
+    ClosedStdoutRun result;
+    int fds[2];
+    if (::pipe(fds) != 0) return result;
+    ::close(fds[0]);
+    const fs::path err = cwd / ".stderr.txt";
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        std::signal(SIGPIPE, SIG_DFL);
+        if (::chdir(cwd.c_str()) != 0) ::_exit(120);
+        ::dup2(fds[1], STDOUT_FILENO);
+        const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ::dup2(err_fd, STDERR_FILENO);
+        std::vector<char*> argv;
+        std::string exe = OCTRAY_EXE;
+        argv.push_back(exe.data());
+        std::vector<std::string> copies = args;
+        for (std::string& a : copies) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        ::execv(exe.c_str(), argv.data());
+        ::_exit(121);
+    }
+    ::close(fds[1]);
+    ::waitpid(pid, &result.wait_status, 0);
+    result.stderr_text = file_bytes(err);
+    fs::remove(err);
+    return result;
 }
 
 TEST_F(CliTest, VersionPrintsTheVersion) {
@@ -335,6 +398,188 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
         EXPECT_TRUE(contains(r.output, "--help")) << joined << "\n" << r.output;
     }
     EXPECT_TRUE(entries().empty());
+}
+
+// Issue 23: the extension of -o decides the format (case-insensitive); a PNG output is the
+// --png preview, byte for byte; frame patterns follow the same rule.
+TEST_F(CliTest, OutputFormatFollowsTheExtension) {
+    const std::string spec = "random:4,width=16,height=12";
+    RunResult r = octray({"render", spec, "-o", "a.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_png_file(dir_ / "a.png"));
+    r = octray({"render", spec, "-o", "b.PNG"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_png_file(dir_ / "b.PNG"));
+    r = octray({"render", spec, "-o", "c.Exr"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_exr_file(dir_ / "c.Exr"));
+    r = octray({"render", spec, "-o", "d.exr", "--png", "d.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_exr_file(dir_ / "d.exr"));
+    EXPECT_EQ(file_bytes(dir_ / "a.png"), file_bytes(dir_ / "d.png"));
+    r = octray({"render", spec, "--frames", "0-1", "-o", "f.####.png"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(is_png_file(dir_ / "f.0000.png"));
+    EXPECT_TRUE(is_png_file(dir_ / "f.0001.png"));
+    EXPECT_EQ(entries(), (std::vector<std::string>{"a.png", "b.PNG", "c.Exr", "d.exr", "d.png",
+                                                   "f.0000.png", "f.0001.png"}));
+}
+
+TEST_F(CliTest, UnknownOutputExtensionIsAUsageErrorNamingTheFormats) {
+    const std::string spec = "random:4,width=16,height=12";
+    for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+             {"render", spec, "-o", "out.jpg"},
+             {"render", spec, "-o", "out"},
+             {"render", spec, "-o", "out.exr.bak"},
+             {"render", spec, "--frames", "0-1", "-o", "f.####.tif"},
+         }) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[3] << "\n" << r.output;
+        for (const char* part : {".exr", ".png", "--png", "--help"})
+            EXPECT_TRUE(contains(r.output, part)) << part << "\n" << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
+// A PNG output holds 8-bit RGB only: what only an EXR can hold is refused, not dropped.
+TEST_F(CliTest, PngOutputRefusesWhatOnlyAnExrHolds) {
+    const std::string spec = "random:4,width=16,height=12";
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"--png", "b.png"}, "--png"},
+        {{"--aov", "depth"}, "--aov"},
+        {{"--float"}, "--float"},
+        {{"--compression", "piz"}, "--compression"},
+        {{"--progressive"}, "--progressive"},
+    };
+    for (const auto& [extra, option] : cases) {
+        std::vector<std::string> args = {"render", spec, "-o", "a.png"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << option << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, option)) << option << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "PNG")) << option << "\n" << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
+// Issue 23: a mistyped option (or command) names the one probably meant, in every command.
+TEST_F(CliTest, MistypedOptionsSuggestTheClosestOne) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", "--threds", "2"}, "--threads"},
+        {{"render", "--threds=2"}, "--threads"},
+        {{"render", "random:2", "--sed", "1"}, "--seed"},
+        {{"scene", "whitted", "--ouput", "x.json"}, "--output"},
+        {{"compare", "a.exr", "b.exr", "--hardfial", "1"}, "--hardfail"},
+        {{"verify", "--wdth", "8"}, "--width"},
+        {{"bench", "--no-embre"}, "--no-embree"},
+        {{"info", "--hepl"}, "--help"},
+        {{"assemble", "a.exr", "--ouptut", "x.exr"}, "--output"},
+        {{"rendr", "whitted"}, "render"},
+        {{"--verison"}, "--version"},
+    };
+    for (const auto& [args, meant] : cases) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[0] << " " << args[1] << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "did you mean \"" + meant + "\"?")) << args[0] << "\n"
+                                                                           << r.output;
+        EXPECT_TRUE(contains(r.output, "--help")) << r.output;
+    }
+    // Nothing close: no guess.
+    const RunResult far = octray({"render", "--frobnicate"});
+    EXPECT_EQ(far.status, 2) << far.output;
+    EXPECT_FALSE(contains(far.output, "did you mean")) << far.output;
+    EXPECT_TRUE(entries().empty());
+}
+
+// Issue 23: integer options take decimal digits only, as scene files do: no hex, no sign,
+// no blanks, and nothing out of range is clamped.
+TEST_F(CliTest, IntegerOptionsTakeDecimalDigitsOnly) {
+    const std::vector<std::vector<std::string>> bad = {
+        {"render", "random:2", "--seed", "18446744073709551616"},
+        {"render", "random:2", "--seed", "99999999999999999999999"},
+        {"render", "random:2", "--seed", "0x10"},
+        {"render", "random:2", "--seed", "+5"},
+        {"render", "random:2", "--seed", " 5"},
+        {"render", "random:2", "--seed", "5 "},
+        {"render", "random:2", "--width", "0x10"},
+        {"render", "random:2", "--height", "+8"},
+        {"render", "random:2", "--spp", " 4"},
+        {"render", "random:2", "--threads", "1e1"},
+        {"render", "random:2", "--max-depth", "010x"},
+        {"verify", "random:2", "--width", "0x10"},
+        {"verify", "random:2", "--threads", "+1"},
+        {"bench", "no-such-scene.json", "--no-embree", "--reps", "0x2"},
+    };
+    for (const auto& args : bad) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[2] << " " << args[3] << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, args[args.size() - 2])) << r.output;
+        EXPECT_TRUE(contains(r.output, "--help")) << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+
+    const RunResult top = octray({"render", "random:2,width=4,height=4", "--seed",
+                                  "18446744073709551615", "-o", "s.exr"});
+    ASSERT_EQ(top.status, 0) << top.output;
+    Imf::InputFile file(path("s.exr").c_str());
+    const auto* seed = file.header().findTypedAttribute<Imf::StringAttribute>("octray.seed");
+    ASSERT_NE(seed, nullptr);
+    EXPECT_EQ(seed->value(), "18446744073709551615");
+}
+
+// Issue 23: -o and --png are the same file when they name one directory entry, however
+// spelled (here through a symlink to "." and ".."); the check compares identities.
+TEST_F(CliTest, OutputsAreComparedByIdentityNotSpelling) {
+    fs::create_directory(dir_ / "sub");
+    fs::create_directory_symlink(".", dir_ / "sub" / "self");
+    const std::string spec = "random:2,width=8,height=8";
+    for (const char* png : {"sub/self/../s3.exr", "./s3.exr", "sub/../s3.exr"}) {
+        const RunResult r = octray({"render", spec, "-o", "s3.exr", "--png", png});
+        EXPECT_EQ(r.status, 2) << png << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "same file")) << r.output;
+        EXPECT_FALSE(fs::exists(dir_ / "s3.exr")) << png;
+    }
+    // Different names in one directory are different files.
+    const RunResult ok = octray({"render", spec, "-o", "s3.exr", "--png", "sub/self/s3.png"});
+    EXPECT_EQ(ok.status, 0) << ok.output;
+    EXPECT_TRUE(is_exr_file(dir_ / "s3.exr"));
+    EXPECT_TRUE(is_png_file(dir_ / "sub" / "s3.png"));
+}
+
+// Issue 23: an output below a regular file says so, rather than "does not exist".
+TEST_F(CliTest, OutputBelowAFileSaysTheParentIsAFile) {
+    { std::ofstream(dir_ / "plain") << "not a directory\n"; }
+    for (const char* out : {"plain/out.exr", "plain/deeper/out.exr"}) {
+        const RunResult r = octray({"render", "random:2,width=8,height=8", "-o", out});
+        EXPECT_EQ(r.status, 4) << out << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, "plain is a file, not a directory")) << r.output;
+        EXPECT_FALSE(contains(r.output, "does not exist")) << r.output;
+    }
+    const RunResult png = octray(
+        {"render", "random:2,width=8,height=8", "-o", "out.exr", "--png", "plain/p.png"});
+    EXPECT_EQ(png.status, 4) << png.output;
+    EXPECT_TRUE(contains(png.output, "plain is a file, not a directory")) << png.output;
+    EXPECT_EQ(entries(), std::vector<std::string>{"plain"});
+}
+
+// Issue 23: a closed standard output (`octray ... | head -0`) is an I/O error, exit 4 with
+// the reason, not death by SIGPIPE (141 in a shell).
+TEST_F(CliTest, ClosedStandardOutputIsAnIoError) {
+    for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+             {"scene", "whitted"},
+             {"info"},
+             {"render", "random:2,width=8,height=8", "-o", "r.exr", "--progress", "lines"},
+         }) {
+        const ClosedStdoutRun r = run_with_closed_stdout(args, dir_);
+        EXPECT_FALSE(WIFSIGNALED(r.wait_status))
+            << args[0] << " killed by signal " << WTERMSIG(r.wait_status);
+        ASSERT_TRUE(WIFEXITED(r.wait_status)) << args[0];
+        EXPECT_EQ(WEXITSTATUS(r.wait_status), 4) << args[0] << "\n" << r.stderr_text;
+        EXPECT_TRUE(contains(r.stderr_text, "standard output")) << r.stderr_text;
+        EXPECT_TRUE(contains(r.stderr_text, "Broken pipe")) << r.stderr_text;
+    }
+    // The render itself was done: only its report could not be written.
+    EXPECT_TRUE(is_exr_file(dir_ / "r.exr"));
 }
 
 // The SIMD packet path (the default) writes the same pixels as the scalar reference, under

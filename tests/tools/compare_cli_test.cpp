@@ -213,6 +213,86 @@ TEST_F(CompareCliTest, BadCommandLinesAreRejected) {
     EXPECT_EQ(r.status, 2) << r.output;
 }
 
+// Issue 23: a NaN threshold would make every comparison pass (nothing is "> NaN"): it is a
+// usage error for every threshold option.
+TEST_F(CompareCliTest, NanThresholdsAreUsageErrors) {
+    write_pair(0.125f);
+    for (const char* option :
+         {"--fail", "--warn", "--failpercent", "--warnpercent", "--hardfail", "--hardwarn"}) {
+        for (const char* value : {"nan", "NaN", "-nan"}) {
+            const RunResult r = compare({"a.exr", "b.exr", option, value});
+            EXPECT_EQ(r.status, 2) << option << " " << value << "\n" << r.output;
+            EXPECT_NE(r.output.find(option), std::string::npos) << r.output;
+            EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
+        }
+    }
+    const RunResult both = compare({"a.exr", "b.exr", "--fail", "nan", "--warn", "nan"});
+    EXPECT_EQ(both.status, 2) << both.output;
+    EXPECT_NE(both.output.find("--help"), std::string::npos) << both.output;
+}
+
+// Issue 23: inf, the documented default of the hard limits, can be given; thresholds take
+// decimal numbers and inf, nothing else.
+TEST_F(CompareCliTest, InfinityIsAValidThreshold) {
+    write_pair(0.125f);
+    RunResult r = compare({"a.exr", "b.exr", "--failpercent", "2", "--warnpercent", "2",
+                           "--hardfail", "inf", "--hardwarn", "inf"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    r = compare({"a.exr", "b.exr", "--fail", "inf", "--warn", "Infinity"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    for (const char* value : {"-inf", "-1", "0x1p3", "1e999", "", " 1", "1x"}) {
+        r = compare({"a.exr", "b.exr", "--hardfail", value});
+        EXPECT_EQ(r.status, 2) << "'" << value << "'\n" << r.output;
+        EXPECT_NE(r.output.find("--help"), std::string::npos) << value << "\n" << r.output;
+    }
+}
+
+// Issue 23: equal infinities are equal (as idiff has it): a depth AOV whose background is
+// +inf matches itself with --fail 0. Different infinities, or one against a number, fail.
+TEST_F(CompareCliTest, EqualInfinitiesAreEqual) {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    ChannelImage z = make_image(4, 4, {"Z"}, 2.0f);
+    z.at(0, 1, 1) = inf;
+    z.at(0, 3, 2) = -inf;
+    write_test_exr(path("z.exr"), z);
+    write_test_exr(path("z2.exr"), z);
+    RunResult r = compare({"z.exr", "z2.exr", "--fail", "0", "--diff", "d.exr"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(last_line(r.output), "PASS: images are identical");
+    const ChannelImage diff = read_image(path("d.exr"));
+    EXPECT_EQ(diff.at(0, 1, 1), 0.0f);
+    EXPECT_EQ(diff.at(0, 3, 2), 0.0f);
+
+    ChannelImage w = z;
+    w.at(0, 1, 1) = -inf;
+    write_test_exr(path("w.exr"), w);
+    r = compare({"z.exr", "w.exr", "--fail", "0"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(last_line(r.output).find("(1 with NaN or Inf)"), std::string::npos) << r.output;
+    ChannelImage f = z;
+    f.at(0, 1, 1) = 1e30f;
+    write_test_exr(path("f.exr"), f);
+    EXPECT_EQ(compare({"z.exr", "f.exr"}).status, 2);
+}
+
+// Issue 23: --diff writes float OpenEXR, chosen by the extension like every output; any
+// other extension is a usage error naming the formats.
+TEST_F(CompareCliTest, DiffOutputMustBeAnExr) {
+    write_pair(0.0f);
+    for (const char* name : {"d.png", "d.tif", "d"}) {
+        const RunResult r = compare({"a.exr", "b.exr", "--diff", name});
+        EXPECT_EQ(r.status, 2) << name << "\n" << r.output;
+        EXPECT_NE(r.output.find(".exr"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("--heatmap"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
+        EXPECT_FALSE(testing::fs::exists(dir_ / name)) << name;
+    }
+    const RunResult r = compare({"a.exr", "b.exr", "--diff", "D.EXR"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(read_image(path("D.EXR")).channel_names,
+              (std::vector<std::string>{"R", "G", "B"}));
+}
+
 TEST_F(CompareCliTest, HelpListsTheExitCodes) {
     const RunResult r = compare({"--help"});
     EXPECT_EQ(r.status, 0);

@@ -1,0 +1,38 @@
+# `cmake --install`: the octray binary, the public API (include/octray/, liboctray.a) and
+# an exported CMake package, so that another project can
+#   find_package(octray CONFIG REQUIRED)
+#   target_link_libraries(app PRIVATE octray::octray)
+# (examples/embed/, docs/embedding.md). The internal libraries are static and linked
+# privately by octray::octray; a static library's private dependencies are still needed
+# when the consumer links, so they are installed and exported too (as octray::scene, ...),
+# without headers: only include/octray/ is installed.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(OCTRAY_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/octray)
+
+# Exported names: octray_scene -> octray::scene, ...
+foreach(lib core scene kernels render reference imageio compare warnings fp_model optimize)
+  set_target_properties(octray_${lib} PROPERTIES EXPORT_NAME ${lib})
+endforeach()
+
+install(TARGETS octray RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS octray_api octray_core octray_scene octray_kernels octray_render
+                octray_reference octray_imageio octray_compare
+                octray_warnings octray_fp_model octray_optimize
+        EXPORT octrayTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/octray
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(EXPORT octrayTargets NAMESPACE octray:: DESTINATION ${OCTRAY_INSTALL_CMAKEDIR})
+
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/octrayConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/octrayConfig.cmake INSTALL_DESTINATION ${OCTRAY_INSTALL_CMAKEDIR})
+# 0.x: a minor version may change the API.
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/octrayConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/octrayConfig.cmake
+              ${PROJECT_BINARY_DIR}/octrayConfigVersion.cmake
+        DESTINATION ${OCTRAY_INSTALL_CMAKEDIR})

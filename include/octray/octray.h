@@ -1,0 +1,237 @@
+#pragma once
+// octray's public C++ API: the one installed header (docs/embedding.md).
+//
+// A thin facade over the renderer's internal libraries: build a scene in code or load one
+// (a JSON file or a built-in such as "whitted"), render it with either path, get the
+// linear RGB image and the ray counts, write it as OpenEXR, compare two images. Nothing
+// here exposes an internal header, so the API stays the same when the internals change.
+//
+//   #include <octray/octray.h>
+//   octray::api::Scene scene = octray::api::Scene::load("whitted");
+//   octray::api::RenderResult r = octray::api::render(scene, {.threads = 2});
+//   octray::api::write_exr("whitted.exr", r.image);
+//
+// CMake: find_package(octray CONFIG REQUIRED) and
+// target_link_libraries(app PRIVATE octray::octray).
+//
+// Every function reports failure by throwing octray::api::Error.
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace octray::api {
+
+// The library's version, "MAJOR.MINOR.PATCH" (the same as `octray --version`).
+const char* version();
+
+// ---- Errors ------------------------------------------------------------------------
+
+enum class ErrorKind {
+    scene,             // a scene that cannot be loaded or is invalid (the CLI's exit code 3)
+    io,                // a file that cannot be read or written (exit code 4)
+    invalid_argument,  // a bad option: an ISA the CPU lacks, images of different sizes, ...
+};
+
+class Error : public std::runtime_error {
+  public:
+    Error(ErrorKind kind, const std::string& message)
+        : std::runtime_error(message), kind_(kind) {}
+    ErrorKind kind() const { return kind_; }
+
+  private:
+    ErrorKind kind_;
+};
+
+// ---- Scenes --------------------------------------------------------------------------
+// The types mirror the scene format (docs/scene-format.md); every default is the format's.
+
+struct Vec3 {
+    float x = 0.0f, y = 0.0f, z = 0.0f;
+};
+
+struct Rgb {  // linear RGB
+    float r = 0.0f, g = 0.0f, b = 0.0f;
+};
+
+enum class CameraType { pinhole, orthographic, thinlens, fisheye };
+
+struct Camera {
+    CameraType type = CameraType::pinhole;
+    Vec3 eye{0.0f, 0.0f, 5.0f};
+    Vec3 lookat{0.0f, 0.0f, 0.0f};
+    Vec3 up{0.0f, 1.0f, 0.0f};
+    float fov = 50.0f;            // degrees across the image width (pinhole, thinlens, fisheye)
+    float width = 2.0f;           // film width in world units (orthographic)
+    float aperture = 0.0f;        // lens radius (thinlens)
+    float focus_distance = 1.0f;  // distance to the plane in focus (thinlens)
+};
+
+struct Material {
+    Rgb color{0.8f, 0.8f, 0.8f};  // diffuse color Cd
+    float kd = 1.0f;              // diffuse weight
+    float ks = 0.0f;              // Phong highlight weight
+    float shininess = 32.0f;      // Phong exponent
+    Rgb reflect{};                // mirror weight kr
+    float transmit = 0.0f;        // refraction weight kt
+    float ior = 1.5f;             // index of refraction
+    // A checker (planes only): checker_color on the odd squares of size checker_size.
+    bool checker = false;
+    Rgb checker_color{};
+    float checker_size = 1.0f;
+};
+
+// An authored scene. Scene() is the format's defaults: 640x480, 1 spp, the default
+// pinhole camera, a black constant background, no objects and no lights. A scene is
+// checked (validate()) before it renders; the setters themselves accept anything.
+class Scene {
+  public:
+    Scene();
+    ~Scene();
+    Scene(const Scene& other);
+    Scene& operator=(const Scene& other);
+    Scene(Scene&& other) noexcept;
+    Scene& operator=(Scene&& other) noexcept;
+
+    // A JSON scene file or a built-in ("whitted", "random:1024,spp=4", "sphereflake:3").
+    static Scene load(const std::string& spec);
+    // A JSON scene from memory; `source` names it in error messages.
+    static Scene from_json(std::string_view json, const std::string& source = "<memory>");
+
+    Scene& set_image(int width, int height, int spp = 1);
+    Scene& set_camera(const Camera& camera);
+    Scene& set_background(Rgb color);            // constant
+    Scene& set_background(Rgb bottom, Rgb top);  // vertical gradient
+    Scene& set_ambient(Rgb ambient);
+    Scene& set_max_depth(int max_depth);  // bounces; 0 traces primary rays only
+    Scene& set_seed(std::uint64_t seed);  // seed of the sample jitter
+
+    // Returns the material's index, for add_sphere / add_plane. A non-empty name must be
+    // unique; an unnamed material is written inline by to_json().
+    std::uint32_t add_material(const Material& material, const std::string& name = {});
+    // A non-empty name must be unique (it is what animations refer to).
+    Scene& add_sphere(Vec3 center, float radius, std::uint32_t material,
+                      const std::string& name = {});
+    Scene& add_plane(Vec3 point, Vec3 normal, std::uint32_t material);
+    Scene& add_point_light(Vec3 position, Rgb color, bool inverse_square = false);
+    Scene& add_directional_light(Vec3 direction, Rgb color);  // the way the light travels
+
+    int width() const;
+    int height() const;
+    int spp() const;
+    std::size_t object_count() const;
+    std::size_t light_count() const;
+
+    // Throws Error(ErrorKind::scene) naming the first problem.
+    void validate() const;
+    // The scene as JSON that Scene::from_json reads back to an identical scene (the format
+    // of docs/scene-format.md). Validates first: throws Error(ErrorKind::scene).
+    std::string to_json() const;
+
+  private:
+    friend struct SceneAccess;
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// ---- Rendering -----------------------------------------------------------------------
+
+enum class Path {
+    simd,    // 8-ray packets through the per-ISA kernels (the default)
+    scalar,  // the scalar reference renderer; the same image bit for bit
+};
+
+enum class Isa {
+    automatic,  // the best this CPU supports
+    sse2,
+    sse4_1,
+    avx2,
+};
+
+// "auto", "sse2", "sse4.1", "avx2".
+const char* isa_name(Isa isa);
+// The ISAs this CPU can run, best last (never Isa::automatic).
+std::vector<Isa> supported_isas();
+
+struct RenderOptions {
+    Path path = Path::simd;
+    Isa isa = Isa::automatic;  // simd path only; a forced ISA the CPU lacks is an Error
+    int threads = 0;           // worker threads; 0 uses every core
+    int spp = 0;               // samples per pixel; 0 keeps the scene's
+    int width = 0;             // image size; 0 keeps the scene's
+    int height = 0;
+    int frame = 0;  // frame number (>= 0) of an animated scene: its pose and jitter
+    // Threads, tile size and ISA never change the image: only its speed.
+    int tile_width = 16;
+    int tile_height = 16;
+};
+
+// Linear RGB floats, row 0 on top: pixel (x, y) is rgb[3 * (y * width + x) + {0, 1, 2}].
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgb;
+};
+
+struct RayCounts {
+    std::uint64_t primary = 0;
+    std::uint64_t shadow = 0;
+    std::uint64_t reflected = 0;
+    std::uint64_t refracted = 0;
+    std::uint64_t total() const { return primary + shadow + reflected + refracted; }
+};
+
+struct RenderResult {
+    Image image;
+    RayCounts rays;
+    double seconds = 0.0;  // wall-clock time of the render
+    std::string path;      // "scalar", or "simd (avx2)" with the ISA used
+};
+
+// Renders the scene (or its animation frame options.frame) with the options' overrides
+// applied and the result validated. Throws Error.
+RenderResult render(const Scene& scene, const RenderOptions& options = {});
+
+// ---- Images ---------------------------------------------------------------------------
+
+struct ExrOptions {
+    bool float32 = false;  // 32-bit float channels instead of half
+};
+
+// Writes R, G, B channels (ZIP-compressed), atomically: the file is complete or absent.
+void write_exr(const std::string& path, const Image& image, const ExrOptions& options = {});
+// Reads the R, G and B channels of an OpenEXR or PNG file (PNG values are not linearised).
+Image read_image(const std::string& path);
+
+// idiff's thresholds and verdicts (octray compare --help).
+struct CompareOptions {
+    double fail_threshold = 1e-6;  // a pixel fails when a channel differs by more
+    double fail_percent = 0.0;     // FAIL when more than this % of the pixels fail
+    double warn_threshold = 1e-6;
+    double warn_percent = 0.0;
+};
+
+enum class Verdict { pass = 0, warn = 1, fail = 2 };
+
+struct CompareResult {
+    Verdict verdict = Verdict::pass;
+    double max_abs_error = 0.0;
+    double mean_abs_error = 0.0;
+    double rmse = 0.0;
+    double psnr = 0.0;  // infinite for identical images
+    std::uint64_t fail_pixels = 0;
+    std::uint64_t warn_pixels = 0;
+    std::uint64_t nonfinite_pixels = 0;  // NaN or Inf in either image
+    std::string reason;                  // one line: the verdict and why
+};
+
+// Compares b against a; images of different sizes are an Error (invalid_argument).
+CompareResult compare(const Image& a, const Image& b, const CompareOptions& options = {});
+// The same for two files (every channel, as `octray compare`).
+CompareResult compare_files(const std::string& a, const std::string& b,
+                            const CompareOptions& options = {});
+
+}  // namespace octray::api

@@ -1,0 +1,141 @@
+// The public API: scenes built in code, loaded and round-tripped through JSON; both paths
+// and every supported ISA give the same image; options; EXR written and read back;
+// comparison verdicts; every failure an api::Error of the right kind.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "octray/octray.h"
+
+namespace api = octray::api;
+
+namespace {
+
+api::Scene small_scene() {
+    api::Scene scene;
+    scene.set_image(48, 32, 4)
+        .set_camera({.eye = {0.0f, 1.5f, 6.0f}, .lookat = {0.0f, 0.8f, 0.0f}, .fov = 45.0f})
+        .set_background({1.0f, 1.0f, 1.0f}, {0.4f, 0.6f, 1.0f})
+        .set_ambient({0.05f, 0.05f, 0.05f});
+    const auto floor = scene.add_material(
+        {.color = {0.9f, 0.9f, 0.9f}, .checker = true, .checker_color = {0.1f, 0.1f, 0.1f}},
+        "floor");
+    const auto glass = scene.add_material({.color = {1.0f, 1.0f, 1.0f},
+                                           .kd = 0.0f,
+                                           .ks = 0.5f,
+                                           .shininess = 128.0f,
+                                           .reflect = {0.1f, 0.1f, 0.1f},
+                                           .transmit = 0.9f});
+    scene.add_plane({0.0f, 0.0f, 0.0f}, {0.0f, 2.0f, 0.0f}, floor);
+    scene.add_sphere({0.0f, 1.0f, 0.0f}, 1.0f, glass, "ball");
+    scene.add_point_light({5.0f, 8.0f, 5.0f}, {1.0f, 1.0f, 1.0f});
+    scene.add_directional_light({-1.0f, -1.0f, -0.5f}, {0.3f, 0.3f, 0.3f});
+    return scene;
+}
+
+std::string temp_path(const std::string& name) {
+    std::filesystem::create_directories(OCTRAY_TEST_TMPDIR);
+    return std::string(OCTRAY_TEST_TMPDIR) + "/api_" + name;
+}
+
+}  // namespace
+
+TEST(Api, BuiltSceneRendersAndCountsRays) {
+    const api::Scene scene = small_scene();
+    EXPECT_NO_THROW(scene.validate());
+    EXPECT_EQ(scene.object_count(), 2u);
+    EXPECT_EQ(scene.light_count(), 2u);
+    const api::RenderResult r = api::render(scene, {.threads = 2});
+    EXPECT_EQ(r.image.width, 48);
+    EXPECT_EQ(r.image.height, 32);
+    EXPECT_EQ(r.image.rgb.size(), 3u * 48 * 32);
+    EXPECT_EQ(r.rays.primary, 48u * 32 * 4);
+    EXPECT_GT(r.rays.shadow, 0u);
+    EXPECT_GT(r.rays.refracted, 0u);
+    EXPECT_EQ(r.rays.total(),
+              r.rays.primary + r.rays.shadow + r.rays.reflected + r.rays.refracted);
+    EXPECT_EQ(r.path.rfind("simd (", 0), 0u) << r.path;
+}
+
+TEST(Api, PathsIsasAndThreadsGiveTheSameImage) {
+    const api::Scene scene = small_scene();
+    const api::RenderResult scalar = api::render(scene, {.path = api::Path::scalar});
+    EXPECT_EQ(scalar.path, "scalar");
+    for (api::Isa isa : api::supported_isas()) {
+        for (int threads : {1, 2}) {
+            const api::RenderResult simd =
+                api::render(scene, {.isa = isa, .threads = threads, .tile_width = 8});
+            EXPECT_EQ(simd.image.rgb, scalar.image.rgb) << api::isa_name(isa);
+            EXPECT_EQ(simd.rays.total(), scalar.rays.total());
+        }
+    }
+}
+
+TEST(Api, JsonRoundTripRendersTheSameImage) {
+    const api::Scene scene = small_scene();
+    const api::Scene back = api::Scene::from_json(scene.to_json());
+    EXPECT_EQ(back.to_json(), scene.to_json());
+    EXPECT_EQ(api::render(back).image.rgb, api::render(scene).image.rgb);
+}
+
+TEST(Api, OptionsOverrideTheScene) {
+    const api::Scene scene = api::Scene::load("random:8");
+    EXPECT_EQ(scene.width(), 1920);
+    const api::RenderResult r = api::render(scene, {.spp = 2, .width = 40, .height = 30});
+    EXPECT_EQ(r.image.width, 40);
+    EXPECT_EQ(r.image.height, 30);
+    EXPECT_EQ(r.rays.primary, 40u * 30 * 2);
+}
+
+TEST(Api, ExrWrittenReadsBackAndCompares) {
+    const api::RenderResult r = api::render(small_scene());
+    const std::string f32 = temp_path("float.exr"), f16 = temp_path("half.exr");
+    api::write_exr(f32, r.image, {.float32 = true});
+    api::write_exr(f16, r.image);
+    const api::Image back = api::read_image(f32);
+    EXPECT_EQ(back.rgb, r.image.rgb);
+
+    const api::CompareResult same = api::compare(r.image, back);
+    EXPECT_EQ(same.verdict, api::Verdict::pass);
+    EXPECT_EQ(same.max_abs_error, 0.0);
+    // Half rounds: over the 1e-6 default, within 1e-2.
+    EXPECT_EQ(api::compare_files(f32, f16).verdict, api::Verdict::fail);
+    const api::CompareResult loose =
+        api::compare_files(f32, f16, {.fail_threshold = 1e-2, .warn_threshold = 1e-2});
+    EXPECT_EQ(loose.verdict, api::Verdict::pass) << loose.reason;
+    EXPECT_GT(loose.max_abs_error, 0.0);
+}
+
+TEST(Api, FailuresAreErrorsOfTheRightKind) {
+    const auto kind_of = [](auto&& f) {
+        try {
+            f();
+        } catch (const api::Error& e) {
+            return e.kind();
+        }
+        ADD_FAILURE() << "no api::Error thrown";
+        return api::ErrorKind::invalid_argument;
+    };
+    EXPECT_EQ(kind_of([] { api::Scene::load(temp_path("missing.json")); }),
+              api::ErrorKind::scene);
+    EXPECT_EQ(kind_of([] { api::Scene::from_json("{\"camera\": {}}"); }),
+              api::ErrorKind::scene);
+    api::Scene bad = small_scene();
+    bad.add_sphere({0.0f, 0.0f, 0.0f}, -1.0f, 0);
+    EXPECT_EQ(kind_of([&] { bad.validate(); }), api::ErrorKind::scene);
+    EXPECT_EQ(kind_of([&] { api::render(bad); }), api::ErrorKind::scene);
+    EXPECT_EQ(kind_of([] { api::read_image(temp_path("missing.exr")); }), api::ErrorKind::io);
+    EXPECT_EQ(kind_of([] {
+                  api::write_exr(temp_path("no/such/dir/x.exr"),
+                                 api::render(small_scene()).image);
+              }),
+              api::ErrorKind::io);
+    const api::Image a{2, 2, std::vector<float>(12, 0.0f)};
+    const api::Image b{3, 2, std::vector<float>(18, 0.0f)};
+    EXPECT_EQ(kind_of([&] { api::compare(a, b); }), api::ErrorKind::invalid_argument);
+    EXPECT_EQ(kind_of([] { api::render(small_scene(), {.threads = -1}); }),
+              api::ErrorKind::invalid_argument);
+    EXPECT_STREQ(api::version(), "0.1.0");
+}

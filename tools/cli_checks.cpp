@@ -1,0 +1,228 @@
+// Checks every command shares (tools/cli_checks.h).
+
+#include "tools/cli_checks.h"
+
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <system_error>
+#include <vector>
+
+#include "scene/suggest.h"
+#include "tools/commands.h"
+
+namespace octray::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A value quoted for a message: control bytes as \xNN, cut after 64 characters.
+std::string quote_value(std::string_view text) {
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out = "\"";
+    for (std::size_t i = 0; i < std::min<std::size_t>(text.size(), 64); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x20 || c == 0x7f) {
+            out += "\\x";
+            out += kHex[c >> 4];
+            out += kHex[c & 15];
+        } else {
+            out += static_cast<char>(c);
+        }
+    }
+    if (text.size() > 64) out += "...";
+    return out + "\"";
+}
+
+std::string lowercase(std::string_view text) {
+    std::string out(text);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+}
+
+std::string format_real(double value) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
+}  // namespace
+
+std::optional<std::uint64_t> parse_decimal_integer(std::string_view text) {
+    if (text.empty() ||
+        !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
+        return std::nullopt;
+    std::uint64_t value = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
+    return value;
+}
+
+CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi) {
+    const std::string range = "an integer from " + std::to_string(lo) + " to " +
+                              std::to_string(hi) + " in decimal digits";
+    return CLI::Validator(
+        [range, lo, hi](std::string& text) -> std::string {
+            const auto value = parse_decimal_integer(text);
+            if (!value || *value < lo || *value > hi)
+                return "expected " + range +
+                       " (no sign, blank, 0x prefix, fraction or exponent), found " +
+                       quote_value(text);
+            text = std::to_string(*value);  // what CLI11 converts: canonical decimal
+            return {};
+        },
+        "");
+}
+
+CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
+    std::string range =
+        hi == std::numeric_limits<double>::max()
+            ? "a decimal number >= " + format_real(lo)
+            : "a decimal number from " + format_real(lo) + " to " + format_real(hi);
+    if (allow_infinity) range += ", or inf";
+    return CLI::Validator(
+        [range, lo, hi, allow_infinity](std::string& text) -> std::string {
+            double value = 0.0;
+            const char* first = text.data();
+            const char* last = text.data() + text.size();
+            const auto [end, error] = std::from_chars(first, last, value);
+            const std::string lower = lowercase(text);
+            const bool infinity_word = lower == "inf" || lower == "infinity";
+            if (error != std::errc() || end != last || text.empty() ||
+                (std::isinf(value) && !infinity_word))
+                return "expected " + range + ", found " + quote_value(text);
+            if (std::isnan(value))
+                return "expected " + range + ", found " + quote_value(text) +
+                       " (NaN compares false with everything, so it would pass any pair)";
+            if (std::isinf(value) && (!allow_infinity || value < 0))
+                return "expected " + range + ", found " + quote_value(text);
+            if (std::isfinite(value) && (value < lo || value > hi))
+                return "expected " + range + ", found " + quote_value(text);
+            if (std::isinf(value)) {
+                text = "inf";
+            } else {
+                char exact[64];
+                std::snprintf(exact, sizeof exact, "%a", value);  // exact, for CLI11's strtold
+                text = exact;
+            }
+            return {};
+        },
+        "");
+}
+
+std::optional<ImageFormat> image_format_of(std::string_view path) {
+    const std::string name = fs::path(path).filename().string();
+    const std::size_t dot = name.rfind('.');
+    if (dot == std::string::npos || dot == 0) return std::nullopt;
+    const std::string extension = lowercase(std::string_view(name).substr(dot));
+    if (extension == ".exr") return ImageFormat::exr;
+    if (extension == ".png") return ImageFormat::png;
+    return std::nullopt;
+}
+
+ImageFormat require_image_format(std::string_view option, const std::string& path,
+                                 bool png_accepted, std::string_view advice) {
+    const auto format = image_format_of(path);
+    if (format && (png_accepted || *format == ImageFormat::exr)) return *format;
+    std::string message = std::string(option) + " " + quote_value(path) +
+                          ": the file name's extension chooses the format, and octray writes " +
+                          (png_accepted ? "OpenEXR (.exr) and 8-bit sRGB PNG (.png) here"
+                                        : "only OpenEXR (.exr) here");
+    if (!advice.empty()) message += "; " + std::string(advice);
+    throw UsageError(message);
+}
+
+std::string directory_identity(const std::string& dir) {
+    const std::string path = dir.empty() ? "." : dir;
+    struct stat info {};
+    if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
+        return "device " + std::to_string(info.st_dev) + ", inode " +
+               std::to_string(info.st_ino) + ": ";
+    std::error_code error;
+    const fs::path absolute = fs::absolute(path, error);
+    return "path " + (error ? fs::path(path) : absolute).lexically_normal().string() + "/";
+}
+
+std::string output_identity(const std::string& path) {
+    const fs::path file(path);
+    return directory_identity(file.parent_path().string()) + file.filename().string();
+}
+
+std::string mistyped_argument_hint(const CLI::App& app) {
+    // The command the arguments were given to: the deepest one that parsed.
+    const CLI::App* command = &app;
+    std::vector<std::string> unknown = app.remaining();
+    for (;;) {
+        const auto parsed = command->get_subcommands();
+        if (parsed.empty()) break;
+        command = parsed.front();
+        const std::vector<std::string> more = command->remaining();
+        unknown.insert(unknown.end(), more.begin(), more.end());
+    }
+    std::vector<std::string> names;
+    for (const CLI::Option* option : command->get_options()) {
+        for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+        for (const std::string& name : option->get_snames()) names.push_back("-" + name);
+    }
+    const bool top = command == &app;
+    if (top) {
+        for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+            names.push_back(sub->get_name());
+    }
+    const std::vector<std::string_view> candidates(names.begin(), names.end());
+    for (const std::string& argument : unknown) {
+        const bool option = argument.size() > 1 && argument.front() == '-';
+        if (!option && !top) continue;  // a stray value, not a name
+        const std::string_view word =
+            std::string_view(argument).substr(0, option ? argument.find('=') : argument.npos);
+        const auto best = closest_word(word, candidates);
+        if (!best) continue;
+        return std::string("unknown ") + (option ? "option " : "command ") + quote_value(word) +
+               " (did you mean " + quote_value(*best) + "?)";
+    }
+    return {};
+}
+
+namespace {
+
+// Why standard output failed, when a failed write left no errno behind (stdio drops what it
+// could not write): a pipe whose reading end is closed shows POLLERR on its writing end.
+int standard_output_error() {
+    struct stat info {};
+    if (::fstat(STDOUT_FILENO, &info) == 0 && S_ISFIFO(info.st_mode)) {
+        pollfd p{STDOUT_FILENO, POLLOUT, 0};
+        if (::poll(&p, 1, 0) == 1 && (p.revents & POLLERR) != 0) return EPIPE;
+    }
+    return 0;
+}
+
+}  // namespace
+
+int finish_standard_output(int status) {
+    std::cout.flush();
+    bool failed = !std::cout || std::ferror(stdout) != 0;
+    int error = 0;
+    if (std::fflush(stdout) != 0) {
+        failed = true;
+        error = errno;
+    }
+    if (!failed || status != kExitSuccess) return status;
+    if (error == 0) error = standard_output_error();
+    std::cerr << "octray: I/O error: cannot write to standard output: "
+              << (error != 0 ? std::strerror(error) : "write error") << '\n';
+    return kExitIo;
+}
+
+}  // namespace octray::tools

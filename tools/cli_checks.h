@@ -1,0 +1,72 @@
+#pragma once
+// Checks every command shares: strict numbers for options, output formats chosen by the
+// file name, output files compared by identity, "did you mean" for mistyped options, and
+// standard output that cannot be written. Each failure is a message saying what was given
+// and what is expected.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace CLI {
+class App;
+class Validator;
+}  // namespace CLI
+
+namespace octray::tools {
+
+// ---- Numbers on the command line -------------------------------------------------------
+
+// Decimal digits only (as scene files have them): no sign, blank, "0x" prefix, fraction or
+// exponent; nullopt for anything else or above 2^64 - 1 (nothing is clamped).
+std::optional<std::uint64_t> parse_decimal_integer(std::string_view text);
+
+// An integer option in [lo, hi], written as parse_decimal_integer reads it. Use with
+// CLI::Option::transform: it hands CLI11 the number in canonical form (CLI11 alone would
+// read "0x10" as 16, "010" as 8, " 5" as 5 and clamp 2^64 to 2^64 - 1).
+CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi);
+
+// A real option (a threshold): a decimal number in [lo, hi], or "inf" / "infinity" (any
+// case) when `allow_infinity`. NaN, hex floats, signs other than a leading '-', blanks and
+// values that overflow to infinity are refused. Use with CLI::Option::transform.
+CLI::Validator real_number(double lo, double hi, bool allow_infinity);
+
+// ---- Output files --------------------------------------------------------------------
+
+enum class ImageFormat { exr, png };
+
+// The format a file name asks for by its extension, case-insensitively: ".exr" or ".png";
+// nullopt for any other or none.
+std::optional<ImageFormat> image_format_of(std::string_view path);
+
+// The format of an output named by `option` (such as "-o"): its extension's, which must be
+// one of `accepted` (".exr", or ".exr and .png"); else a UsageError that names the file,
+// the formats and `advice`.
+ImageFormat require_image_format(std::string_view option, const std::string& path,
+                                 bool png_accepted, std::string_view advice);
+
+// What a write to `path` replaces (octray writes a temporary and renames it over the
+// target): the directory entry, as the device and inode of the parent directory plus the
+// file name. Two paths with one identity are one file however they are spelled (".",
+// "..", symlinks). When the parent does not exist yet, its lexically normal absolute path
+// stands in for it.
+std::string output_identity(const std::string& path);
+
+// The directory part of output_identity: for `dir` ("" is the current directory), a key
+// such that output_identity(dir / name) == directory_identity(dir) + name.
+std::string directory_identity(const std::string& dir);
+
+// ---- Command-line errors and standard output -------------------------------------------
+
+// After a failed parse: "unknown option "--threds" (did you mean "--threads"?)" for the
+// first argument CLI11 could not place that is close to an option of the command it was
+// given to (or to a command name), else "".
+std::string mistyped_argument_hint(const CLI::App& app);
+
+// Flushes standard output. A write that failed (a closed pipe: EPIPE, since octray ignores
+// SIGPIPE; a full disk) is reported on stderr as an I/O error and turns a success into
+// kExitIo; any other status stays.
+int finish_standard_output(int status);
+
+}  // namespace octray::tools
