@@ -433,58 +433,22 @@ struct PacketFrustum {
     F inv_lo[3], inv_hi[3], near_off[3], far_off[3];
 };
 
-// `live`: not empty.
+// Lanes of `bits` (of 8) as an AVX mask. AVX2 translation unit only (F::size == 8); a
+// template, so that no other translation unit compiles it (the ODR rule).
 template <class F>
-PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
-    using Plane = typename PacketFrustum<F>::Plane;
-    const float* const inv[3] = {p.inv_x, p.inv_y, p.inv_z};
-    const float* const lo_off[3] = {p.lo_off_x, p.lo_off_y, p.lo_off_z};
-    const float* const hi_off[3] = {p.hi_off_x, p.hi_off_y, p.hi_off_z};
-    const Plane mins[3] = {&BvhNode8::min_x, &BvhNode8::min_y, &BvhNode8::min_z};
-    const Plane maxs[3] = {&BvhNode8::max_x, &BvhNode8::max_y, &BvhNode8::max_z};
-    PacketFrustum<F> f;
-    for (int a = 0; a < 3; ++a) {
-        float lo = kInf, hi = -kInf;
-        for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
-            const float v = inv[a][__builtin_ctz(bits)];
-            lo = v < lo ? v : lo;
-            hi = v > hi ? v : hi;
-        }
-        const bool positive = lo > 0.0f;
-        if (!positive && !(hi < 0.0f)) return f;  // mixed signs (or NaN): no bundle
-        const float* near_off = positive ? lo_off[a] : hi_off[a];
-        const float* far_off = positive ? hi_off[a] : lo_off[a];
-        float near_max = -kInf, far_min = kInf;
-        for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
-            const auto l = static_cast<std::uint32_t>(__builtin_ctz(bits));
-            near_max = near_off[l] > near_max ? near_off[l] : near_max;
-            far_min = far_off[l] < far_min ? far_off[l] : far_min;
-        }
-        f.near[a] = positive ? mins[a] : maxs[a];
-        f.far[a] = positive ? maxs[a] : mins[a];
-        f.inv_lo[a] = F(lo), f.inv_hi[a] = F(hi);
-        f.near_off[a] = F(near_max), f.far_off[a] = F(far_min);
-    }
-    f.valid = true;
-    const auto l0 = static_cast<std::uint32_t>(__builtin_ctz(live));
-    f.one_origin = true;
-    for (std::uint32_t bits = live; bits != 0; bits &= bits - 1) {
-        const auto l = static_cast<std::uint32_t>(__builtin_ctz(bits));
-        f.one_origin =
-            f.one_origin && p.ox[l] == p.ox[l0] && p.oy[l] == p.oy[l0] && p.oz[l] == p.oz[l0];
-    }
-    return f;
+__m256 lane_mask8(std::uint32_t bits) {
+    const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), lane_bit), lane_bit));
 }
 
-// The largest of v[i] over the lanes i in `bits` (not empty).
+// The largest / smallest of v[i] over the lanes i in `bits` (not empty). Exact: min and
+// max do not round, so the order of the reduction does not matter.
 template <class F>
 float masked_max(const float* v, std::uint32_t bits) {
     if constexpr (F::size == 8) {
-        const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-        const __m256i in = _mm256_cmpeq_epi32(
-            _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), lane_bit), lane_bit);
         const __m256 x =
-            _mm256_blendv_ps(_mm256_set1_ps(-kInf), _mm256_load_ps(v), _mm256_castsi256_ps(in));
+            _mm256_blendv_ps(_mm256_set1_ps(-kInf), _mm256_load_ps(v), lane_mask8<F>(bits));
         __m128 m = _mm_max_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1));
         m = _mm_max_ps(m, _mm_movehl_ps(m, m));
         return _mm_cvtss_f32(_mm_max_ss(m, _mm_shuffle_ps(m, m, 1)));
@@ -496,6 +460,64 @@ float masked_max(const float* v, std::uint32_t bits) {
         }
         return m;
     }
+}
+template <class F>
+float masked_min(const float* v, std::uint32_t bits) {
+    if constexpr (F::size == 8) {
+        const __m256 x =
+            _mm256_blendv_ps(_mm256_set1_ps(kInf), _mm256_load_ps(v), lane_mask8<F>(bits));
+        __m128 m = _mm_min_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1));
+        m = _mm_min_ps(m, _mm_movehl_ps(m, m));
+        return _mm_cvtss_f32(_mm_min_ss(m, _mm_shuffle_ps(m, m, 1)));
+    } else {
+        float m = kInf;
+        for (; bits != 0; bits &= bits - 1) {
+            const float x = v[__builtin_ctz(bits)];
+            m = x < m ? x : m;
+        }
+        return m;
+    }
+}
+// Whether v[i] == v[first lane of bits] for every lane i in `bits`.
+template <class F>
+bool masked_all_equal(const float* v, std::uint32_t bits) {
+    const float v0 = v[__builtin_ctz(bits)];
+    if constexpr (F::size == 8) {
+        const __m256 eq = _mm256_cmp_ps(_mm256_load_ps(v), _mm256_set1_ps(v0), _CMP_EQ_OQ);
+        const auto eq_bits = static_cast<std::uint32_t>(_mm256_movemask_ps(eq));
+        return (eq_bits & bits) == bits;
+    } else {
+        for (; bits != 0; bits &= bits - 1)
+            if (!(v[__builtin_ctz(bits)] == v0)) return false;
+        return true;
+    }
+}
+
+// `live`: not empty.
+template <class F>
+PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
+    using Plane = typename PacketFrustum<F>::Plane;
+    const float* const inv[3] = {p.inv_x, p.inv_y, p.inv_z};
+    const float* const lo_off[3] = {p.lo_off_x, p.lo_off_y, p.lo_off_z};
+    const float* const hi_off[3] = {p.hi_off_x, p.hi_off_y, p.hi_off_z};
+    const Plane mins[3] = {&BvhNode8::min_x, &BvhNode8::min_y, &BvhNode8::min_z};
+    const Plane maxs[3] = {&BvhNode8::max_x, &BvhNode8::max_y, &BvhNode8::max_z};
+    PacketFrustum<F> f;
+    for (int a = 0; a < 3; ++a) {
+        const float lo = masked_min<F>(inv[a], live), hi = masked_max<F>(inv[a], live);
+        const bool positive = lo > 0.0f;
+        if (!positive && !(hi < 0.0f)) return f;  // mixed signs (or NaN): no bundle
+        const float near_max = masked_max<F>(positive ? lo_off[a] : hi_off[a], live);
+        const float far_min = masked_min<F>(positive ? hi_off[a] : lo_off[a], live);
+        f.near[a] = positive ? mins[a] : maxs[a];
+        f.far[a] = positive ? maxs[a] : mins[a];
+        f.inv_lo[a] = F(lo), f.inv_hi[a] = F(hi);
+        f.near_off[a] = F(near_max), f.far_off[a] = F(far_min);
+    }
+    f.valid = true;
+    f.one_origin = masked_all_equal<F>(p.ox, live) && masked_all_equal<F>(p.oy, live) &&
+                   masked_all_equal<F>(p.oz, live);
+    return f;
 }
 
 // The children of `n` that are not kBvhEmpty, as bits (they come first).
