@@ -340,6 +340,24 @@ struct Variant {
     TileSize tile;
 };
 
+// A whole-frame row: warm-up frames, then o.reps timed ones (each frame's own seconds),
+// the last frame's ray counts, the rates and frames per second.
+void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
+                 const BenchOptions& o) {
+    RenderResult last;
+    for (int i = 0; i < std::max(1, o.warmup); ++i) last = render();
+    for (int i = 0; i < o.reps; ++i) {
+        last = render();
+        row.seconds.push_back(last.seconds);
+    }
+    row.counts = last.rays;
+    row.rays = last.rays.total();
+    row.hit_fraction = std::nan("");
+    row.timing = summarize(row.seconds, row.rays);
+    row.frames_per_second =
+        row.timing.seconds_median > 0.0 ? 1.0 / row.timing.seconds_median : 0.0;
+}
+
 // One configuration of the SIMD rows: brute force or the BVH with a packet/single switch.
 struct SimdConfig {
     bool bvh;
@@ -678,19 +696,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                                            ? render_packet(compiled, ro, isa)
                                            : render_reference(scene, ro);
                             };
-                            RenderResult last;
-                            for (int i = 0; i < std::max(1, o.warmup); ++i) last = render();
-                            for (int i = 0; i < o.reps; ++i) {
-                                last = render();
-                                row.seconds.push_back(last.seconds);
-                            }
-                            row.counts = last.rays;
-                            row.rays = last.rays.total();
-                            row.hit_fraction = std::nan("");
-                            row.timing = summarize(row.seconds, row.rays);
-                            row.frames_per_second = row.timing.seconds_median > 0.0
-                                                        ? 1.0 / row.timing.seconds_median
-                                                        : 0.0;
+                            time_frames(row, render, o);
                             log_line(log, "  whitted octray " + row.mode + " " + row.isa + " " +
                                               row.accel + " tile " + row.tile + ": " +
                                               format("%.3f frames/s", row.frames_per_second) +
@@ -718,20 +724,8 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                         ro.threads = ctx.threads;
                         ro.tile_width = tile.width;
                         ro.tile_height = tile.height;
-                        RenderResult last;
-                        for (int i = 0; i < std::max(1, o.warmup); ++i)
-                            last = frames.render(compiled, ro);
-                        for (int i = 0; i < o.reps; ++i) {
-                            last = frames.render(compiled, ro);
-                            row.seconds.push_back(last.seconds);
-                        }
-                        row.counts = last.rays;
-                        row.rays = last.rays.total();
-                        row.hit_fraction = std::nan("");
-                        row.timing = summarize(row.seconds, row.rays);
-                        row.frames_per_second = row.timing.seconds_median > 0.0
-                                                    ? 1.0 / row.timing.seconds_median
-                                                    : 0.0;
+                        time_frames(
+                            row, [&] { return frames.render(compiled, ro); }, o);
                         log_line(log, "  whitted embree " + row.mode + " " + row.isa +
                                           " tile " + row.tile + ": " +
                                           format("%.3f frames/s", row.frames_per_second) +
