@@ -3,7 +3,9 @@
 # it asks dpkg first and only runs apt-get when something is missing, so it is cheap to
 # call before every build. Uses sudo only when not already root. clang and its runtime
 # build the asan preset (ASan, UBSan, libFuzzer); dpkg-dev and xz-utils let
-# tests/tsan/build_tbb.sh fetch and unpack oneTBB's Debian source.
+# tests/tsan/build_tbb.sh fetch and unpack oneTBB's Debian source. slurmctld, slurmd,
+# slurm-client and munge let tests/farm/slurm.sh run a single-node Slurm (it starts the
+# daemons itself, from a temporary folder; installing them starts nothing here).
 set -euo pipefail
 
 packages=(
@@ -13,6 +15,7 @@ packages=(
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
     libpng-dev libembree-dev
+    slurmctld slurmd slurm-client munge
 )
 
 missing=()

@@ -4,7 +4,10 @@
 #   1. install what is missing (tools/setup.sh, apt),
 #   2. release preset (g++ 12, -Wall -Wextra -Werror, Embree): build, run the whole suite,
 #      then install that build into a temporary prefix and build and run examples/embed
-#      against the installed package (tests/install/run.sh),
+#      against the installed package (tests/install/run.sh), then the render-farm test:
+#      a private single-node Slurm runs tools/farm/slurm_array.sh with one task killed
+#      and requeued (tests/farm/slurm.sh, at most 600 s; it stops its daemons itself,
+#      also when the timeout's SIGTERM ends it),
 #   3. asan preset (clang, ASan + UBSan, Embree off so that configuration is built and
 #      tested too): build, run the whole suite again plus every libFuzzer target for
 #      OCTRAY_FUZZ_SECONDS (30) each,
@@ -22,6 +25,14 @@ ctest --preset release
 echo "tools/test.sh: release done at $((SECONDS - start)) s"
 tests/install/run.sh build/release
 echo "tools/test.sh: install + examples/embed done at $((SECONDS - start)) s"
+farm_start=$SECONDS
+farm_status=0
+timeout 600 tests/farm/slurm.sh build/release/tools/octray || farm_status=$?
+echo "tools/test.sh: slurm farm test took $((SECONDS - farm_start)) s (exit $farm_status)," \
+    "done at $((SECONDS - start)) s"
+if [[ $farm_status -ne 0 ]]; then
+    exit "$farm_status"
+fi
 
 cmake --preset asan
 cmake --build --preset asan -j2
