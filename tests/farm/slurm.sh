@@ -28,7 +28,7 @@ job_script=$repo/tools/farm/slurm_array.sh
 frames=0-11       # 12 frames of the 48
 tasks=3           # array 0-2 on two CPUs: two run at once, the third waits
 kill_task=1       # the task whose octray is killed mid-frame and requeued
-size=(--width 64 --height 36 --spp 1024)  # ~0.7 s a frame on one thread
+size=(--width 64 --height 36 --spp 4096)  # ~2.5 s a frame on one thread: a wide window to kill one mid-frame
 
 fail() {
     echo "tests/farm/slurm.sh: FAIL: $*" >&2
