@@ -187,7 +187,11 @@ std::string mistyped_argument_hint(const CLI::App& app) {
         if (!option && !top) continue;  // a stray value, not a name
         const std::string_view word =
             std::string_view(argument).substr(0, option ? argument.find('=') : argument.npos);
-        const auto best = closest_word(word, candidates);
+        // A wrong case first ("-v" is "-V", not "-h"), then the closest spelling.
+        std::optional<std::string_view> best;
+        for (std::string_view candidate : candidates)
+            if (lowercase(candidate) == lowercase(word) && candidate != word) best = candidate;
+        if (!best) best = closest_word(word, candidates);
         if (!best) continue;
         return std::string("unknown ") + (option ? "option " : "command ") + quote_value(word) +
                " (did you mean " + quote_value(*best) + "?)";

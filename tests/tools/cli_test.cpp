@@ -198,6 +198,70 @@ TEST_F(CliTest, HelpExplainsCommandsOptionsAndExitCodes) {
         EXPECT_TRUE(contains(render.output, option)) << option << "\n" << render.output;
 }
 
+// Issue 26: `octray help COMMAND` is `octray COMMAND --help`, `-V` is `--version`, and an
+// unknown command is named as such.
+TEST_F(CliTest, HelpCommandAndShortVersionFlag) {
+    const RunResult v = octray({"-V"});
+    EXPECT_EQ(v.status, 0) << v.output;
+    EXPECT_EQ(v.output, "octray 0.1.0\n");
+
+    for (const std::string command :
+         {"render", "scene", "compare", "bench", "verify", "info", "assemble"}) {
+        const RunResult help = octray({"help", command});
+        const RunResult flag = octray({command, "--help"});
+        EXPECT_EQ(help.status, 0) << command << "\n" << help.output;
+        EXPECT_EQ(help.output, flag.output) << command;
+    }
+    const RunResult top = octray({"help"});
+    EXPECT_EQ(top.status, 0) << top.output;
+    EXPECT_EQ(top.output, octray({"--help"}).output);
+    EXPECT_TRUE(contains(top.output, "octray help <command>")) << top.output;
+
+    RunResult r = octray({"help", "rendr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "unknown command \"rendr\" (did you mean \"render\"?)"))
+        << r.output;
+    r = octray({"frobnicate"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "unknown command \"frobnicate\"; the commands are render"))
+        << r.output;
+    r = octray({"-v"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "did you mean \"-V\"?")) << r.output;
+    EXPECT_TRUE(entries().empty());
+}
+
+// Issue 26: every usage error names the help of the command it was given to, whether the
+// parser or the command found it.
+TEST_F(CliTest, UsageErrorsNameTheCommandsOwnHelp) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", "--no-such-option"}, "render"},
+        {{"render", "random:2", "--threads", "-1"}, "render"},
+        {{"render", "random:2", "-o", "same.exr", "--png", "same.exr"}, "render"},
+        {{"render", "random:2", "-o", "x.tif"}, "render"},
+        {{"scene"}, "scene"},
+        {{"verify", "--wdth", "8"}, "verify"},
+        {{"bench", "--reps", "0x2", "--no-embree"}, "bench"},
+        {{"info", "--nope"}, "info"},
+        {{"assemble"}, "assemble"},
+    };
+    for (const auto& [args, command] : cases) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[0] << " " << args[1] << "\n" << r.output;
+        EXPECT_TRUE(
+            contains(r.output, "\nRun 'octray " + command + " --help' for more information.\n"))
+            << r.output;
+    }
+    for (const std::vector<std::string>& args :
+         std::vector<std::vector<std::string>>{{}, {"frobnicate"}, {"--nope"}}) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << r.output;
+        EXPECT_TRUE(contains(r.output, "\nRun 'octray --help' for more information.\n"))
+            << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
 TEST_F(CliTest, RendersSmallBuiltinWithAttributesAndPreview) {
     const std::string spec = "random:8,width=32,height=24";
     const RunResult r =
@@ -479,7 +543,9 @@ TEST_F(CliTest, MistypedOptionsSuggestTheClosestOne) {
     };
     for (const auto& [args, meant] : cases) {
         const RunResult r = octray(args);
-        EXPECT_EQ(r.status, 2) << args[0] << " " << args[1] << "\n" << r.output;
+        // compare's usage errors exit 5 (issue 26): 2 is its FAIL verdict.
+        EXPECT_EQ(r.status, args[0] == "compare" ? 5 : 2) << args[0] << " " << args[1] << "\n"
+                                                          << r.output;
         EXPECT_TRUE(contains(r.output, "did you mean \"" + meant + "\"?")) << args[0] << "\n"
                                                                            << r.output;
         EXPECT_TRUE(contains(r.output, "--help")) << r.output;
