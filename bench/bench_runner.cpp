@@ -124,7 +124,7 @@ using Tracer = std::function<void(const RaySet&, HitSet&)>;
 // Warm-up runs, then `reps` timed runs; the hits of the last run stay in `hits`.
 std::vector<double> time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits, int warmup,
                               int reps) {
-    for (int i = 0; i < std::max(1, warmup); ++i) trace(rays, hits);
+    for (int i = 0; i < warmup; ++i) trace(rays, hits);
     std::vector<double> seconds;
     for (int i = 0; i < reps; ++i) {
         const auto start = Clock::now();
@@ -352,7 +352,9 @@ struct SimdConfig {
 
 void compute_ratios(std::vector<BenchRow>& rows) {
     const auto key = [](const BenchRow& r) {
-        return r.scene + '\n' + workload_name(r.workload) + '\n' + r.order + '\n' + r.tile;
+        // A --threads sweep compares the two systems at each thread count.
+        return r.scene + '\n' + workload_name(r.workload) + '\n' + r.order + '\n' + r.tile +
+               '\n' + std::to_string(r.threads);
     };
     std::map<std::string, double> best_embree, best_octray;
     for (const BenchRow& r : rows) {
@@ -679,7 +681,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                                            : render_reference(scene, ro);
                             };
                             RenderResult last;
-                            for (int i = 0; i < std::max(1, o.warmup); ++i) last = render();
+                            for (int i = 0; i < o.warmup; ++i) last = render();
                             for (int i = 0; i < o.reps; ++i) {
                                 last = render();
                                 row.seconds.push_back(last.seconds);
@@ -719,8 +721,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                         ro.tile_width = tile.width;
                         ro.tile_height = tile.height;
                         RenderResult last;
-                        for (int i = 0; i < std::max(1, o.warmup); ++i)
-                            last = frames.render(compiled, ro);
+                        for (int i = 0; i < o.warmup; ++i) last = frames.render(compiled, ro);
                         for (int i = 0; i < o.reps; ++i) {
                             last = frames.render(compiled, ro);
                             row.seconds.push_back(last.seconds);
@@ -752,11 +753,40 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
 
 // ---- Output ------------------------------------------------------------------------------
 
+namespace {
+
+// The thread counts of the rows, in the order measured (one for a run, more for a sweep).
+std::vector<int> thread_counts(const BenchReport& report) {
+    std::vector<int> counts;
+    for (const BenchRow& r : report.rows)
+        if (std::find(counts.begin(), counts.end(), r.threads) == counts.end())
+            counts.push_back(r.threads);
+    if (counts.empty()) counts.push_back(report.context.threads);
+    return counts;
+}
+
+// The threads column of a sweep, in front of the others.
+std::string format_threads(const std::string& text) {
+    char cell[32];
+    std::snprintf(cell, sizeof cell, "%7s ", text.c_str());
+    return cell;
+}
+
+std::string join_counts(const std::vector<int>& counts) {
+    std::string out;
+    for (int n : counts) out += (out.empty() ? "" : ",") + std::to_string(n);
+    return out;
+}
+
+}  // namespace
+
 void print_table(const BenchReport& report, std::ostream& out) {
     const BenchContext& c = report.context;
+    const std::vector<int> counts = thread_counts(report);
+    const bool sweep = counts.size() > 1;  // then a threads column
     out << "octray bench " << c.octray_version << "  " << c.date << "\n"
-        << "CPU: " << c.cpu << " (" << c.logical_cpus << " logical), threads " << c.threads
-        << ", octray ISA " << c.isa << ", " << c.compiler << "\n"
+        << "CPU: " << c.cpu << " (" << c.logical_cpus << " logical), threads "
+        << join_counts(counts) << ", octray ISA " << c.isa << ", " << c.compiler << "\n"
         << "Embree: " << c.embree << "\n"
         << "frame " << c.width << "x" << c.height << ", " << c.reps << " timed reps after "
         << c.warmup << " warm-up, load average at start " << format("%.2f", c.load_average)
@@ -784,6 +814,7 @@ void print_table(const BenchReport& report, std::ostream& out) {
                   "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9s %6s %9s %9s %9s %8s %s\n",
                   "scene", "rays", "system", "mode", "isa", "accel", "order", "tile", "count",
                   "hit%", "Mrays/s", "min", "max", "oct/emb", "valid");
+    if (sweep) out << format_threads("threads");
     out << line;
     for (const BenchRow& r : report.rows) {
         const std::string ratio = r.ratio ? format("%.3f", *r.ratio) : "-";
@@ -796,6 +827,7 @@ void print_table(const BenchReport& report, std::ostream& out) {
             r.isa.c_str(), r.accel_label().c_str(), r.order.c_str(), r.tile.c_str(),
             static_cast<unsigned long long>(r.rays), hit.c_str(), r.timing.mrays_median,
             r.timing.mrays_min, r.timing.mrays_max, ratio.c_str(), r.valid ? "yes" : "NO");
+        if (sweep) out << format_threads(std::to_string(r.threads));
         out << line;
         if (r.workload == Workload::whitted)
             out << "               frames/s " << format("%.3f", r.frames_per_second)
@@ -822,6 +854,7 @@ std::string report_json(const BenchReport& report) {
         {"cpu", c.cpu},
         {"logical_cpus", c.logical_cpus},
         {"threads", c.threads},
+        {"thread_counts", thread_counts(report)},
         {"isa", c.isa},
         {"compiler", c.compiler},
         {"octray_version", c.octray_version},

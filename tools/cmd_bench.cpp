@@ -27,7 +27,8 @@ struct BenchArguments {
     std::vector<std::string> paths;
     std::vector<std::string> accels;
     std::vector<std::uint32_t> packet_lanes;
-    int threads = 0, reps = 5, warmup = 1, width = 1920, height = 1080;
+    std::vector<int> threads;  // a scaling sweep; empty: every core
+    int reps = 5, warmup = 1, width = 1920, height = 1080;
     std::uint32_t validate_rays = 1u << 16;
     bool no_embree = false;
     std::string json;
@@ -44,7 +45,11 @@ std::string command_line(const BenchArguments& a) {
     std::string c = "octray bench";
     for (const std::string& s : a.scenes) c += " " + s;
     if (!a.rays.empty()) c += " --rays " + join(a.rays);
-    if (a.threads > 0) c += " --threads " + std::to_string(a.threads);
+    if (!a.threads.empty()) {
+        std::vector<std::string> counts;
+        for (int n : a.threads) counts.push_back(std::to_string(n));
+        c += " --threads " + join(counts);
+    }
     c += " --reps " + std::to_string(a.reps);
     if (a.warmup != 1) c += " --warmup " + std::to_string(a.warmup);
     c += " --width " + std::to_string(a.width) + " --height " + std::to_string(a.height);
@@ -95,7 +100,6 @@ void run_bench_command(const BenchArguments& a) {
         if (!isa_supported(isa))
             throw UsageError(std::string("--isa ") + isa_name(isa) +
                              ": this CPU does not support it");
-    o.threads = a.threads;
     o.reps = a.reps;
     o.warmup = a.warmup;
     o.width = a.width;
@@ -108,7 +112,20 @@ void run_bench_command(const BenchArguments& a) {
         std::cerr
             << "octray bench: Embree 3 was not found when octray was built; measuring octray "
                "alone\n";
-    const bench::BenchReport report = bench::run_bench(o, &std::cerr);
+    // A --threads list is a scaling sweep: the whole run once per count, one row per
+    // configuration and count, octray against Embree at the same count.
+    bench::BenchReport report;
+    const std::vector<int> counts = a.threads.empty() ? std::vector<int>{0} : a.threads;
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        o.threads = counts[k];
+        bench::BenchReport part = bench::run_bench(o, &std::cerr);
+        if (k == 0) {
+            report = std::move(part);
+        } else {
+            report.rows.insert(report.rows.end(), part.rows.begin(), part.rows.end());
+        }
+    }
+    bench::compute_ratios(report.rows);
     std::cout << '\n';
     bench::print_table(report, std::cout);
     if (!a.json.empty()) {
@@ -136,12 +153,18 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                     "[default: all]")
         ->delimiter(',')
         ->type_name("LIST");
-    cmd->add_option("--threads", a->threads, "Threads for both systems [default: all cores]")
+    cmd->add_option("--threads", a->threads,
+                    "Threads for both systems; a list (1,2,4) is a scaling sweep, rows for "
+                    "each count; 0 = all cores [default: all cores]")
+        ->delimiter(',')
+        ->type_name("LIST")
         ->transform(decimal_integer(0, kMaxInt));
     cmd->add_option("--reps", a->reps, "Timed repetitions per row [default: 5]")
         ->transform(decimal_integer(1, kMaxInt));
-    cmd->add_option("--warmup", a->warmup, "Untimed runs before them [default: 1]")
-        ->transform(decimal_integer(1, kMaxInt));
+    cmd->add_option("--warmup", a->warmup,
+                    "Untimed runs before them, 0 for none (the hits of the last timed run "
+                    "are validated) [default: 1]")
+        ->transform(decimal_integer(0, kMaxInt));
     cmd->add_option("--width", a->width, "Frame width [default: 1920]")
         ->transform(decimal_integer(1, kMaxInt));
     cmd->add_option("--height", a->height, "Frame height [default: 1080]")
@@ -191,6 +214,7 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray bench                                   # the default table\n"
         "  octray bench random:1024 --rays primary,shadow --threads 2 --json out.json\n"
+        "  octray bench random:1024 --rays primary --threads 1,2,4,8 # a scaling sweep\n"
         "  octray bench whitted --order rowmajor,tiled,morton --rays primary\n"
         "  octray bench random:65536 random:1048576 sphereflake:5 --rays primary,shadow "
         "--threads 2\n"

@@ -32,6 +32,7 @@
 #include "scene/builtin.h"
 #include "scene/limits.h"
 #include "scene/load.h"
+#include "scene/max_depth.h"
 #include "scene/scene.h"
 #include "scene/scene_error.h"
 #include "tools/batch.h"
@@ -534,10 +535,10 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
             ->transform(decimal_integer(1, 1 << 20));
     args->max_depth_option =
         cmd->add_option("--max-depth", args->max_depth,
-                        "Reflection/refraction bounces, 0..1000; 0 = primary rays only\n"
-                        "(overrides the scene)")
+                        "Reflection/refraction bounces, 0.." + std::to_string(kMaxDepthLimit) +
+                            "; 0 = primary rays only\n(overrides the scene)")
             ->type_name("D")
-            ->transform(decimal_integer(0, 1000));
+            ->transform(decimal_integer(0, kMaxDepthLimit));
     args->seed_option =
         cmd->add_option("--seed", args->seed,
                         "Seed of the sample jitter, 0..2^64-1 (overrides the scene)")

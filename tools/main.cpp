@@ -187,6 +187,11 @@ int main(int argc, char** argv) {
             }
         }
         if (message.empty()) message = e.what();
+        // CLI11 writes "--warmup: must be an integer >= 0 ..." for the number checks
+        // (tools/cli_checks.h); it reads as a sentence without the colon.
+        if (const auto colon = message.find(": must be ");
+            colon != std::string::npos && message.rfind(' ', colon) == std::string::npos)
+            message.erase(colon, 1);
         std::cerr << "octray: error: " << message << '\n' << help_hint(command) << '\n';
         return usage_status(command);
     }

@@ -100,6 +100,53 @@ TEST_F(BenchCliTest, ScalarAndSimdPathsAreBothRowsOfOneRun) {
     EXPECT_GE(modes.size(), 2u) << "one mode per path expected";
 }
 
+// Issue 26: --threads takes a list, a scaling sweep with rows for each count (octray against
+// Embree at the same count), and --warmup 0 is allowed.
+TEST_F(BenchCliTest, ThreadListIsAScalingSweepAndWarmupZeroIsAllowed) {
+    const auto r = run_octray(
+        {"bench", "random:16", "--width", "32", "--height", "24", "--reps", "1", "--warmup",
+         "0", "--rays", "primary", "--threads", "1,2", "--json", "r.json"},
+        dir_);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "threads 1,2,")) << r.output;
+    EXPECT_TRUE(contains(r.output, "--threads 1,2 ")) << r.output;  // the command line
+    const nlohmann::json report = read_json(dir_ / "r.json");
+    EXPECT_EQ(report["context"]["warmup"], 0);
+    EXPECT_EQ(report["context"]["thread_counts"], nlohmann::json::array({1, 2}));
+    std::set<int> threads;
+    for (const auto& row : report["rows"]) {
+        threads.insert(row["threads"].get<int>());
+        EXPECT_TRUE(row["valid"].get<bool>()) << row.dump(2);
+        // A ratio compares the two systems at one thread count.
+        if (!row["ratio_octray_over_embree"].is_null()) {
+            bool partner = false;
+            for (const auto& other : report["rows"])
+                partner |=
+                    other["system"] != row["system"] && other["threads"] == row["threads"];
+            EXPECT_TRUE(partner) << row.dump(2);
+        }
+    }
+    EXPECT_EQ(threads, (std::set<int>{1, 2}));
+}
+
+// Issue 26: range errors say what the option takes, not a 300-digit number or 2^31 - 1.
+TEST_F(BenchCliTest, RangeErrorsReadAsTheOptionsLimits) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"--warmup", "-1"}, "--warmup must be an integer >= 0"},
+        {{"--reps", "0"}, "--reps must be an integer >= 1"},
+        {{"--threads", "1,x"}, "--threads must be an integer >= 0"},
+        {{"--packet-lanes", "10"}, "--packet-lanes must be an integer from 0 to 9"},
+    };
+    for (const auto& [args, message] : cases) {
+        std::vector<std::string> command = {"bench", "--no-embree"};
+        command.insert(command.end(), args.begin(), args.end());
+        const auto r = run_octray(command, dir_);
+        EXPECT_EQ(r.status, 2) << args[0] << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, message)) << args[0] << "\n" << r.output;
+        EXPECT_FALSE(contains(r.output, "2147483647")) << r.output;
+    }
+}
+
 TEST_F(BenchCliTest, BadInputExitsWithItsCode) {
     EXPECT_EQ(run_octray({"bench", "--rays", "sideways"}, dir_).status, 2);
     EXPECT_EQ(run_octray({"bench", "--reps", "0"}, dir_).status, 2);

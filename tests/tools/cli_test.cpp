@@ -593,6 +593,23 @@ TEST_F(CliTest, IntegerOptionsTakeDecimalDigitsOnly) {
     EXPECT_EQ(seed->value(), "18446744073709551615");
 }
 
+// Issue 26: --max-depth's help and its limit are the scene's limit, from one constant.
+TEST_F(CliTest, MaxDepthHelpAndLimitAgreeWithTheScene) {
+    const RunResult help = octray({"render", "--help"});
+    EXPECT_TRUE(contains(help.output, "bounces, 0..64;")) << help.output;
+    const RunResult over = octray({"render", "random:2,width=4,height=4", "--max-depth", "65"});
+    EXPECT_EQ(over.status, 2) << over.output;
+    EXPECT_TRUE(contains(over.output, "--max-depth must be an integer from 0 to 64"))
+        << over.output;
+    const RunResult spec = octray({"render", "random:2,width=4,height=4,max_depth=65"});
+    EXPECT_EQ(spec.status, 3) << spec.output;
+    EXPECT_TRUE(contains(spec.output, "from 0 to 64")) << spec.output;
+    EXPECT_TRUE(entries().empty());
+    const RunResult top = octray({"render", "random:2,width=4,height=4", "--max-depth", "64",
+                                  "-o", "d.exr", "--progress", "none"});
+    EXPECT_EQ(top.status, 0) << top.output;
+}
+
 // Issue 23: -o and --png are the same file when they name one directory entry, however
 // spelled (here through a symlink to "." and ".."); the check compares identities.
 TEST_F(CliTest, OutputsAreComparedByIdentityNotSpelling) {
