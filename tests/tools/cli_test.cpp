@@ -418,22 +418,46 @@ TEST_F(CliTest, DeviceAsSceneFileIsRefusedBeforeReading) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 26 changed this: a missing output directory is created (MissingOutputDirectoriesAre
+// Created); one that cannot be created is still an I/O error found before rendering.
 TEST_F(CliTest, MissingOutputDirectoryIsAnIoErrorAndLeavesNothing) {
+    { std::ofstream(path("file")) << "not a directory"; }
     const RunResult r =
-        octray({"render", "random:2,width=8,height=8", "-o", "nope/sub/out.exr"});
+        octray({"render", "random:2,width=8,height=8", "-o", "file/sub/out.exr"});
     EXPECT_EQ(r.status, 4) << r.output;
-    EXPECT_TRUE(contains(r.output, "nope/sub/out.exr")) << r.output;
+    EXPECT_TRUE(contains(r.output, "file/sub/out.exr")) << r.output;
+    EXPECT_TRUE(contains(r.output, "file is a file, not a directory")) << r.output;
 
     // An unwritable preview is found before rendering, so the EXR is not written either.
     const RunResult png = octray(
-        {"render", "random:2,width=8,height=8", "-o", "out.exr", "--png", "nope/out.png"});
+        {"render", "random:2,width=8,height=8", "-o", "out.exr", "--png", "file/out.png"});
     EXPECT_EQ(png.status, 4) << png.output;
 
     const RunResult scene = octray({"scene", "random:2", "-o", "nope/x.json"});
     EXPECT_EQ(scene.status, 4) << scene.output;
     EXPECT_TRUE(contains(scene.output, "nope/x.json")) << scene.output;
 
-    EXPECT_TRUE(entries().empty());
+    EXPECT_EQ(entries(), std::vector<std::string>{"file"});
+}
+
+// Issue 26: render creates the missing directories of its outputs (as Blender does) and
+// says which, on stderr; the README's `-o out/bounce.####.exr` works in a fresh directory.
+TEST_F(CliTest, MissingOutputDirectoriesAreCreated) {
+    const RunResult r = octray({"render", "random:2,width=8,height=8", "-o", "out/sub/x.exr",
+                                "--png", "previews/x.png", "--progress", "none"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::is_regular_file(path("out/sub/x.exr")));
+    EXPECT_TRUE(fs::is_regular_file(path("previews/x.png")));
+    for (const char* dir : {"out/", "out/sub/", "previews/"})
+        EXPECT_TRUE(
+            contains(r.output, std::string("octray: created output directory ") + dir + "\n"))
+            << dir << "\n"
+            << r.output;
+    // Nothing to create the second time: nothing said.
+    const RunResult again = octray(
+        {"render", "random:2,width=8,height=8", "-o", "out/sub/y.exr", "--progress", "none"});
+    ASSERT_EQ(again.status, 0) << again.output;
+    EXPECT_FALSE(contains(again.output, "created")) << again.output;
 }
 
 TEST_F(CliTest, UsageErrorsExitWithTwo) {
