@@ -634,6 +634,39 @@ TEST_F(CliTest, MaxDepthHelpAndLimitAgreeWithTheScene) {
     EXPECT_EQ(top.status, 0) << top.output;
 }
 
+// Issue 26: the two paths promise identical bits, so verify is exact by default (a
+// tolerance stays available), and it verifies frames of an animated scene.
+TEST_F(CliTest, VerifyIsExactByDefaultAndTakesFrames) {
+    const RunResult help = octray({"verify", "--help"});
+    EXPECT_TRUE(contains(help.output, "--frames")) << help.output;
+    EXPECT_TRUE(contains(help.output, "--fail X")) << help.output;
+
+    const RunResult exact = octray({"verify", "random:8,width=16,height=12", "--threads", "2"});
+    EXPECT_EQ(exact.status, 0) << exact.output;
+    EXPECT_TRUE(contains(exact.output, "check    exact: every value equal (the default)\n"))
+        << exact.output;
+    EXPECT_TRUE(contains(exact.output, "differ by more than 0 (0 pixels)")) << exact.output;
+    EXPECT_TRUE(contains(exact.output, "\nPASS\n")) << exact.output;
+
+    const RunResult tolerant = octray(
+        {"verify", "random:8,width=16,height=12", "--fail", "1e-4", "--hardfail", "1e-3"});
+    EXPECT_EQ(tolerant.status, 0) << tolerant.output;
+    EXPECT_TRUE(contains(tolerant.output, "check    within the tolerance given"))
+        << tolerant.output;
+
+    const std::string bounce = std::string(OCTRAY_SOURCE_DIR) + "/scene/examples/bounce.json";
+    const RunResult frames =
+        octray({"verify", bounce, "--frames", "0,20-40:20", "--width", "32", "--height", "24"});
+    EXPECT_EQ(frames.status, 0) << frames.output;
+    for (const char* part :
+         {"frame    0\n", "frame    20\n", "frame    40\n", "PASS: all 3 frames"})
+        EXPECT_TRUE(contains(frames.output, part)) << part << "\n" << frames.output;
+    const RunResult bad = octray({"verify", bounce, "--frames", "1-x"});
+    EXPECT_EQ(bad.status, 2) << bad.output;
+    EXPECT_TRUE(contains(bad.output, "--frames")) << bad.output;
+    EXPECT_TRUE(entries().empty());
+}
+
 // Issue 23: -o and --png are the same file when they name one directory entry, however
 // spelled (here through a symlink to "." and ".."); the check compares identities.
 TEST_F(CliTest, OutputsAreComparedByIdentityNotSpelling) {
