@@ -283,10 +283,17 @@ void ProgressReporter::finish(const BatchSummary& summary) {
                     frame_count_ == 1 ? "" : "s", summary.rendered, summary.skipped,
                     summary.failed);
         if (summary.not_started > 0) std::printf(", %zu not started", summary.not_started);
+        // The phases of short runs in milliseconds' precision: "0.0s" says nothing.
+        const auto phase = [](double seconds) {
+            if (seconds >= 10.0) return format_duration(seconds);
+            char text[32];
+            std::snprintf(text, sizeof text, "%.3fs", seconds);
+            return std::string(text);
+        };
         std::printf(" in %s: trace %s (%.2f Mrays/s), write %s\n",
                     format_duration(summary.seconds).c_str(),
-                    format_duration(summary.trace_seconds).c_str(), mrays,
-                    format_duration(summary.write_seconds).c_str());
+                    phase(summary.trace_seconds).c_str(), mrays,
+                    phase(summary.write_seconds).c_str());
     }
     std::fflush(stdout);
 }
