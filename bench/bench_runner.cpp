@@ -19,9 +19,11 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "bench/embree_baseline.h"
 #include "bench/embree_frames.h"
@@ -772,6 +774,51 @@ std::string format_threads(const std::string& text) {
     return cell;
 }
 
+// The headline: one line per scene and ray kind (and thread count in a sweep) with the
+// best valid octray row, the best valid Embree row and octray / Embree, before the detail.
+void print_headline(const BenchReport& report, bool sweep, std::ostream& out) {
+    struct Best {
+        std::optional<double> octray, embree;
+    };
+    std::vector<std::string> order;  // keys as first measured
+    std::map<std::string, Best> best;
+    std::map<std::string, std::tuple<std::string, std::string, int>> label;
+    for (const BenchRow& r : report.rows) {
+        const std::string key = r.scene + '\n' + workload_name(r.workload) + '\n' +
+                                std::to_string(sweep ? r.threads : 0);
+        if (!best.count(key)) {
+            order.push_back(key);
+            best[key] = {};
+            label[key] = {r.scene, workload_name(r.workload), r.threads};
+        }
+        if (!r.valid) continue;
+        std::optional<double>& b = r.system == "embree" ? best[key].embree : best[key].octray;
+        b = std::max(b.value_or(0.0), r.timing.mrays_median);
+    }
+    out << "Mrays/s, median of the repetitions; the best valid row of each system (the detail\n"
+           "below has every configuration). octray/Embree > 1: octray is faster.\n";
+    char line[256];
+    std::snprintf(line, sizeof line, "%-14s %-9s %s%12s %12s %14s\n", "scene", "rays",
+                  sweep ? "threads " : "", "octray", "Embree", "octray/Embree");
+    out << line;
+    for (const std::string& key : order) {
+        const Best& b = best[key];
+        const auto& [scene, rays, threads] = label[key];
+        const auto cell = [](const std::optional<double>& v) {
+            return v ? format("%.2f", *v) : std::string("-");
+        };
+        const std::string ratio = b.octray && b.embree && *b.embree > 0.0
+                                      ? format("%.3f", *b.octray / *b.embree)
+                                      : std::string("-");
+        const std::string thread_cell = sweep ? format_threads(std::to_string(threads)) : "";
+        std::snprintf(line, sizeof line, "%-14s %-9s %s%12s %12s %14s\n", scene.c_str(),
+                      rays.c_str(), thread_cell.c_str(), cell(b.octray).c_str(),
+                      cell(b.embree).c_str(), ratio.c_str());
+        out << line;
+    }
+    out << "\n";
+}
+
 std::string join_counts(const std::vector<int>& counts) {
     std::string out;
     for (int n : counts) out += (out.empty() ? "" : ",") + std::to_string(n);
@@ -809,6 +856,8 @@ void print_table(const BenchReport& report, std::ostream& out) {
         out << "\n";
     }
     out << "\n";
+    print_headline(report, sweep, out);
+    out << "Detail:\n";
     char line[512];
     std::snprintf(line, sizeof line,
                   "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9s %6s %9s %9s %9s %8s %s\n",

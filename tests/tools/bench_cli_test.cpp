@@ -5,11 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "bench/embree_baseline.h"
 #include "run_octray.h"
@@ -145,6 +147,42 @@ TEST_F(BenchCliTest, RangeErrorsReadAsTheOptionsLimits) {
         EXPECT_TRUE(contains(r.output, message)) << args[0] << "\n" << r.output;
         EXPECT_FALSE(contains(r.output, "2147483647")) << r.output;
     }
+}
+
+// Issue 26: one headline table (scene x ray kind: octray, Embree, ratio) before the
+// detail, and --csv with one line per row besides --json.
+TEST_F(BenchCliTest, HeadlineTableLeadsAndCsvHasOneLinePerRow) {
+    const auto r = run_octray(
+        {"bench", "random:16", "--width", "32", "--height", "24", "--reps", "1", "--rays",
+         "primary,shadow", "--order", "rowmajor,tiled", "--json", "r.json", "--csv", "r.csv"},
+        dir_, /*capture_stderr=*/false);
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::size_t headline = r.output.find("octray/Embree\n");
+    const std::size_t detail = r.output.find("Detail:\n");
+    ASSERT_NE(headline, std::string::npos) << r.output;
+    ASSERT_NE(detail, std::string::npos) << r.output;
+    EXPECT_LT(headline, detail) << r.output;
+    // One headline line per scene and ray kind, however many orders were measured.
+    const std::string head = r.output.substr(headline, detail - headline);
+    std::size_t lines = 0;
+    for (std::size_t at = head.find("\nrandom:16"); at != std::string::npos;
+         at = head.find("\nrandom:16", at + 1))
+        ++lines;
+    EXPECT_EQ(lines, 2u) << head;
+    EXPECT_TRUE(contains(head, "primary")) << head;
+    EXPECT_TRUE(contains(head, "shadow")) << head;
+
+    const nlohmann::json report = read_json(dir_ / "r.json");
+    std::ifstream csv(dir_ / "r.csv");
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(csv, line);) rows.push_back(line);
+    ASSERT_EQ(rows.size(), report["rows"].size() + 1) << "a header and one line per row";
+    EXPECT_EQ(rows[0].rfind("scene,ray_kind,system,mode,", 0), 0u) << rows[0];
+    EXPECT_EQ(rows[1].rfind("random:16,primary,", 0), 0u) << rows[1];
+    const auto fields = [](const std::string& line) {
+        return std::count(line.begin(), line.end(), ',') + 1;
+    };
+    for (const std::string& row : rows) EXPECT_EQ(fields(row), fields(rows[0])) << row;
 }
 
 TEST_F(BenchCliTest, BadInputExitsWithItsCode) {
