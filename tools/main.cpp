@@ -24,6 +24,7 @@ std::string exit_code_help() {
            "  0  success\n"
            "  1  unexpected internal error (a bug, or out of memory)\n"
            "  2  usage error: unknown option, bad value, bad combination of options\n"
+           "     (octray compare: 5, as 2 is its FAIL verdict; see its --help)\n"
            "  3  scene error: the scene file or built-in spec cannot be loaded or is invalid\n"
            "  4  I/O error: an output file cannot be written (nothing partial is left),\n"
            "     or standard output cannot be (a closed pipe: EPIPE, not death by SIGPIPE)\n";

@@ -216,6 +216,8 @@ TEST_F(CliTest, HelpCommandAndShortVersionFlag) {
     EXPECT_EQ(top.status, 0) << top.output;
     EXPECT_EQ(top.output, octray({"--help"}).output);
     EXPECT_TRUE(contains(top.output, "octray help <command>")) << top.output;
+    EXPECT_TRUE(contains(top.output, "(octray compare: 5, as 2 is its FAIL verdict"))
+        << top.output;
 
     RunResult r = octray({"help", "rendr"});
     EXPECT_EQ(r.status, 2) << r.output;
