@@ -186,6 +186,10 @@ int main(int argc, char** argv) {
                 message = unknown_command_message(app, word);
                 break;
             }
+            // `octray` alone: CLI11's "A subcommand is required" names none of them.
+            if (message.empty() && app.remaining().empty() &&
+                dynamic_cast<const CLI::RequiredError*>(&e) != nullptr)
+                message = "no command given; the commands are " + joined(command_names(app));
         }
         if (message.empty()) message = e.what();
         // CLI11 writes "--warmup: must be an integer >= 0 ..." for the number checks

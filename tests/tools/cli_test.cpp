@@ -227,6 +227,10 @@ TEST_F(CliTest, HelpCommandAndShortVersionFlag) {
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_TRUE(contains(r.output, "unknown command \"frobnicate\"; the commands are render"))
         << r.output;
+    r = octray({});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "no command given; the commands are render, scene,"))
+        << r.output;
     r = octray({"-v"});
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_TRUE(contains(r.output, "did you mean \"-V\"?")) << r.output;
