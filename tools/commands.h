@@ -65,5 +65,7 @@ void add_bench_command(CLI::App& app, CommandRunner& run);
 void add_verify_command(CLI::App& app, CommandRunner& run);
 void add_info_command(CLI::App& app, CommandRunner& run);
 void add_assemble_command(CLI::App& app, CommandRunner& run);
+// Last: it describes the commands added before it.
+void add_completion_command(CLI::App& app, CommandRunner& run);
 
 }  // namespace octray::tools

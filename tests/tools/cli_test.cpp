@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -235,6 +236,59 @@ TEST_F(CliTest, HelpCommandAndShortVersionFlag) {
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_TRUE(contains(r.output, "did you mean \"-V\"?")) << r.output;
     EXPECT_TRUE(entries().empty());
+}
+
+// Issue 26: bash and zsh completion scripts generated from the parser's own option
+// definitions: every option that a command's --help lists is in both, and bash completes.
+TEST_F(CliTest, CompletionScriptsCoverEveryCommandAndOption) {
+    const RunResult bash = octray({"completion", "bash"});
+    const RunResult zsh = octray({"completion", "zsh"});
+    ASSERT_EQ(bash.status, 0) << bash.output;
+    ASSERT_EQ(zsh.status, 0) << zsh.output;
+    for (const std::string command :
+         {"render", "scene", "compare", "bench", "verify", "info", "assemble", "completion"}) {
+        EXPECT_TRUE(contains(bash.output, "        " + command + ") words=\"")) << command;
+        EXPECT_TRUE(contains(zsh.output, "        '" + command + ":")) << command;
+        // The options as --help lists them: lines that start with blanks and a dash.
+        std::istringstream help(octray({command, "--help"}).output);
+        std::size_t options = 0;
+        for (std::string line; std::getline(help, line);) {
+            const std::size_t dash = line.find_first_not_of(' ');
+            if (dash < 2 || dash == std::string::npos || line[dash] != '-') continue;
+            std::istringstream words(line.substr(dash));
+            std::string names;  // "-o,--output"
+            words >> names;
+            std::istringstream split(names);
+            for (std::string word; std::getline(split, word, ',');) {
+                if (word.empty() || word[0] != '-') continue;
+                ++options;
+                EXPECT_TRUE(contains(bash.output, " " + word + " ") ||
+                            contains(bash.output, " " + word + "\"") ||
+                            contains(bash.output, "\"" + word + " "))
+                    << command << " " << word;
+                EXPECT_TRUE(contains(zsh.output, "'" + word + "[")) << command << " " << word;
+            }
+        }
+        EXPECT_GT(options, 0u) << command;
+    }
+    // The bash script parses and completes a command and an option.
+    { std::ofstream(path("octray.bash")) << bash.output; }
+    const std::string script =
+        "bash -n octray.bash && source octray.bash && "
+        "COMP_WORDS=(octray rend) COMP_CWORD=1 && _octray && echo \"[${COMPREPLY[*]}]\" && "
+        "COMP_WORDS=(octray render --thr) COMP_CWORD=2 && _octray && "
+        "echo \"[${COMPREPLY[*]}]\"";
+    const std::string command = "cd " + octray::testing::shell_quote(dir_.string()) +
+                                " && bash -c " + octray::testing::shell_quote(script);
+    FILE* pipe = ::popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string out;
+    char buffer[256];
+    while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) out += buffer;
+    EXPECT_EQ(::pclose(pipe), 0) << out;
+    EXPECT_EQ(out, "[render]\n[--threads]\n");
+    const RunResult fish = octray({"completion", "fish"});
+    EXPECT_EQ(fish.status, 2) << fish.output;
 }
 
 // Issue 26: every usage error names the help of the command it was given to, whether the
