@@ -19,9 +19,11 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "bench/embree_baseline.h"
 #include "bench/embree_frames.h"
@@ -124,7 +126,7 @@ using Tracer = std::function<void(const RaySet&, HitSet&)>;
 // Warm-up runs, then `reps` timed runs; the hits of the last run stay in `hits`.
 std::vector<double> time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits, int warmup,
                               int reps) {
-    for (int i = 0; i < std::max(1, warmup); ++i) trace(rays, hits);
+    for (int i = 0; i < warmup; ++i) trace(rays, hits);
     std::vector<double> seconds;
     for (int i = 0; i < reps; ++i) {
         const auto start = Clock::now();
@@ -345,7 +347,7 @@ struct Variant {
 void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
                  const BenchOptions& o) {
     RenderResult last;
-    for (int i = 0; i < std::max(1, o.warmup); ++i) last = render();
+    for (int i = 0; i < o.warmup; ++i) last = render();
     for (int i = 0; i < o.reps; ++i) {
         last = render();
         row.seconds.push_back(last.seconds);
@@ -370,7 +372,9 @@ struct SimdConfig {
 
 void compute_ratios(std::vector<BenchRow>& rows) {
     const auto key = [](const BenchRow& r) {
-        return r.scene + '\n' + workload_name(r.workload) + '\n' + r.order + '\n' + r.tile;
+        // A --threads sweep compares the two systems at each thread count.
+        return r.scene + '\n' + workload_name(r.workload) + '\n' + r.order + '\n' + r.tile +
+               '\n' + std::to_string(r.threads);
     };
     std::map<std::string, double> best_embree, best_octray;
     for (const BenchRow& r : rows) {
@@ -746,11 +750,85 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
 
 // ---- Output ------------------------------------------------------------------------------
 
+namespace {
+
+// The thread counts of the rows, in the order measured (one for a run, more for a sweep).
+std::vector<int> thread_counts(const BenchReport& report) {
+    std::vector<int> counts;
+    for (const BenchRow& r : report.rows)
+        if (std::find(counts.begin(), counts.end(), r.threads) == counts.end())
+            counts.push_back(r.threads);
+    if (counts.empty()) counts.push_back(report.context.threads);
+    return counts;
+}
+
+// The threads column of a sweep, in front of the others.
+std::string format_threads(const std::string& text) {
+    char cell[32];
+    std::snprintf(cell, sizeof cell, "%7s ", text.c_str());
+    return cell;
+}
+
+// The headline: one line per scene and ray kind (and thread count in a sweep) with the
+// best valid octray row, the best valid Embree row and octray / Embree, before the detail.
+void print_headline(const BenchReport& report, bool sweep, std::ostream& out) {
+    struct Best {
+        std::optional<double> octray, embree;
+    };
+    std::vector<std::string> order;  // keys as first measured
+    std::map<std::string, Best> best;
+    std::map<std::string, std::tuple<std::string, std::string, int>> label;
+    for (const BenchRow& r : report.rows) {
+        const std::string key = r.scene + '\n' + workload_name(r.workload) + '\n' +
+                                std::to_string(sweep ? r.threads : 0);
+        if (!best.count(key)) {
+            order.push_back(key);
+            best[key] = {};
+            label[key] = {r.scene, workload_name(r.workload), r.threads};
+        }
+        if (!r.valid) continue;
+        std::optional<double>& b = r.system == "embree" ? best[key].embree : best[key].octray;
+        b = std::max(b.value_or(0.0), r.timing.mrays_median);
+    }
+    out << "Mrays/s, median of the repetitions; the best valid row of each system (the detail\n"
+           "below has every configuration). octray/Embree > 1: octray is faster.\n";
+    char line[256];
+    std::snprintf(line, sizeof line, "%-14s %-9s %s%12s %12s %14s\n", "scene", "rays",
+                  sweep ? "threads " : "", "octray", "Embree", "octray/Embree");
+    out << line;
+    for (const std::string& key : order) {
+        const Best& b = best[key];
+        const auto& [scene, rays, threads] = label[key];
+        const auto cell = [](const std::optional<double>& v) {
+            return v ? format("%.2f", *v) : std::string("-");
+        };
+        const std::string ratio = b.octray && b.embree && *b.embree > 0.0
+                                      ? format("%.3f", *b.octray / *b.embree)
+                                      : std::string("-");
+        const std::string thread_cell = sweep ? format_threads(std::to_string(threads)) : "";
+        std::snprintf(line, sizeof line, "%-14s %-9s %s%12s %12s %14s\n", scene.c_str(),
+                      rays.c_str(), thread_cell.c_str(), cell(b.octray).c_str(),
+                      cell(b.embree).c_str(), ratio.c_str());
+        out << line;
+    }
+    out << "\n";
+}
+
+std::string join_counts(const std::vector<int>& counts) {
+    std::string out;
+    for (int n : counts) out += (out.empty() ? "" : ",") + std::to_string(n);
+    return out;
+}
+
+}  // namespace
+
 void print_table(const BenchReport& report, std::ostream& out) {
     const BenchContext& c = report.context;
+    const std::vector<int> counts = thread_counts(report);
+    const bool sweep = counts.size() > 1;  // then a threads column
     out << "octray bench " << c.octray_version << "  " << c.date << "\n"
-        << "CPU: " << c.cpu << " (" << c.logical_cpus << " logical), threads " << c.threads
-        << ", octray ISA " << c.isa << ", " << c.compiler << "\n"
+        << "CPU: " << c.cpu << " (" << c.logical_cpus << " logical), threads "
+        << join_counts(counts) << ", octray ISA " << c.isa << ", " << c.compiler << "\n"
         << "Embree: " << c.embree << "\n"
         << "frame " << c.width << "x" << c.height << ", " << c.reps << " timed reps after "
         << c.warmup << " warm-up, load average at start " << format("%.2f", c.load_average)
@@ -773,11 +851,14 @@ void print_table(const BenchReport& report, std::ostream& out) {
         out << "\n";
     }
     out << "\n";
+    print_headline(report, sweep, out);
+    out << "Detail:\n";
     char line[512];
     std::snprintf(line, sizeof line,
                   "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9s %6s %9s %9s %9s %8s %s\n",
                   "scene", "rays", "system", "mode", "isa", "accel", "order", "tile", "count",
                   "hit%", "Mrays/s", "min", "max", "oct/emb", "valid");
+    if (sweep) out << format_threads("threads");
     out << line;
     for (const BenchRow& r : report.rows) {
         const std::string ratio = r.ratio ? format("%.3f", *r.ratio) : "-";
@@ -790,6 +871,7 @@ void print_table(const BenchReport& report, std::ostream& out) {
             r.isa.c_str(), r.accel_label().c_str(), r.order.c_str(), r.tile.c_str(),
             static_cast<unsigned long long>(r.rays), hit.c_str(), r.timing.mrays_median,
             r.timing.mrays_min, r.timing.mrays_max, ratio.c_str(), r.valid ? "yes" : "NO");
+        if (sweep) out << format_threads(std::to_string(r.threads));
         out << line;
         if (r.workload == Workload::whitted)
             out << "               frames/s " << format("%.3f", r.frames_per_second)
@@ -816,6 +898,7 @@ std::string report_json(const BenchReport& report) {
         {"cpu", c.cpu},
         {"logical_cpus", c.logical_cpus},
         {"threads", c.threads},
+        {"thread_counts", thread_counts(report)},
         {"isa", c.isa},
         {"compiler", c.compiler},
         {"octray_version", c.octray_version},

@@ -35,7 +35,7 @@ struct BenchOptions {
                                     Workload::whitted};
     int threads = 0;  // 0: every core TBB sees
     int reps = 5;     // timed repetitions per row
-    int warmup = 1;   // untimed runs before them (at least 1: its hits are validated)
+    int warmup = 1;  // untimed runs before them (0 allowed: the timed runs' hits are validated)
     int width = 1920, height = 1080;
     // Knobs; each list is measured in one run, every value a row of its own. The first
     // value of each list is the default configuration.

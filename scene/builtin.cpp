@@ -19,6 +19,7 @@
 
 #include "core/random.h"
 #include "scene/load.h"
+#include "scene/max_depth.h"
 #include "scene/scene_error.h"
 
 namespace octray {
@@ -30,8 +31,6 @@ namespace {
 constexpr std::uint64_t kMaxGeneratedSpheres = std::uint64_t{1} << 24;
 // sum 9^k for k = 0..7 is 5,380,840 spheres; level 8 would be 48 million, over the limit.
 constexpr int kMaxSphereflakeLevel = 7;
-// Same cap as validate_scene applies to render.max_depth (scene/README.md).
-constexpr int kMaxDepthLimit = 64;
 
 std::string quote_text(std::string_view s) { return "\"" + std::string(s) + "\""; }
 

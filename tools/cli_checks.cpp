@@ -71,14 +71,20 @@ std::optional<std::uint64_t> parse_decimal_integer(std::string_view text) {
 }
 
 CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi) {
-    const std::string range = "an integer from " + std::to_string(lo) + " to " +
-                              std::to_string(hi) + " in decimal digits";
+    // "--warmup must be an integer >= 0": the open end of a range reads as no limit, not as
+    // 2147483647 (main.cpp turns CLI11's "--warmup: must be" into "--warmup must be").
+    const bool open =
+        hi == static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max());
+    const std::string range =
+        open ? "an integer >= " + std::to_string(lo)
+             : "an integer from " + std::to_string(lo) + " to " + std::to_string(hi);
     return CLI::Validator(
         [range, lo, hi](std::string& text) -> std::string {
             const auto value = parse_decimal_integer(text);
             if (!value || *value < lo || *value > hi)
-                return "expected " + range +
-                       " (no sign, blank, 0x prefix, fraction or exponent), found " +
+                return "must be " + range +
+                       " in decimal digits (no sign, blank, 0x prefix, fraction or exponent), "
+                       "found " +
                        quote_value(text);
             text = std::to_string(*value);  // what CLI11 converts: canonical decimal
             return {};
@@ -187,7 +193,11 @@ std::string mistyped_argument_hint(const CLI::App& app) {
         if (!option && !top) continue;  // a stray value, not a name
         const std::string_view word =
             std::string_view(argument).substr(0, option ? argument.find('=') : argument.npos);
-        const auto best = closest_word(word, candidates);
+        // A wrong case first ("-v" is "-V", not "-h"), then the closest spelling.
+        std::optional<std::string_view> best;
+        for (std::string_view candidate : candidates)
+            if (lowercase(candidate) == lowercase(word) && candidate != word) best = candidate;
+        if (!best) best = closest_word(word, candidates);
         if (!best) continue;
         return std::string("unknown ") + (option ? "option " : "command ") + quote_value(word) +
                " (did you mean " + quote_value(*best) + "?)";

@@ -2,7 +2,10 @@
 // Thin: parse, call bench/bench_runner.h, report.
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -12,6 +15,7 @@
 #include "bench/bench_runner.h"
 #include "bench/embree_baseline.h"
 #include "kernels/dispatch.h"
+#include "render/image_io.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 
@@ -27,10 +31,12 @@ struct BenchArguments {
     std::vector<std::string> paths;
     std::vector<std::string> accels;
     std::vector<std::uint32_t> packet_lanes;
-    int threads = 0, reps = 5, warmup = 1, width = 1920, height = 1080;
+    std::vector<int> threads;  // a scaling sweep; empty: every core
+    int reps = 5, warmup = 1, width = 1920, height = 1080;
     std::uint32_t validate_rays = 1u << 16;
     bool no_embree = false;
     std::string json;
+    std::string csv;
 };
 
 std::string join(const std::vector<std::string>& items) {
@@ -44,7 +50,11 @@ std::string command_line(const BenchArguments& a) {
     std::string c = "octray bench";
     for (const std::string& s : a.scenes) c += " " + s;
     if (!a.rays.empty()) c += " --rays " + join(a.rays);
-    if (a.threads > 0) c += " --threads " + std::to_string(a.threads);
+    if (!a.threads.empty()) {
+        std::vector<std::string> counts;
+        for (int n : a.threads) counts.push_back(std::to_string(n));
+        c += " --threads " + join(counts);
+    }
     c += " --reps " + std::to_string(a.reps);
     if (a.warmup != 1) c += " --warmup " + std::to_string(a.warmup);
     c += " --width " + std::to_string(a.width) + " --height " + std::to_string(a.height);
@@ -62,7 +72,62 @@ std::string command_line(const BenchArguments& a) {
         c += " --validate-rays " + std::to_string(a.validate_rays);
     if (a.no_embree) c += " --no-embree";
     if (!a.json.empty()) c += " --json " + a.json;
+    if (!a.csv.empty()) c += " --csv " + a.csv;
     return c;
+}
+
+// A CSV field: quoted when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+    std::string out = "\"";
+    for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+}
+
+std::string csv_number(double value) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.17g", value);
+    return text;
+}
+
+// The rows as CSV (RFC 4180), one line per row, for spreadsheets and plotting: the JSON
+// rows' keys that are single values, ratio empty where there is none.
+void write_csv_file(const bench::BenchReport& report, const std::string& path) {
+    std::string text =
+        "scene,ray_kind,system,mode,isa,accel,packet_min_lanes,order,tile,threads,rays,"
+        "mrays_median,mrays_min,mrays_max,seconds_median,frames_per_second,hit_fraction,"
+        "ratio_octray_over_embree,valid\n";
+    for (const bench::BenchRow& r : report.rows) {
+        const std::vector<std::string> fields = {
+            r.scene,
+            bench::workload_name(r.workload),
+            r.system,
+            r.mode,
+            r.isa,
+            r.accel,
+            std::to_string(r.packet_min_lanes),
+            r.order,
+            r.tile,
+            std::to_string(r.threads),
+            std::to_string(r.rays),
+            csv_number(r.timing.mrays_median),
+            csv_number(r.timing.mrays_min),
+            csv_number(r.timing.mrays_max),
+            csv_number(r.timing.seconds_median),
+            r.workload == bench::Workload::whitted ? csv_number(r.frames_per_second) : "",
+            std::isnan(r.hit_fraction) ? "" : csv_number(r.hit_fraction),
+            r.ratio ? csv_number(*r.ratio) : "",
+            r.valid ? "true" : "false"};
+        std::string line;
+        for (const std::string& f : fields) line += (line.empty() ? "" : ",") + csv_field(f);
+        text += line + "\n";
+    }
+    write_file_atomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        out.close();
+        if (!out) throw IoError("cannot write " + tmp);
+    });
 }
 
 // Each list option into its values; an unknown value is a usage error naming it.
@@ -95,7 +160,6 @@ void run_bench_command(const BenchArguments& a) {
         if (!isa_supported(isa))
             throw UsageError(std::string("--isa ") + isa_name(isa) +
                              ": this CPU does not support it");
-    o.threads = a.threads;
     o.reps = a.reps;
     o.warmup = a.warmup;
     o.width = a.width;
@@ -108,12 +172,29 @@ void run_bench_command(const BenchArguments& a) {
         std::cerr
             << "octray bench: Embree 3 was not found when octray was built; measuring octray "
                "alone\n";
-    const bench::BenchReport report = bench::run_bench(o, &std::cerr);
+    // A --threads list is a scaling sweep: the whole run once per count, one row per
+    // configuration and count, octray against Embree at the same count.
+    bench::BenchReport report;
+    const std::vector<int> counts = a.threads.empty() ? std::vector<int>{0} : a.threads;
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        o.threads = counts[k];
+        bench::BenchReport part = bench::run_bench(o, &std::cerr);
+        if (k == 0) {
+            report = std::move(part);
+        } else {
+            report.rows.insert(report.rows.end(), part.rows.begin(), part.rows.end());
+        }
+    }
+    bench::compute_ratios(report.rows);
     std::cout << '\n';
     bench::print_table(report, std::cout);
     if (!a.json.empty()) {
         bench::write_json_file(report, a.json);
         std::cerr << "wrote " << a.json << '\n';
+    }
+    if (!a.csv.empty()) {
+        write_csv_file(report, a.csv);
+        std::cerr << "wrote " << a.csv << '\n';
     }
 }
 
@@ -136,17 +217,26 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                     "[default: all]")
         ->delimiter(',')
         ->type_name("LIST");
-    cmd->add_option("--threads", a->threads, "Threads for both systems [default: all cores]")
+    cmd->add_option("--threads", a->threads,
+                    "Threads for both systems; a list (1,2,4) is a scaling sweep, rows for "
+                    "each count; 0 = all cores [default: all cores]")
+        ->delimiter(',')
+        ->type_name("LIST")
         ->transform(decimal_integer(0, kMaxInt));
     cmd->add_option("--reps", a->reps, "Timed repetitions per row [default: 5]")
         ->transform(decimal_integer(1, kMaxInt));
-    cmd->add_option("--warmup", a->warmup, "Untimed runs before them [default: 1]")
-        ->transform(decimal_integer(1, kMaxInt));
+    cmd->add_option("--warmup", a->warmup,
+                    "Untimed runs before them, 0 for none (the hits of the last timed run "
+                    "are validated) [default: 1]")
+        ->transform(decimal_integer(0, kMaxInt));
     cmd->add_option("--width", a->width, "Frame width [default: 1920]")
         ->transform(decimal_integer(1, kMaxInt));
     cmd->add_option("--height", a->height, "Frame height [default: 1080]")
         ->transform(decimal_integer(1, kMaxInt));
     cmd->add_option("--json", a->json, "Also write the report as JSON")->type_name("FILE");
+    cmd->add_option("--csv", a->csv,
+                    "Also write the rows as CSV (one line per row, the JSON rows' keys)")
+        ->type_name("FILE");
     cmd->add_option(
            "--tile", a->tiles,
            "Tile sizes WxH (tiled order, whole renders); a list is measured in one run "
@@ -191,6 +281,8 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray bench                                   # the default table\n"
         "  octray bench random:1024 --rays primary,shadow --threads 2 --json out.json\n"
+        "  octray bench whitted --rays primary --csv rows.csv     # for a spreadsheet\n"
+        "  octray bench random:1024 --rays primary --threads 1,2,4,8 # a scaling sweep\n"
         "  octray bench whitted --order rowmajor,tiled,morton --rays primary\n"
         "  octray bench random:65536 random:1048576 sphereflake:5 --rays primary,shadow "
         "--threads 2\n"

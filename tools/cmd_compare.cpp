@@ -22,7 +22,8 @@
 namespace octray::tools {
 namespace {
 
-// compare's own exit codes, idiff's: 0 pass, 1 warn, 2 fail (Verdict), 3 and 4 below.
+// compare's own exit codes, idiff's: 0 pass, 1 warn, 2 fail (Verdict), 3 and 4 below;
+// 5 a usage error (kExitCompareUsage, mapped in main.cpp).
 constexpr int kCompareMismatch = 3;
 
 struct CompareArguments {
@@ -97,10 +98,11 @@ std::string compare_exit_code_help() {
     return "Exit codes (compare's own, as idiff's):\n"
            "  0  PASS\n"
            "  1  WARN: over the warn limits, within the fail limits\n"
-           "  2  FAIL: over the fail limits (also a bad command line, reported on stderr)\n"
+           "  2  FAIL: over the fail limits\n"
            "  3  the images cannot be compared: size, data window or channel mismatch\n"
            "  4  file error: an input is missing, unreadable, not an image, truncated or\n"
            "     corrupt, or --diff / --heatmap / standard output cannot be written\n"
+           "  5  usage error: a bad command line (reported on stderr), never a verdict\n"
            "The last line of the report (or \"reason\" in --json) says why.\n";
 }
 

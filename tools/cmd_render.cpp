@@ -32,6 +32,7 @@
 #include "scene/builtin.h"
 #include "scene/limits.h"
 #include "scene/load.h"
+#include "scene/max_depth.h"
 #include "scene/scene.h"
 #include "scene/scene_error.h"
 #include "tools/batch.h"
@@ -164,12 +165,32 @@ std::string default_pattern(bool sequence) {
     return sequence ? "{scene}.####.exr" : "{scene}.exr";
 }
 
-// Fails before the render when an output directory clearly cannot be written, rather than
-// after hours of rendering. (The writes themselves still report anything this misses.)
-void check_output_directory(const fs::path& file) {
+// Creates the missing directories above an output (as Blender does), top down, adding each
+// one created to `created`; fails before the render when one cannot be created or the
+// directory clearly cannot be written, rather than after hours of rendering. (The writes
+// themselves still report anything this misses.)
+void prepare_output_directory(const fs::path& file, std::vector<std::string>& created) {
     fs::path dir = file.parent_path();
     if (dir.empty()) dir = ".";
     struct stat info {};
+    if (::stat(dir.c_str(), &info) != 0 && errno == ENOENT) {
+        std::vector<fs::path> missing;  // deepest first
+        for (fs::path up = dir; !up.empty(); up = up.parent_path()) {
+            if (::stat(up.c_str(), &info) == 0 || errno != ENOENT) break;
+            missing.push_back(up);
+            if (up == up.parent_path()) break;
+        }
+        for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+            if (::mkdir(it->c_str(), 0777) == 0) {
+                created.push_back(it->string());
+            } else if (errno != EEXIST) {  // EEXIST: a concurrent shard made it first
+                const int error = errno;
+                if (error == ENOTDIR) break;  // a file in the way: named below
+                throw IoError("cannot write " + file.string() + ": cannot create directory " +
+                              it->string() + ": " + std::strerror(error));
+            }
+        }
+    }
     if (::stat(dir.c_str(), &info) != 0) {
         const int error = errno;
         // A file in the way is the reason, not a missing directory: name it.
@@ -183,9 +204,6 @@ void check_output_directory(const fs::path& file) {
                 }
             }
         }
-        if (error == ENOENT)
-            throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
-                          " does not exist");
         throw IoError("cannot write " + file.string() + ": " + dir.string() + ": " +
                       std::strerror(error));
     }
@@ -425,14 +443,18 @@ void run_render(const RenderArguments& args) {
     const std::size_t planned = jobs.size();
     jobs = select_jobs(jobs, shard);
     std::set<std::string> directories;
+    std::vector<std::string> created;
     for (const BatchJob& job : jobs) {
         for (const std::string* file : {&job.output, &job.png}) {
             if (file->empty()) continue;
             const fs::path path(*file);
             if (directories.insert(path.parent_path().string()).second)
-                check_output_directory(path);
+                prepare_output_directory(path, created);
         }
     }
+    // On stderr, so that standard output stays the progress format (--progress json).
+    for (const std::string& dir : created)
+        std::fprintf(stderr, "octray: created output directory %s/\n", dir.c_str());
     if (shard.count > 1 && settings.progress != ProgressMode::json)
         std::printf("shard    %d/%d: %zu of %zu frames\n", shard.index, shard.count,
                     jobs.size(), planned);
@@ -534,10 +556,10 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
             ->transform(decimal_integer(1, 1 << 20));
     args->max_depth_option =
         cmd->add_option("--max-depth", args->max_depth,
-                        "Reflection/refraction bounces, 0..1000; 0 = primary rays only\n"
-                        "(overrides the scene)")
+                        "Reflection/refraction bounces, 0.." + std::to_string(kMaxDepthLimit) +
+                            "; 0 = primary rays only\n(overrides the scene)")
             ->type_name("D")
-            ->transform(decimal_integer(0, 1000));
+            ->transform(decimal_integer(0, kMaxDepthLimit));
     args->seed_option =
         cmd->add_option("--seed", args->seed,
                         "Seed of the sample jitter, 0..2^64-1 (overrides the scene)")

@@ -1,20 +1,25 @@
 // `octray verify SCENE`: renders the scene with the scalar reference and with the SIMD
 // packet path and compares them with the compare library (render/image_compare.h):
 // max abs error, RMSE, PSNR, the share of pixels over the fail threshold and the worst
-// pixel with both values. Exit 0 within the thresholds, 1 otherwise.
+// pixel with both values. The two paths promise identical bits, so the default is exact
+// (every threshold 0); a tolerance can be given. --frames verifies frames of an animated
+// scene. Exit 0 within the thresholds, 1 otherwise.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "kernels/dispatch.h"
 #include "render/image_compare.h"
 #include "render/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
+#include "scene/animation.h"
 #include "scene/load.h"
+#include "tools/batch.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 
@@ -26,9 +31,10 @@ struct VerifyArguments {
     int width = 0, height = 0, spp = 0;
     int threads = 0;
     std::string isa = "auto";
-    double fail = 1e-4;         // a pixel fails when a channel is off by more
-    double fail_percent = 0.1;  // ... and at most this % of the pixels may
-    double hard_fail = 1e-3;    // no value may be off by more
+    std::string frames;         // --frames; empty: frame 0
+    double fail = 0.0;          // a pixel fails when a channel is off by more
+    double fail_percent = 0.0;  // ... and at most this % of the pixels may
+    double hard_fail = 0.0;     // no value may be off by more
 };
 
 ChannelImage to_channels(const Image& image) {
@@ -42,25 +48,10 @@ ChannelImage to_channels(const Image& image) {
     return out;
 }
 
-void run_verify(const VerifyArguments& args) {
-    Isa isa = Isa::automatic;
-    try {
-        isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
-    } catch (const std::runtime_error& e) {
-        throw UsageError(std::string("--isa: ") + e.what());
-    }
-    Scene scene = load_scene(args.scene);
-    if (args.width > 0) scene.image.width = args.width;
-    if (args.height > 0) scene.image.height = args.height;
-    if (args.spp > 0) scene.image.spp = args.spp;
-    validate_scene(scene);
-
+// Renders one frame with both paths and reports; true when they agree.
+bool verify_frame(const VerifyArguments& args, const Scene& scene, Isa isa) {
     RenderOptions options;
     options.threads = args.threads;
-    std::printf("scene    %s (%zu objects, %zu lights), %dx%d, %d spp\n", args.scene.c_str(),
-                scene.objects.size(), scene.lights.size(), scene.image.width,
-                scene.image.height, scene.image.spp);
-    std::fflush(stdout);
     const RenderResult ref = render_reference(scene, options);
     const RenderResult simd = render_packet(scene, options, isa);
     std::printf("scalar   %.3f s, %llu rays\n", ref.seconds,
@@ -96,7 +87,54 @@ void run_verify(const VerifyArguments& args) {
     const bool pass = r.verdict == Verdict::pass && same_rays;
     std::printf("%s\n", pass ? "PASS" : ("FAIL: " + r.reason).c_str());
     std::fflush(stdout);
-    if (!pass) throw CommandExit{1};
+    return pass;
+}
+
+void run_verify(const VerifyArguments& args) {
+    Isa isa = Isa::automatic;
+    try {
+        isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
+    } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--isa: ") + e.what());
+    }
+    std::vector<int> frames{0};
+    if (!args.frames.empty()) {
+        try {
+            frames = batch::parse_frame_spec(args.frames);
+        } catch (const batch::SpecError& e) {
+            throw UsageError(std::string("--frames: ") + e.what());
+        }
+    }
+    Scene scene = load_scene(args.scene);
+    if (args.width > 0) scene.image.width = args.width;
+    if (args.height > 0) scene.image.height = args.height;
+    if (args.spp > 0) scene.image.spp = args.spp;
+    validate_scene(scene);
+
+    std::printf("scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp\n", args.scene.c_str(),
+                scene.objects.size(), scene.lights.size(), scene.animation ? ", animated" : "",
+                scene.image.width, scene.image.height, scene.image.spp);
+    std::printf("check    %s\n",
+                args.fail == 0.0 && args.fail_percent == 0.0 && args.hard_fail == 0.0
+                    ? "exact: every value equal (the default)"
+                    : "within the tolerance given (--fail, --failpercent, --hardfail)");
+    std::fflush(stdout);
+    std::size_t failed = 0;
+    for (const int frame : frames) {
+        if (!args.frames.empty()) std::printf("frame    %d\n", frame);
+        failed +=
+            verify_frame(args, args.frames.empty() ? scene : scene_at_frame(scene, frame), isa)
+                ? 0
+                : 1;
+    }
+    if (frames.size() > 1) {
+        if (failed == 0)
+            std::printf("PASS: all %zu frames\n", frames.size());
+        else
+            std::printf("FAIL: %zu of %zu frames\n", failed, frames.size());
+        std::fflush(stdout);
+    }
+    if (failed > 0) throw CommandExit{1};
 }
 
 CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
@@ -123,12 +161,16 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         ->type_name("N")
         ->transform(decimal_integer(0, 4096))
         ->capture_default_str();
+    cmd->add_option("--frames", args->frames,
+                    "Frames of an animated scene to verify, as render takes them: 5, 1-100,\n"
+                    "1-100:2,150 [default: frame 0]")
+        ->type_name("SPEC");
     cmd->add_option("--isa", args->isa, "ISA of the simd path: auto, avx2, sse4.1, sse2")
         ->type_name("ISA")
         ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
     cmd->add_option("--fail", args->fail,
-                    "A pixel fails when any channel differs by more than X")
+                    "A pixel fails when any channel differs by more than X; 0 = exact")
         ->type_name("X")
         ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();
@@ -145,8 +187,12 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray verify whitted\n"
         "  octray verify random:64,width=320,height=180 --isa sse2\n"
-        "  octray verify scene.json --spp 4 --fail 1e-5 --failpercent 0\n\n"
-        "Exit codes: 0 within the thresholds (and equal ray counts), 1 otherwise;\n"
+        "  octray verify scene/examples/bounce.json --frames 0-47:8\n"
+        "  octray verify scene.json --spp 4 --fail 1e-5 --failpercent 0.1  # a tolerance\n\n"
+        "The two paths promise identical bits: by default every value must be equal\n"
+        "(--fail 0 --failpercent 0 --hardfail 0).\n\n"
+        "Exit codes: 0 within the thresholds (and equal ray counts) for every frame,\n"
+        "1 otherwise;\n"
         "2 usage error, 3 scene error, as every command.\n");
     cmd->callback([args, &run] { run.action = [args] { run_verify(*args); }; });
 }

@@ -25,6 +25,10 @@ enum ExitCode : int {
     kExitIo = 4,        // a file cannot be written (octray::IoError)
 };
 
+// `octray compare` keeps idiff's 0..4 (2 is its FAIL verdict), so its usage errors need a
+// status of their own: a CI script can then tell a typo from a regression.
+constexpr int kExitCompareUsage = 5;
+
 // The exit-code table as help text, for the --help footers.
 std::string exit_code_help();
 
@@ -45,8 +49,14 @@ struct CommandRunner {
     std::function<void()> action;  // set by the subcommand the user chose
 };
 
-// Runs `action`, reports any exception on stderr and returns the exit code for it.
-int run_command(const std::function<void()>& action);
+// The hint after a usage error: "Run 'octray render --help' for more information." for
+// `command` ("" for octray itself).
+std::string help_hint(const std::string& command);
+
+// Runs `action` of `command`, reports any exception on stderr and returns the exit code for
+// it; a usage error names the command's own help and exits with `usage_status`.
+int run_command(const std::function<void()>& action, const std::string& command,
+                int usage_status);
 
 void add_render_command(CLI::App& app, CommandRunner& run);
 void add_scene_command(CLI::App& app, CommandRunner& run);
@@ -55,5 +65,7 @@ void add_bench_command(CLI::App& app, CommandRunner& run);
 void add_verify_command(CLI::App& app, CommandRunner& run);
 void add_info_command(CLI::App& app, CommandRunner& run);
 void add_assemble_command(CLI::App& app, CommandRunner& run);
+// Last: it describes the commands added before it.
+void add_completion_command(CLI::App& app, CommandRunner& run);
 
 }  // namespace octray::tools

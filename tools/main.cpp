@@ -1,15 +1,19 @@
 // octray: the command line. Thin by design: parse, call the library, report.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <csignal>
 #include <exception>
 #include <iostream>
 #include <new>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/version.h"
 #include "render/image_io.h"
 #include "scene/scene_error.h"
+#include "scene/suggest.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 
@@ -20,21 +24,27 @@ std::string exit_code_help() {
            "  0  success\n"
            "  1  unexpected internal error (a bug, or out of memory)\n"
            "  2  usage error: unknown option, bad value, bad combination of options\n"
+           "     (octray compare: 5, as 2 is its FAIL verdict; see its --help)\n"
            "  3  scene error: the scene file or built-in spec cannot be loaded or is invalid\n"
            "  4  I/O error: an output file cannot be written (nothing partial is left),\n"
            "     or standard output cannot be (a closed pipe: EPIPE, not death by SIGPIPE)\n";
 }
 
-int run_command(const std::function<void()>& action) {
+std::string help_hint(const std::string& command) {
+    return "Run 'octray " + (command.empty() ? std::string() : command + " ") +
+           "--help' for more information.";
+}
+
+int run_command(const std::function<void()>& action, const std::string& command,
+                int usage_status) {
     try {
         action();
         return kExitSuccess;
     } catch (const CommandExit& e) {
         return e.status;
     } catch (const UsageError& e) {
-        std::cerr << "octray: error: " << e.what()
-                  << "\nRun with --help for more information.\n";
-        return kExitUsage;
+        std::cerr << "octray: error: " << e.what() << '\n' << help_hint(command) << '\n';
+        return usage_status;
     } catch (const SceneError& e) {
         std::cerr << "octray: scene error: " << e.what() << '\n';
         return kExitScene;
@@ -53,6 +63,68 @@ int run_command(const std::function<void()>& action) {
     }
 }
 
+namespace {
+
+// The command a command line was given to: the deepest one that parsed ("" for none).
+std::string parsed_command(const CLI::App& app) {
+    std::string name;
+    const CLI::App* command = &app;
+    for (;;) {
+        const auto parsed = command->get_subcommands();
+        if (parsed.empty()) return name;
+        command = parsed.front();
+        name += (name.empty() ? "" : " ") + command->get_name();
+    }
+}
+
+// The exit status of a usage error of `command`: compare has its own (kExitCompareUsage).
+int usage_status(const std::string& command) {
+    return command == "compare" ? kExitCompareUsage : kExitUsage;
+}
+
+std::vector<std::string> command_names(const CLI::App& app) {
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+        names.push_back(sub->get_name());
+    return names;
+}
+
+std::string joined(const std::vector<std::string>& words) {
+    std::string out;
+    for (const std::string& word : words) out += (out.empty() ? "" : ", ") + word;
+    return out;
+}
+
+// "unknown command "frobnicate" (did you mean ...?)" or with the list of commands.
+std::string unknown_command_message(const CLI::App& app, const std::string& word) {
+    const std::vector<std::string> names = command_names(app);
+    const std::vector<std::string_view> candidates(names.begin(), names.end());
+    if (const auto best = closest_word(word, candidates))
+        return "unknown command \"" + word + "\" (did you mean \"" + std::string(*best) +
+               "\"?)";
+    return "unknown command \"" + word + "\"; the commands are " + joined(names);
+}
+
+// `octray help [COMMAND]` is `octray [COMMAND] --help`, as git and cargo have it. Rewrites
+// the arguments, or returns the usage error's message.
+std::string rewrite_help_command(const CLI::App& app, std::vector<std::string>& args) {
+    if (args.size() < 2 || args[1] != "help") return {};
+    if (args.size() > 3)
+        return "help takes one command name, found " + std::to_string(args.size() - 2) +
+               " arguments (octray help COMMAND)";
+    if (args.size() == 2 || args[2] == "help") {
+        args = {args[0], "--help"};
+        return {};
+    }
+    const std::vector<std::string> names = command_names(app);
+    if (std::find(names.begin(), names.end(), args[2]) == names.end())
+        return unknown_command_message(app, args[2]);
+    args = {args[0], args[2], "--help"};
+    return {};
+}
+
+}  // namespace
+
 }  // namespace octray::tools
 
 int main(int argc, char** argv) {
@@ -67,14 +139,9 @@ int main(int argc, char** argv) {
 
     CLI::App app{"octray renders Whitted-style ray-traced images (OpenEXR, with PNG previews).",
                  "octray"};
-    app.set_version_flag("--version", std::string("octray ") + octray::kVersion,
+    app.set_version_flag("-V,--version", std::string("octray ") + octray::kVersion,
                          "Print the version and exit");
     app.require_subcommand(1);
-    // Set before the subcommands are added: they copy it when created.
-    app.failure_message([](const CLI::App*, const CLI::Error& e) {
-        return std::string("octray: error: ") + e.what() +
-               "\nRun with --help for more information.\n";
-    });
     app.footer(
         "Examples:\n"
         "  octray render                                  # the built-in whitted scene -> "
@@ -82,7 +149,8 @@ int main(int argc, char** argv) {
         "  octray render whitted -o whitted.exr --png whitted.png\n"
         "  octray render random:1024,width=640,height=360 --spp 4 -o random.exr\n"
         "  octray scene random:16 -o random16.json        # a built-in written as JSON\n"
-        "Run 'octray <command> --help' for the options of a command.\n\n" +
+        "Run 'octray help <command>' (or 'octray <command> --help') for the options of a\n"
+        "command.\n\n" +
         exit_code_help());
 
     CommandRunner run;
@@ -93,28 +161,50 @@ int main(int argc, char** argv) {
     add_verify_command(app, run);
     add_info_command(app, run);
     add_assemble_command(app, run);
+    add_completion_command(app, run);
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        // A mistyped option or command: name the one probably meant, as git and cargo do
-        // (the scene loader's "did you mean", scene/suggest.h).
-        if (e.get_exit_code() != 0) {
-            const std::string hint = mistyped_argument_hint(app);
-            if (!hint.empty()) {
-                std::cerr << "octray: error: " << hint
-                          << "\nRun with --help for more information.\n";
-                return kExitUsage;
-            }
-        }
-        // app.exit prints --help / --version output (status 0) or the parse error with a
-        // "Run with --help" hint; CLI11's own error numbers all mean "usage error" here.
-        const int status = app.exit(e);
-        return finish_standard_output(status == 0 ? kExitSuccess : kExitUsage);
-    }
-    if (!run.action) {
-        std::cerr << "octray: error: no command given\nRun with --help for more information.\n";
+    std::vector<std::string> args(argv, argv + argc);
+    if (const std::string error = rewrite_help_command(app, args); !error.empty()) {
+        std::cerr << "octray: error: " << error << '\n' << help_hint("") << '\n';
         return kExitUsage;
     }
-    return finish_standard_output(run_command(run.action));
+    std::vector<char*> arguments;
+    for (std::string& arg : args) arguments.push_back(arg.data());
+
+    try {
+        app.parse(static_cast<int>(arguments.size()), arguments.data());
+    } catch (const CLI::ParseError& e) {
+        // --help and --version: their output, status 0.
+        if (e.get_exit_code() == 0) return finish_standard_output(app.exit(e));
+        // Every usage error names the help of the command it was given to.
+        const std::string command = parsed_command(app);
+        // A mistyped option or command: name the one probably meant, as git and cargo do
+        // (the scene loader's "did you mean", scene/suggest.h).
+        std::string message = mistyped_argument_hint(app);
+        if (message.empty() && command.empty()) {
+            for (const std::string& word : app.remaining()) {
+                if (word.empty() || word.front() == '-') continue;
+                message = unknown_command_message(app, word);
+                break;
+            }
+            // `octray` alone: CLI11's "A subcommand is required" names none of them.
+            if (message.empty() && app.remaining().empty() &&
+                dynamic_cast<const CLI::RequiredError*>(&e) != nullptr)
+                message = "no command given; the commands are " + joined(command_names(app));
+        }
+        if (message.empty()) message = e.what();
+        // CLI11 writes "--warmup: must be an integer >= 0 ..." for the number checks
+        // (tools/cli_checks.h); it reads as a sentence without the colon.
+        if (const auto colon = message.find(": must be ");
+            colon != std::string::npos && message.rfind(' ', colon) == std::string::npos)
+            message.erase(colon, 1);
+        std::cerr << "octray: error: " << message << '\n' << help_hint(command) << '\n';
+        return usage_status(command);
+    }
+    const std::string command = parsed_command(app);
+    if (!run.action) {
+        std::cerr << "octray: error: no command given\n" << help_hint("") << '\n';
+        return kExitUsage;
+    }
+    return finish_standard_output(run_command(run.action, command, usage_status(command)));
 }

@@ -128,7 +128,11 @@ void ProgressReporter::draw_bar_locked(bool final_draw) {
 }
 
 void ProgressReporter::maybe_progress_line_locked(bool force) {
-    const int percent = static_cast<int>(fraction_locked() * 100.0);
+    int percent = static_cast<int>(fraction_locked() * 100.0);
+    // 100% only once every frame is finished (its line printed): the pixel counter of the
+    // last frame reaches its end before the frame is written, and the ticker would then
+    // print "Progress: 100%" before or after the frame line, as the threads raced.
+    if (work_done_ < total_work_) percent = std::min(percent, 99);
     const auto now = Clock::now();
     if (percent == last_percent_line_) return;
     if (!force && last_percent_line_ >= 0 && now - last_percent_time_ < kPercentLineInterval)
@@ -177,10 +181,11 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
     current_index_ = report.index;
     if (report.outcome == FrameOutcome::rendered) {
         rays_done_ += report.rays;
-        render_seconds_ += report.seconds;
+        render_seconds_ += report.trace_seconds;
     }
-    const double mrays =
-        report.seconds > 0.0 ? static_cast<double>(report.rays) / report.seconds / 1e6 : 0.0;
+    const double mrays = report.trace_seconds > 0.0
+                             ? static_cast<double>(report.rays) / report.trace_seconds / 1e6
+                             : 0.0;
     switch (mode_) {
         case ProgressMode::bar:
             if (report.outcome == FrameOutcome::failed) {
@@ -193,10 +198,12 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
             break;
         case ProgressMode::lines:
             if (report.outcome == FrameOutcome::rendered)
-                std::printf("frame %zu/%zu  %s frame %d  -> %s%s%s  %.2f s  %.2f Mrays/s\n",
-                            report.index, frame_count_, report.scene.c_str(), report.frame,
-                            report.output.c_str(), report.preview.empty() ? "" : " + ",
-                            report.preview.c_str(), report.seconds, mrays);
+                std::printf(
+                    "frame %zu/%zu  %s frame %d  -> %s%s%s  trace %.3f s  %.2f Mrays/s  "
+                    "write %.3f s\n",
+                    report.index, frame_count_, report.scene.c_str(), report.frame,
+                    report.output.c_str(), report.preview.empty() ? "" : " + ",
+                    report.preview.c_str(), report.trace_seconds, mrays, report.write_seconds);
             else if (report.outcome == FrameOutcome::failed)
                 std::printf("frame %zu/%zu  %s frame %d  FAILED: %s\n", report.index,
                             frame_count_, report.scene.c_str(), report.frame,
@@ -217,6 +224,8 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
                                     {"output", report.output},
                                     {"outcome", outcome_key(report.outcome)},
                                     {"seconds", report.seconds},
+                                    {"trace_seconds", report.trace_seconds},
+                                    {"write_seconds", report.write_seconds},
                                     {"rays", report.rays},
                                     {"mrays_per_second", mrays}};
             if (!report.preview.empty()) event["preview"] = report.preview;
@@ -249,8 +258,9 @@ void ProgressReporter::finish(const BatchSummary& summary) {
 
     std::lock_guard lock(mutex_);
     if (mode_ == ProgressMode::bar && bar_drawn_) draw_bar_locked(true);
-    const double mrays =
-        summary.seconds > 0.0 ? static_cast<double>(summary.rays) / summary.seconds / 1e6 : 0.0;
+    const double mrays = summary.trace_seconds > 0.0
+                             ? static_cast<double>(summary.rays) / summary.trace_seconds / 1e6
+                             : 0.0;
     if (mode_ == ProgressMode::json) {
         nlohmann::json event = {{"event", "summary"},
                                 {"frames", frame_count_},
@@ -260,6 +270,8 @@ void ProgressReporter::finish(const BatchSummary& summary) {
                                 {"not_started", summary.not_started},
                                 {"interrupted", summary.interrupted},
                                 {"seconds", summary.seconds},
+                                {"trace_seconds", summary.trace_seconds},
+                                {"write_seconds", summary.write_seconds},
                                 {"rays", summary.rays},
                                 {"mrays_per_second", mrays}};
         std::printf("%s\n", event.dump().c_str());
@@ -271,7 +283,17 @@ void ProgressReporter::finish(const BatchSummary& summary) {
                     frame_count_ == 1 ? "" : "s", summary.rendered, summary.skipped,
                     summary.failed);
         if (summary.not_started > 0) std::printf(", %zu not started", summary.not_started);
-        std::printf(" in %s, %.2f Mrays/s\n", format_duration(summary.seconds).c_str(), mrays);
+        // The phases of short runs in milliseconds' precision: "0.0s" says nothing.
+        const auto phase = [](double seconds) {
+            if (seconds >= 10.0) return format_duration(seconds);
+            char text[32];
+            std::snprintf(text, sizeof text, "%.3fs", seconds);
+            return std::string(text);
+        };
+        std::printf(" in %s: trace %s (%.2f Mrays/s), write %s\n",
+                    format_duration(summary.seconds).c_str(),
+                    phase(summary.trace_seconds).c_str(), mrays,
+                    phase(summary.write_seconds).c_str());
     }
     std::fflush(stdout);
 }

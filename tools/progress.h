@@ -35,14 +35,17 @@ struct FrameReport {
     std::string output;
     std::string preview;  // the PNG, if any
     FrameOutcome outcome = FrameOutcome::rendered;
-    double seconds = 0.0;    // render + write
-    std::uint64_t rays = 0;  // rendered frames
-    std::string message;     // failed frames: the reason
+    double seconds = 0.0;        // everything: claims, trace, write
+    double trace_seconds = 0.0;  // rendering (AOVs included), what Mrays/s is over
+    double write_seconds = 0.0;  // EXR and PNG encoding and writing (every progressive pass)
+    std::uint64_t rays = 0;      // rendered frames
+    std::string message;         // failed frames: the reason
 };
 
 struct BatchSummary {
     std::size_t rendered = 0, skipped = 0, failed = 0, not_started = 0;
-    double seconds = 0.0;
+    double seconds = 0.0;                             // wall time of the run
+    double trace_seconds = 0.0, write_seconds = 0.0;  // of the rendered frames
     std::uint64_t rays = 0;
     bool interrupted = false;
 };

@@ -313,7 +313,17 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         options.cancel = &InterruptGuard::flag();
         options.pixels_done = &progress_.pixel_counter();
         options.crop = scene.crop;
+        // Writing (EXR and PNG encoding) is timed apart from tracing: the frame line and
+        // the summary report each, and the rate is rays over trace time alone.
+        const auto trace_started = Clock::now();
         const AovImages aovs = compute_aovs(posed, options, settings_.aovs);
+        double write_seconds = 0.0;
+        const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
+            const auto write_started = Clock::now();
+            write_outputs(scene, job, posed, r, aovs, samples_so_far);
+            write_seconds +=
+                std::chrono::duration<double>(Clock::now() - write_started).count();
+        };
 
         RenderResult result;
         if (settings_.progressive) {
@@ -321,13 +331,15 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
                 [&](const RenderOptions& o) { return render_still(settings_, posed, o); },
                 posed.image.spp, options,
                 [&](const RenderResult& pass, int samples_so_far) {
-                    if (samples_so_far < posed.image.spp)
-                        write_outputs(scene, job, posed, pass, aovs, samples_so_far);
+                    if (samples_so_far < posed.image.spp) timed_write(pass, samples_so_far);
                 });
         } else {
             result = render_still(settings_, posed, options);
         }
-        write_outputs(scene, job, posed, result, aovs, posed.image.spp);
+        out.report.trace_seconds =
+            std::chrono::duration<double>(Clock::now() - trace_started).count() - write_seconds;
+        timed_write(result, posed.image.spp);
+        out.report.write_seconds = write_seconds;
         out.report.rays = result.rays.total();
         out.report.outcome = FrameOutcome::rendered;
     } catch (const RenderCancelled&) {
@@ -438,6 +450,8 @@ int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>
             case FrameOutcome::rendered:
                 ++summary.rendered;
                 summary.rays += result.report.rays;
+                summary.trace_seconds += result.report.trace_seconds;
+                summary.write_seconds += result.report.write_seconds;
                 break;
             case FrameOutcome::skipped_existing:
             case FrameOutcome::skipped_claimed:

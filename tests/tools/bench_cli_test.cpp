@@ -5,11 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "bench/embree_baseline.h"
 #include "run_octray.h"
@@ -98,6 +100,89 @@ TEST_F(BenchCliTest, ScalarAndSimdPathsAreBothRowsOfOneRun) {
     const nlohmann::json report = read_json(dir_ / "r.json");
     for (const auto& row : report["rows"]) modes.insert(row["mode"].get<std::string>());
     EXPECT_GE(modes.size(), 2u) << "one mode per path expected";
+}
+
+// Issue 26: --threads takes a list, a scaling sweep with rows for each count (octray against
+// Embree at the same count), and --warmup 0 is allowed.
+TEST_F(BenchCliTest, ThreadListIsAScalingSweepAndWarmupZeroIsAllowed) {
+    const auto r = run_octray(
+        {"bench", "random:16", "--width", "32", "--height", "24", "--reps", "1", "--warmup",
+         "0", "--rays", "primary", "--threads", "1,2", "--json", "r.json"},
+        dir_);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "threads 1,2,")) << r.output;
+    EXPECT_TRUE(contains(r.output, "--threads 1,2 ")) << r.output;  // the command line
+    const nlohmann::json report = read_json(dir_ / "r.json");
+    EXPECT_EQ(report["context"]["warmup"], 0);
+    EXPECT_EQ(report["context"]["thread_counts"], nlohmann::json::array({1, 2}));
+    std::set<int> threads;
+    for (const auto& row : report["rows"]) {
+        threads.insert(row["threads"].get<int>());
+        EXPECT_TRUE(row["valid"].get<bool>()) << row.dump(2);
+        // A ratio compares the two systems at one thread count.
+        if (!row["ratio_octray_over_embree"].is_null()) {
+            bool partner = false;
+            for (const auto& other : report["rows"])
+                partner |=
+                    other["system"] != row["system"] && other["threads"] == row["threads"];
+            EXPECT_TRUE(partner) << row.dump(2);
+        }
+    }
+    EXPECT_EQ(threads, (std::set<int>{1, 2}));
+}
+
+// Issue 26: range errors say what the option takes, not a 300-digit number or 2^31 - 1.
+TEST_F(BenchCliTest, RangeErrorsReadAsTheOptionsLimits) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"--warmup", "-1"}, "--warmup must be an integer >= 0"},
+        {{"--reps", "0"}, "--reps must be an integer >= 1"},
+        {{"--threads", "1,x"}, "--threads must be an integer >= 0"},
+        {{"--packet-lanes", "10"}, "--packet-lanes must be an integer from 0 to 9"},
+    };
+    for (const auto& [args, message] : cases) {
+        std::vector<std::string> command = {"bench", "--no-embree"};
+        command.insert(command.end(), args.begin(), args.end());
+        const auto r = run_octray(command, dir_);
+        EXPECT_EQ(r.status, 2) << args[0] << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, message)) << args[0] << "\n" << r.output;
+        EXPECT_FALSE(contains(r.output, "2147483647")) << r.output;
+    }
+}
+
+// Issue 26: one headline table (scene x ray kind: octray, Embree, ratio) before the
+// detail, and --csv with one line per row besides --json.
+TEST_F(BenchCliTest, HeadlineTableLeadsAndCsvHasOneLinePerRow) {
+    const auto r = run_octray(
+        {"bench", "random:16", "--width", "32", "--height", "24", "--reps", "1", "--rays",
+         "primary,shadow", "--order", "rowmajor,tiled", "--json", "r.json", "--csv", "r.csv"},
+        dir_, /*capture_stderr=*/false);
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::size_t headline = r.output.find("octray/Embree\n");
+    const std::size_t detail = r.output.find("Detail:\n");
+    ASSERT_NE(headline, std::string::npos) << r.output;
+    ASSERT_NE(detail, std::string::npos) << r.output;
+    EXPECT_LT(headline, detail) << r.output;
+    // One headline line per scene and ray kind, however many orders were measured.
+    const std::string head = r.output.substr(headline, detail - headline);
+    std::size_t lines = 0;
+    for (std::size_t at = head.find("\nrandom:16"); at != std::string::npos;
+         at = head.find("\nrandom:16", at + 1))
+        ++lines;
+    EXPECT_EQ(lines, 2u) << head;
+    EXPECT_TRUE(contains(head, "primary")) << head;
+    EXPECT_TRUE(contains(head, "shadow")) << head;
+
+    const nlohmann::json report = read_json(dir_ / "r.json");
+    std::ifstream csv(dir_ / "r.csv");
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(csv, line);) rows.push_back(line);
+    ASSERT_EQ(rows.size(), report["rows"].size() + 1) << "a header and one line per row";
+    EXPECT_EQ(rows[0].rfind("scene,ray_kind,system,mode,", 0), 0u) << rows[0];
+    EXPECT_EQ(rows[1].rfind("random:16,primary,", 0), 0u) << rows[1];
+    const auto fields = [](const std::string& line) {
+        return std::count(line.begin(), line.end(), ',') + 1;
+    };
+    for (const std::string& row : rows) EXPECT_EQ(fields(row), fields(rows[0])) << row;
 }
 
 TEST_F(BenchCliTest, BadInputExitsWithItsCode) {

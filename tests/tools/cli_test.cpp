@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -198,6 +199,129 @@ TEST_F(CliTest, HelpExplainsCommandsOptionsAndExitCodes) {
         EXPECT_TRUE(contains(render.output, option)) << option << "\n" << render.output;
 }
 
+// Issue 26: `octray help COMMAND` is `octray COMMAND --help`, `-V` is `--version`, and an
+// unknown command is named as such.
+TEST_F(CliTest, HelpCommandAndShortVersionFlag) {
+    const RunResult v = octray({"-V"});
+    EXPECT_EQ(v.status, 0) << v.output;
+    EXPECT_EQ(v.output, "octray 0.1.0\n");
+
+    for (const std::string command :
+         {"render", "scene", "compare", "bench", "verify", "info", "assemble"}) {
+        const RunResult help = octray({"help", command});
+        const RunResult flag = octray({command, "--help"});
+        EXPECT_EQ(help.status, 0) << command << "\n" << help.output;
+        EXPECT_EQ(help.output, flag.output) << command;
+    }
+    const RunResult top = octray({"help"});
+    EXPECT_EQ(top.status, 0) << top.output;
+    EXPECT_EQ(top.output, octray({"--help"}).output);
+    EXPECT_TRUE(contains(top.output, "octray help <command>")) << top.output;
+    EXPECT_TRUE(contains(top.output, "(octray compare: 5, as 2 is its FAIL verdict"))
+        << top.output;
+
+    RunResult r = octray({"help", "rendr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "unknown command \"rendr\" (did you mean \"render\"?)"))
+        << r.output;
+    r = octray({"frobnicate"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "unknown command \"frobnicate\"; the commands are render"))
+        << r.output;
+    r = octray({});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "no command given; the commands are render, scene,"))
+        << r.output;
+    r = octray({"-v"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "did you mean \"-V\"?")) << r.output;
+    EXPECT_TRUE(entries().empty());
+}
+
+// Issue 26: bash and zsh completion scripts generated from the parser's own option
+// definitions: every option that a command's --help lists is in both, and bash completes.
+TEST_F(CliTest, CompletionScriptsCoverEveryCommandAndOption) {
+    const RunResult bash = octray({"completion", "bash"});
+    const RunResult zsh = octray({"completion", "zsh"});
+    ASSERT_EQ(bash.status, 0) << bash.output;
+    ASSERT_EQ(zsh.status, 0) << zsh.output;
+    for (const std::string command :
+         {"render", "scene", "compare", "bench", "verify", "info", "assemble", "completion"}) {
+        EXPECT_TRUE(contains(bash.output, "        " + command + ") words=\"")) << command;
+        EXPECT_TRUE(contains(zsh.output, "        '" + command + ":")) << command;
+        // The options as --help lists them: lines that start with blanks and a dash.
+        std::istringstream help(octray({command, "--help"}).output);
+        std::size_t options = 0;
+        for (std::string line; std::getline(help, line);) {
+            const std::size_t dash = line.find_first_not_of(' ');
+            if (dash < 2 || dash == std::string::npos || line[dash] != '-') continue;
+            std::istringstream words(line.substr(dash));
+            std::string names;  // "-o,--output"
+            words >> names;
+            std::istringstream split(names);
+            for (std::string word; std::getline(split, word, ',');) {
+                if (word.empty() || word[0] != '-') continue;
+                ++options;
+                EXPECT_TRUE(contains(bash.output, " " + word + " ") ||
+                            contains(bash.output, " " + word + "\"") ||
+                            contains(bash.output, "\"" + word + " "))
+                    << command << " " << word;
+                EXPECT_TRUE(contains(zsh.output, "'" + word + "[")) << command << " " << word;
+            }
+        }
+        EXPECT_GT(options, 0u) << command;
+    }
+    // The bash script parses and completes a command and an option.
+    { std::ofstream(path("octray.bash")) << bash.output; }
+    const std::string script =
+        "bash -n octray.bash && source octray.bash && "
+        "COMP_WORDS=(octray rend) COMP_CWORD=1 && _octray && echo \"[${COMPREPLY[*]}]\" && "
+        "COMP_WORDS=(octray render --thr) COMP_CWORD=2 && _octray && "
+        "echo \"[${COMPREPLY[*]}]\"";
+    const std::string command = "cd " + octray::testing::shell_quote(dir_.string()) +
+                                " && bash -c " + octray::testing::shell_quote(script);
+    FILE* pipe = ::popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string out;
+    char buffer[256];
+    while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) out += buffer;
+    EXPECT_EQ(::pclose(pipe), 0) << out;
+    EXPECT_EQ(out, "[render]\n[--threads]\n");
+    const RunResult fish = octray({"completion", "fish"});
+    EXPECT_EQ(fish.status, 2) << fish.output;
+}
+
+// Issue 26: every usage error names the help of the command it was given to, whether the
+// parser or the command found it.
+TEST_F(CliTest, UsageErrorsNameTheCommandsOwnHelp) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"render", "--no-such-option"}, "render"},
+        {{"render", "random:2", "--threads", "-1"}, "render"},
+        {{"render", "random:2", "-o", "same.exr", "--png", "same.exr"}, "render"},
+        {{"render", "random:2", "-o", "x.tif"}, "render"},
+        {{"scene"}, "scene"},
+        {{"verify", "--wdth", "8"}, "verify"},
+        {{"bench", "--reps", "0x2", "--no-embree"}, "bench"},
+        {{"info", "--nope"}, "info"},
+        {{"assemble"}, "assemble"},
+    };
+    for (const auto& [args, command] : cases) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << args[0] << " " << args[1] << "\n" << r.output;
+        EXPECT_TRUE(
+            contains(r.output, "\nRun 'octray " + command + " --help' for more information.\n"))
+            << r.output;
+    }
+    for (const std::vector<std::string>& args :
+         std::vector<std::vector<std::string>>{{}, {"frobnicate"}, {"--nope"}}) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 2) << r.output;
+        EXPECT_TRUE(contains(r.output, "\nRun 'octray --help' for more information.\n"))
+            << r.output;
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
 TEST_F(CliTest, RendersSmallBuiltinWithAttributesAndPreview) {
     const std::string spec = "random:8,width=32,height=24";
     const RunResult r =
@@ -354,22 +478,46 @@ TEST_F(CliTest, DeviceAsSceneFileIsRefusedBeforeReading) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 26 changed this: a missing output directory is created (MissingOutputDirectoriesAre
+// Created); one that cannot be created is still an I/O error found before rendering.
 TEST_F(CliTest, MissingOutputDirectoryIsAnIoErrorAndLeavesNothing) {
+    { std::ofstream(path("file")) << "not a directory"; }
     const RunResult r =
-        octray({"render", "random:2,width=8,height=8", "-o", "nope/sub/out.exr"});
+        octray({"render", "random:2,width=8,height=8", "-o", "file/sub/out.exr"});
     EXPECT_EQ(r.status, 4) << r.output;
-    EXPECT_TRUE(contains(r.output, "nope/sub/out.exr")) << r.output;
+    EXPECT_TRUE(contains(r.output, "file/sub/out.exr")) << r.output;
+    EXPECT_TRUE(contains(r.output, "file is a file, not a directory")) << r.output;
 
     // An unwritable preview is found before rendering, so the EXR is not written either.
     const RunResult png = octray(
-        {"render", "random:2,width=8,height=8", "-o", "out.exr", "--png", "nope/out.png"});
+        {"render", "random:2,width=8,height=8", "-o", "out.exr", "--png", "file/out.png"});
     EXPECT_EQ(png.status, 4) << png.output;
 
     const RunResult scene = octray({"scene", "random:2", "-o", "nope/x.json"});
     EXPECT_EQ(scene.status, 4) << scene.output;
     EXPECT_TRUE(contains(scene.output, "nope/x.json")) << scene.output;
 
-    EXPECT_TRUE(entries().empty());
+    EXPECT_EQ(entries(), std::vector<std::string>{"file"});
+}
+
+// Issue 26: render creates the missing directories of its outputs (as Blender does) and
+// says which, on stderr; the README's `-o out/bounce.####.exr` works in a fresh directory.
+TEST_F(CliTest, MissingOutputDirectoriesAreCreated) {
+    const RunResult r = octray({"render", "random:2,width=8,height=8", "-o", "out/sub/x.exr",
+                                "--png", "previews/x.png", "--progress", "none"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::is_regular_file(path("out/sub/x.exr")));
+    EXPECT_TRUE(fs::is_regular_file(path("previews/x.png")));
+    for (const char* dir : {"out/", "out/sub/", "previews/"})
+        EXPECT_TRUE(
+            contains(r.output, std::string("octray: created output directory ") + dir + "\n"))
+            << dir << "\n"
+            << r.output;
+    // Nothing to create the second time: nothing said.
+    const RunResult again = octray(
+        {"render", "random:2,width=8,height=8", "-o", "out/sub/y.exr", "--progress", "none"});
+    ASSERT_EQ(again.status, 0) << again.output;
+    EXPECT_FALSE(contains(again.output, "created")) << again.output;
 }
 
 TEST_F(CliTest, UsageErrorsExitWithTwo) {
@@ -479,7 +627,9 @@ TEST_F(CliTest, MistypedOptionsSuggestTheClosestOne) {
     };
     for (const auto& [args, meant] : cases) {
         const RunResult r = octray(args);
-        EXPECT_EQ(r.status, 2) << args[0] << " " << args[1] << "\n" << r.output;
+        // compare's usage errors exit 5 (issue 26): 2 is its FAIL verdict.
+        EXPECT_EQ(r.status, args[0] == "compare" ? 5 : 2) << args[0] << " " << args[1] << "\n"
+                                                          << r.output;
         EXPECT_TRUE(contains(r.output, "did you mean \"" + meant + "\"?")) << args[0] << "\n"
                                                                            << r.output;
         EXPECT_TRUE(contains(r.output, "--help")) << r.output;
@@ -525,6 +675,56 @@ TEST_F(CliTest, IntegerOptionsTakeDecimalDigitsOnly) {
     const auto* seed = file.header().findTypedAttribute<Imf::StringAttribute>("octray.seed");
     ASSERT_NE(seed, nullptr);
     EXPECT_EQ(seed->value(), "18446744073709551615");
+}
+
+// Issue 26: --max-depth's help and its limit are the scene's limit, from one constant.
+TEST_F(CliTest, MaxDepthHelpAndLimitAgreeWithTheScene) {
+    const RunResult help = octray({"render", "--help"});
+    EXPECT_TRUE(contains(help.output, "bounces, 0..64;")) << help.output;
+    const RunResult over = octray({"render", "random:2,width=4,height=4", "--max-depth", "65"});
+    EXPECT_EQ(over.status, 2) << over.output;
+    EXPECT_TRUE(contains(over.output, "--max-depth must be an integer from 0 to 64"))
+        << over.output;
+    const RunResult spec = octray({"render", "random:2,width=4,height=4,max_depth=65"});
+    EXPECT_EQ(spec.status, 3) << spec.output;
+    EXPECT_TRUE(contains(spec.output, "from 0 to 64")) << spec.output;
+    EXPECT_TRUE(entries().empty());
+    const RunResult top = octray({"render", "random:2,width=4,height=4", "--max-depth", "64",
+                                  "-o", "d.exr", "--progress", "none"});
+    EXPECT_EQ(top.status, 0) << top.output;
+}
+
+// Issue 26: the two paths promise identical bits, so verify is exact by default (a
+// tolerance stays available), and it verifies frames of an animated scene.
+TEST_F(CliTest, VerifyIsExactByDefaultAndTakesFrames) {
+    const RunResult help = octray({"verify", "--help"});
+    EXPECT_TRUE(contains(help.output, "--frames")) << help.output;
+    EXPECT_TRUE(contains(help.output, "--fail X")) << help.output;
+
+    const RunResult exact = octray({"verify", "random:8,width=16,height=12", "--threads", "2"});
+    EXPECT_EQ(exact.status, 0) << exact.output;
+    EXPECT_TRUE(contains(exact.output, "check    exact: every value equal (the default)\n"))
+        << exact.output;
+    EXPECT_TRUE(contains(exact.output, "differ by more than 0 (0 pixels)")) << exact.output;
+    EXPECT_TRUE(contains(exact.output, "\nPASS\n")) << exact.output;
+
+    const RunResult tolerant = octray(
+        {"verify", "random:8,width=16,height=12", "--fail", "1e-4", "--hardfail", "1e-3"});
+    EXPECT_EQ(tolerant.status, 0) << tolerant.output;
+    EXPECT_TRUE(contains(tolerant.output, "check    within the tolerance given"))
+        << tolerant.output;
+
+    const std::string bounce = std::string(OCTRAY_SOURCE_DIR) + "/scene/examples/bounce.json";
+    const RunResult frames =
+        octray({"verify", bounce, "--frames", "0,20-40:20", "--width", "32", "--height", "24"});
+    EXPECT_EQ(frames.status, 0) << frames.output;
+    for (const char* part :
+         {"frame    0\n", "frame    20\n", "frame    40\n", "PASS: all 3 frames"})
+        EXPECT_TRUE(contains(frames.output, part)) << part << "\n" << frames.output;
+    const RunResult bad = octray({"verify", bounce, "--frames", "1-x"});
+    EXPECT_EQ(bad.status, 2) << bad.output;
+    EXPECT_TRUE(contains(bad.output, "--frames")) << bad.output;
+    EXPECT_TRUE(entries().empty());
 }
 
 // Issue 23: -o and --png are the same file when they name one directory entry, however

@@ -205,12 +205,12 @@ TEST_F(CompareCliTest, JsonCarriesTheVerdictForEveryOutcome) {
 TEST_F(CompareCliTest, BadCommandLinesAreRejected) {
     write_pair(0.0f);
     RunResult r = compare({"a.exr", "b.exr", "--failpercent", "200"});
-    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_EQ(r.status, 5) << r.output;
     EXPECT_NE(r.output.find("--failpercent"), std::string::npos) << r.output;
     r = compare({"a.exr"});
-    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_EQ(r.status, 5) << r.output;
     r = compare({"a.exr", "b.exr", "--diff", "x.exr", "--heatmap", "x.exr"});
-    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_EQ(r.status, 5) << r.output;
 }
 
 // Issue 23: a NaN threshold would make every comparison pass (nothing is "> NaN"): it is a
@@ -221,13 +221,13 @@ TEST_F(CompareCliTest, NanThresholdsAreUsageErrors) {
          {"--fail", "--warn", "--failpercent", "--warnpercent", "--hardfail", "--hardwarn"}) {
         for (const char* value : {"nan", "NaN", "-nan"}) {
             const RunResult r = compare({"a.exr", "b.exr", option, value});
-            EXPECT_EQ(r.status, 2) << option << " " << value << "\n" << r.output;
+            EXPECT_EQ(r.status, 5) << option << " " << value << "\n" << r.output;
             EXPECT_NE(r.output.find(option), std::string::npos) << r.output;
             EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
         }
     }
     const RunResult both = compare({"a.exr", "b.exr", "--fail", "nan", "--warn", "nan"});
-    EXPECT_EQ(both.status, 2) << both.output;
+    EXPECT_EQ(both.status, 5) << both.output;
     EXPECT_NE(both.output.find("--help"), std::string::npos) << both.output;
 }
 
@@ -242,7 +242,7 @@ TEST_F(CompareCliTest, InfinityIsAValidThreshold) {
     EXPECT_EQ(r.status, 0) << r.output;
     for (const char* value : {"-inf", "-1", "0x1p3", "1e999", "", " 1", "1x"}) {
         r = compare({"a.exr", "b.exr", "--hardfail", value});
-        EXPECT_EQ(r.status, 2) << "'" << value << "'\n" << r.output;
+        EXPECT_EQ(r.status, 5) << "'" << value << "'\n" << r.output;
         EXPECT_NE(r.output.find("--help"), std::string::npos) << value << "\n" << r.output;
     }
 }
@@ -281,7 +281,7 @@ TEST_F(CompareCliTest, DiffOutputMustBeAnExr) {
     write_pair(0.0f);
     for (const char* name : {"d.png", "d.tif", "d"}) {
         const RunResult r = compare({"a.exr", "b.exr", "--diff", name});
-        EXPECT_EQ(r.status, 2) << name << "\n" << r.output;
+        EXPECT_EQ(r.status, 5) << name << "\n" << r.output;
         EXPECT_NE(r.output.find(".exr"), std::string::npos) << r.output;
         EXPECT_NE(r.output.find("--heatmap"), std::string::npos) << r.output;
         EXPECT_NE(r.output.find("--help"), std::string::npos) << r.output;
@@ -298,6 +298,30 @@ TEST_F(CompareCliTest, HelpListsTheExitCodes) {
     EXPECT_EQ(r.status, 0);
     EXPECT_NE(r.output.find("3  the images cannot be compared"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("--hardfail"), std::string::npos);
+    EXPECT_NE(r.output.find("5  usage error"), std::string::npos) << r.output;
+}
+
+// Issue 26: a usage error is not the FAIL verdict (2): a CI script tells a typo from a
+// regression by the status alone, and the message names compare's own help.
+TEST_F(CompareCliTest, UsageErrorsExit5NotTheFailStatus) {
+    write_pair(0.125f);
+    const std::vector<std::vector<std::string>> bad = {
+        {"a.exr"},
+        {"a.exr", "b.exr", "--no-such-option"},
+        {"a.exr", "b.exr", "--failpercent", "200"},
+        {"a.exr", "b.exr", "--fail", "nan"},
+        {"a.exr", "b.exr", "--diff", "d.png"},
+        {"a.exr", "b.exr", "--diff", "x.exr", "--heatmap", "x.exr"},
+    };
+    for (const auto& args : bad) {
+        const RunResult r = compare(args);
+        EXPECT_EQ(r.status, 5) << args.back() << "\n" << r.output;
+        EXPECT_NE(r.output.find("Run 'octray compare --help' for more information."),
+                  std::string::npos)
+            << r.output;
+    }
+    // The same pair with a good command line is a FAIL: 2, a different status.
+    EXPECT_EQ(compare({"a.exr", "b.exr"}).status, 2);
 }
 
 }  // namespace
