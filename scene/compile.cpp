@@ -65,6 +65,23 @@ CompiledScene compile_scene(const Scene& scene) {
     CompiledSpheres& s = out.spheres;
     CompiledPlanes& p = out.planes;
     CompiledObjects& o = out.objects;
+    // Every array reserved at its padded size up front: growing them one push_back at a
+    // time copied each array several times over (and touched its pages twice).
+    {
+        std::uint32_t planes = 0;
+        for (const Object& obj : scene.objects) planes += obj.type == ObjectType::plane;
+        const auto objects = static_cast<std::uint32_t>(scene.objects.size());
+        const std::uint32_t sp = padded(objects - planes), pp = padded(planes),
+                            op = padded(objects);
+        for (auto* v : {&s.cx, &s.cy, &s.cz, &s.r2, &s.radius}) v->reserve(sp);
+        for (auto* v : {&s.material, &s.object}) v->reserve(sp);
+        for (auto* v : {&p.nx, &p.ny, &p.nz, &p.d}) v->reserve(pp);
+        for (auto* v : {&p.material, &p.object}) v->reserve(pp);
+        for (auto* v : {&o.is_plane, &o.material, &o.checker}) v->reserve(op);
+        for (auto* v : {&o.cx, &o.cy, &o.cz, &o.nx, &o.ny, &o.nz, &o.t1x, &o.t1y, &o.t1z,
+                        &o.t2x, &o.t2y, &o.t2z})
+            v->reserve(op);
+    }
     for (std::uint32_t k = 0; k < scene.objects.size(); ++k) {
         const Object& obj = scene.objects[k];
         const Material& m = scene.materials[obj.material].material;

@@ -307,7 +307,10 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         if (!job.png.empty()) remove_stale_temporaries(job.png);
         progress_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
 
-        const Scene posed = scene_at_frame(scene.scene, job.frame);
+        // A still scene is its own pose: no copy of its (possibly millions of) objects.
+        std::optional<Scene> animated;
+        if (scene.scene.animation) animated = scene_at_frame(scene.scene, job.frame);
+        const Scene& posed = animated ? *animated : scene.scene;
         RenderOptions options = settings_.options;
         options.frame = static_cast<std::uint32_t>(job.frame);
         options.cancel = &InterruptGuard::flag();

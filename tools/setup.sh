@@ -12,7 +12,7 @@ packages=(
     dpkg-dev xz-utils
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
-    libpng-dev libembree-dev
+    libpng-dev libembree-dev libssl-dev
 )
 
 missing=()
