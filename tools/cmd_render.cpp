@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <charconv>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -59,6 +60,7 @@ struct RenderArguments {
     int shard_count = 0;
     bool skip_existing = false;
     bool placeholders = false;
+    bool stats = false;
     std::string crop;
     std::string aov;
     std::string progress = "auto";
@@ -168,8 +170,11 @@ BatchScene load_batch_scene(const std::string& spec, const RenderArguments& args
     BatchScene loaded;
     loaded.spec = spec;
     loaded.name = batch::scene_display_name(spec);
+    const auto load_start = std::chrono::steady_clock::now();
     std::string digest;
     std::tie(loaded.scene, digest) = load_scene_and_digest(spec);
+    loaded.load_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     Scene& scene = loaded.scene;
     const bool overridden = args.width_option->count() || args.height_option->count() ||
                             args.spp_option->count() || args.max_depth_option->count() ||
@@ -379,6 +384,7 @@ void run_render(const RenderArguments& args) {
     settings.png_output = output_format(args) == ImageFormat::png;
     settings.skip_existing = args.skip_existing;
     settings.placeholders = args.placeholders;
+    settings.stats = args.stats;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
     if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
     settings.progress = *progress;
@@ -533,6 +539,9 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                   "sharing one output directory never render a frame twice (empty claims of\n"
                   "a run that crashed stay: delete empty files to release them; unfinished\n"
                   "--progressive images of a run gone from this host are taken over)");
+    cmd->add_flag("--stats", args->stats,
+                  "After each frame, print the seconds of each phase on stderr: load (read,\n"
+                  "hash and parse the scene, once per scene), compile, BVH, render, write");
     cmd->add_option("--crop", args->crop,
                     "Render only pixels x0..x1-1, y0..y1-1 (row 0 on top) into an EXR whose\n"
                     "data window is that region; `octray assemble` stitches regions together")

@@ -330,7 +330,20 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         } else {
             result = render_still(settings_, posed, options);
         }
+        const auto write_start = std::chrono::steady_clock::now();
         write_outputs(scene, job, posed, result, aovs, posed.image.spp);
+        if (settings_.stats) {
+            const double write =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start)
+                    .count();
+            // The scene is loaded once for all its frames: its load time is on each line.
+            std::fprintf(stderr,
+                         "stats: %s frame %d: load %.3f s, compile %.3f s, BVH %.3f s, "
+                         "render %.3f s, write %.3f s\n",
+                         scene.name.c_str(), job.frame, scene.load_seconds,
+                         result.compile_seconds, result.bvh_seconds,
+                         result.seconds - result.compile_seconds - result.bvh_seconds, write);
+        }
         out.report.rays = result.rays.total();
         out.report.outcome = FrameOutcome::rendered;
     } catch (const RenderCancelled&) {
