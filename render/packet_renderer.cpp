@@ -448,6 +448,7 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     run_with_threads(options.threads, render_tiles);
     control.finish();
     for (const TileScratch& s : scratch) result.rays += s.counts;
+    result.bvh_seconds = use_bvh ? bvh.build_seconds : 0.0;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
@@ -457,6 +458,7 @@ RenderResult render_packet(const Scene& scene, const RenderOptions& options, Isa
     const auto start = std::chrono::steady_clock::now();
     const CompiledScene compiled = compile_scene(scene);
     RenderResult result = render_packet(compiled, options, isa);
+    result.compile_seconds = compiled.compile_seconds;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

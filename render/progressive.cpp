@@ -23,7 +23,7 @@ RenderResult render_progressive(const PassRenderer& render, int spp,
             "render_progressive sets the sample range itself: options.samples and "
             "options.sample_sums must be unset");
     RayCounts rays;
-    double seconds = 0.0;
+    double seconds = 0.0, compile_seconds = 0.0, bvh_seconds = 0.0;
     RenderResult result;
     int done = 0;
     for (const int end : progressive_schedule(spp)) {
@@ -33,12 +33,16 @@ RenderResult render_progressive(const PassRenderer& render, int spp,
         RenderResult next = render(pass);
         rays += next.rays;
         seconds += next.seconds;
+        compile_seconds += next.compile_seconds;
+        bvh_seconds += next.bvh_seconds;
         result = std::move(next);
         done = end;
         if (on_pass) on_pass(result, done);
     }
     result.rays = rays;
     result.seconds = seconds;
+    result.compile_seconds = compile_seconds;
+    result.bvh_seconds = bvh_seconds;
     result.sample_sums = Image();
     return result;
 }

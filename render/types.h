@@ -107,6 +107,10 @@ struct RenderResult {
     Image sample_sums;
     RayCounts rays;
     double seconds = 0.0;  // wall-clock time of the render itself
+    // The parts of `seconds` spent compiling the scene and building its BVH (0 where the
+    // render did neither: a precompiled scene, no BVH; summed over progressive passes).
+    double compile_seconds = 0.0;
+    double bvh_seconds = 0.0;
 };
 
 }  // namespace octray

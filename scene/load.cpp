@@ -1086,27 +1086,30 @@ class Validator {
     }
 
     void objects() const {
+        // Paths are built only for a failing object: a valid scene of millions of spheres
+        // would otherwise build several strings per object for nothing.
         std::unordered_map<std::string_view, std::size_t> names;
         for (std::size_t i = 0; i < scene_.objects.size(); ++i) {
-            const std::string path = index_path("objects", i);
+            const auto path = [i] { return index_path("objects", i); };
             const Object& o = scene_.objects[i];
             if (o.material >= scene_.materials.size()) {
-                fail(child_path(path, "material"), "expected a material index below " +
-                                                       std::to_string(scene_.materials.size()) +
-                                                       " (the scene's material count), found " +
-                                                       std::to_string(o.material));
+                fail(child_path(path(), "material"),
+                     "expected a material index below " +
+                         std::to_string(scene_.materials.size()) +
+                         " (the scene's material count), found " + std::to_string(o.material));
             }
             if (o.type == ObjectType::sphere) {
-                finite(o.center, child_path(path, "center"));
-                positive(o.radius, child_path(path, "radius"), "a radius");
+                if (!is_finite(o.center)) finite(o.center, child_path(path(), "center"));
+                if (!(std::isfinite(o.radius) && o.radius > 0.0f))
+                    positive(o.radius, child_path(path(), "radius"), "a radius");
             } else {
-                finite(o.point, child_path(path, "point"));
-                finite(o.normal, child_path(path, "normal"));
+                if (!is_finite(o.point)) finite(o.point, child_path(path(), "point"));
+                if (!is_finite(o.normal)) finite(o.normal, child_path(path(), "normal"));
                 const double len2 = static_cast<double>(o.normal.x) * o.normal.x +
                                     static_cast<double>(o.normal.y) * o.normal.y +
                                     static_cast<double>(o.normal.z) * o.normal.z;
                 if (!(std::fabs(len2 - 1.0) <= kValidateUnitTolerance)) {
-                    fail(child_path(path, "normal"),
+                    fail(child_path(path(), "normal"),
                          "expected a unit-length normal (scene files are normalised on load), "
                          "found " +
                              format_vec(o.normal));
@@ -1115,10 +1118,10 @@ class Validator {
             if (!o.name.empty()) {
                 const auto [it, inserted] = names.emplace(o.name, i);
                 if (!inserted) {
-                    fail(child_path(path, "name"), "expected a unique object name, found " +
-                                                       quote_text(o.name) +
-                                                       " again (first used by objects[" +
-                                                       std::to_string(it->second) + "])");
+                    fail(child_path(path(), "name"), "expected a unique object name, found " +
+                                                         quote_text(o.name) +
+                                                         " again (first used by objects[" +
+                                                         std::to_string(it->second) + "])");
                 }
             }
         }
@@ -1388,7 +1391,10 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source) {
     return scene;
 }
 
-std::string read_scene_file(const std::string& path) {
+std::string read_scene_file(const std::string& path) { return read_scene_file(path, {}); }
+
+std::string read_scene_file(const std::string& path,
+                            const std::function<void(std::string_view)>& on_chunk) {
     // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused below anyway.
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
@@ -1431,6 +1437,7 @@ std::string read_scene_file(const std::string& path) {
     for (;;) {
         const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), file.get());
         text.append(buffer.data(), n);
+        if (on_chunk && n > 0) on_chunk(std::string_view(buffer.data(), n));
         if (n < buffer.size()) break;
     }
     if (std::ferror(file.get())) {

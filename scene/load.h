@@ -2,6 +2,7 @@
 // Scenes from the command line: a JSON file (docs/scene-format.md) or a built-in
 // generator spec ("whitted", "random:1024,width=640", "sphereflake:4").
 
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -16,6 +17,10 @@ Scene parse_scene_json(std::string_view json_text, const std::string& source);
 // The bytes of a scene file. Refuses anything but a regular file (a directory, a device
 // such as /dev/zero, a FIFO) before reading, so a read always ends. Throws SceneError.
 std::string read_scene_file(const std::string& path);
+// The same, handing each chunk to `on_chunk` as it is read (while it is in cache): a
+// caller hashes the file's bytes in the same single read.
+std::string read_scene_file(const std::string& path,
+                            const std::function<void(std::string_view)>& on_chunk);
 
 // Reads and parses a JSON scene file. Throws SceneError (unreadable file included).
 Scene load_scene_file(const std::string& path);

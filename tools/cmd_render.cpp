@@ -2,12 +2,14 @@
 // (one still by default; animations, frame ranges, several scenes, shards of a farm job)
 // to EXR (+ PNG previews). The frame loop itself lives in render_batch.cpp.
 
+#include <openssl/evp.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <charconv>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -20,9 +22,12 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/sha256.h"
@@ -56,6 +61,7 @@ struct RenderArguments {
     int shard_count = 0;
     bool skip_existing = false;
     bool placeholders = false;
+    bool stats = false;
     std::string crop;
     std::string aov;
     std::string progress = "auto";
@@ -111,10 +117,46 @@ std::optional<TileSize> parse_tile(const std::string& text) {
 // The scene's identity for the EXR: SHA-256 of the file's bytes (what `sha256sum` prints),
 // or for a built-in, of its spec string as given (`printf %s SPEC | sha256sum`): the
 // generators are deterministic, so the spec names the scene, and hashing it costs nothing
-// where serializing random:1048576 to JSON and hashing that took seconds.
-std::string scene_digest(const std::string& spec) {
-    if (!is_builtin_scene(spec)) return sha256_hex(read_scene_file(spec));
-    return sha256_hex(spec);
+// where serializing random:1048576 to JSON and hashing that took seconds. A file is hashed
+// chunk by chunk while it is read for parsing (one read), by OpenSSL's libcrypto, which
+// uses the CPU's SHA instructions: 0.13 s for a 114 MB scene against 0.88 s for the
+// portable core/sha256.h.
+class FileDigest {
+  public:
+    FileDigest() : ctx_(EVP_MD_CTX_new(), &EVP_MD_CTX_free) {
+        if (!ctx_ || EVP_DigestInit_ex(ctx_.get(), EVP_sha256(), nullptr) != 1)
+            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestInit_ex failed");
+    }
+    void update(std::string_view bytes) {
+        if (EVP_DigestUpdate(ctx_.get(), bytes.data(), bytes.size()) != 1)
+            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestUpdate failed");
+    }
+    std::string hex() {
+        unsigned char digest[EVP_MAX_MD_SIZE];
+        unsigned int size = 0;
+        if (EVP_DigestFinal_ex(ctx_.get(), digest, &size) != 1)
+            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestFinal_ex failed");
+        static constexpr char kHex[] = "0123456789abcdef";
+        std::string out;
+        for (unsigned int i = 0; i < size; ++i) {
+            out += kHex[digest[i] >> 4];
+            out += kHex[digest[i] & 15];
+        }
+        return out;
+    }
+
+  private:
+    std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> ctx_;
+};
+
+// The scene of `spec` and its digest (above).
+std::pair<Scene, std::string> load_scene_and_digest(const std::string& spec) {
+    if (is_builtin_scene(spec)) return {make_builtin_scene(spec), sha256_hex(spec)};
+    FileDigest digest;
+    const std::string text =
+        read_scene_file(spec, [&](std::string_view chunk) { digest.update(chunk); });
+    Scene scene = parse_scene_json(text, spec);
+    return {std::move(scene), digest.hex()};
 }
 
 // Physical memory: the default --max-memory (0 if unknown: no limit).
@@ -129,7 +171,11 @@ BatchScene load_batch_scene(const std::string& spec, const RenderArguments& args
     BatchScene loaded;
     loaded.spec = spec;
     loaded.name = batch::scene_display_name(spec);
-    loaded.scene = load_scene(spec);
+    const auto load_start = std::chrono::steady_clock::now();
+    std::string digest;
+    std::tie(loaded.scene, digest) = load_scene_and_digest(spec);
+    loaded.load_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     Scene& scene = loaded.scene;
     const bool overridden = args.width_option->count() || args.height_option->count() ||
                             args.spp_option->count() || args.max_depth_option->count() ||
@@ -147,7 +193,7 @@ BatchScene load_batch_scene(const std::string& spec, const RenderArguments& args
             throw UsageError(std::string("the options make the scene invalid: ") + e.what());
         }
     }
-    loaded.sha256 = scene_digest(spec);
+    loaded.sha256 = std::move(digest);
     return loaded;
 }
 
@@ -356,6 +402,7 @@ void run_render(const RenderArguments& args) {
     settings.png_output = output_format(args) == ImageFormat::png;
     settings.skip_existing = args.skip_existing;
     settings.placeholders = args.placeholders;
+    settings.stats = args.stats;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
     if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
     settings.progress = *progress;
@@ -514,6 +561,9 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                   "sharing one output directory never render a frame twice (empty claims of\n"
                   "a run that crashed stay: delete empty files to release them; unfinished\n"
                   "--progressive images of a run gone from this host are taken over)");
+    cmd->add_flag("--stats", args->stats,
+                  "After each frame, print the seconds of each phase on stderr: load (read,\n"
+                  "hash and parse the scene, once per scene), compile, BVH, render, write");
     cmd->add_option("--crop", args->crop,
                     "Render only pixels x0..x1-1, y0..y1-1 (row 0 on top) into an EXR whose\n"
                     "data window is that region; `octray assemble` stitches regions together")

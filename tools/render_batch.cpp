@@ -307,7 +307,10 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         if (!job.png.empty()) remove_stale_temporaries(job.png);
         progress_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
 
-        const Scene posed = scene_at_frame(scene.scene, job.frame);
+        // A still scene is its own pose: no copy of its (possibly millions of) objects.
+        std::optional<Scene> animated;
+        if (scene.scene.animation) animated = scene_at_frame(scene.scene, job.frame);
+        const Scene& posed = animated ? *animated : scene.scene;
         RenderOptions options = settings_.options;
         options.frame = static_cast<std::uint32_t>(job.frame);
         options.cancel = &InterruptGuard::flag();
@@ -340,6 +343,14 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
             std::chrono::duration<double>(Clock::now() - trace_started).count() - write_seconds;
         timed_write(result, posed.image.spp);
         out.report.write_seconds = write_seconds;
+        if (settings_.stats)  // the scene is loaded once for all its frames: on each line
+            std::fprintf(stderr,
+                         "stats: %s frame %d: load %.3f s, compile %.3f s, BVH %.3f s, "
+                         "render %.3f s, write %.3f s\n",
+                         scene.name.c_str(), job.frame, scene.load_seconds,
+                         result.compile_seconds, result.bvh_seconds,
+                         result.seconds - result.compile_seconds - result.bvh_seconds,
+                         write_seconds);
         out.report.rays = result.rays.total();
         out.report.outcome = FrameOutcome::rendered;
     } catch (const RenderCancelled&) {

@@ -27,6 +27,7 @@ struct BatchScene {
     std::string sha256;             // octray.sceneSha256
     Scene scene;                    // loaded, overrides applied, validated
     std::optional<PixelRect> crop;  // --crop, checked against the image
+    double load_seconds = 0.0;      // reading (and hashing) and parsing it, for --stats
 };
 
 struct BatchJob {
@@ -48,6 +49,8 @@ struct BatchSettings {
     bool skip_existing = false;
     bool placeholders = false;
     ProgressMode progress = ProgressMode::lines;
+    // --stats: each frame's phases (load, compile, BVH, render, write) on stderr.
+    bool stats = false;
 };
 
 // The jobs of one shard: positions k of the whole list with k % count == index.

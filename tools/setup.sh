@@ -14,7 +14,7 @@ packages=(
     dpkg-dev xz-utils
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
-    libpng-dev libembree-dev
+    libpng-dev libembree-dev libssl-dev
     slurmctld slurmd slurm-client munge
 )
 

@@ -331,13 +331,14 @@ done
 echo "check: ${#expected[@]} frames, each once, no temporary or empty file, pixels equal to a local render"
 
 # The logs: how many frames each task rendered (summed over its attempts), and the
-# requeue. A frame line ("... -> path  0.52 s  1.2 Mrays/s") is printed once per frame
-# rendered; the killed attempt prints no summary.
+# requeue. A frame line ("frame 2/4  bounce frame 4  -> path  trace 1.2 s  9.7 Mrays/s
+# write 0.004 s") is printed once per frame rendered (a skipped frame's line has no rate);
+# the killed attempt prints no summary.
 total=0
 for ((t = 0; t < tasks; t++)); do
     log=$(log_of "$t")
     [[ -f $log ]] || fail "task $t wrote no log $log"
-    n=$(grep -E -c '^frame [0-9]+/[0-9]+ .* -> .* Mrays/s$' "$log" || true)
+    n=$(grep -E -c '^frame [0-9]+/[0-9]+ .* -> .* Mrays/s' "$log" || true)
     attempts=$(grep -c '^octray task .* attempt ' "$log" || true)
     summary=$(grep -E '^(done|interrupted): ' "$log" | tail -n 1)
     echo "task $t: $attempts attempt(s), $n frame(s) rendered; last summary: ${summary:-none}"

@@ -528,6 +528,18 @@ TEST_F(BatchCliTest, ABuiltInsDigestIsItsSpecString) {
     EXPECT_EQ(digest->value(), sha256_hex(spec));
 }
 
+// --stats: one line per frame with the seconds of each phase (issue 19).
+TEST_F(BatchCliTest, StatsPrintEachPhaseOfEachFrame) {
+    const auto r =
+        run_octray({"render", "shot.json", "--frames", "0,1", "--stats", "-o", "s#.exr"}, dir_,
+                   /*with_stderr=*/true);
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* frame : {"stats: shot frame 0: load ", "stats: shot frame 1: load "})
+        EXPECT_TRUE(contains(r.output, frame)) << r.output;
+    for (const char* phase : {" s, compile ", " s, BVH ", " s, render ", " s, write "})
+        EXPECT_TRUE(contains(r.output, phase)) << r.output;
+}
+
 TEST_F(BatchCliTest, SeveralScenesNeedSceneInThePattern) {
     const auto clash = run_octray(
         {"render", "shot.json", "random:4,width=16,height=12", "-o", "out/x.exr"}, dir_);
