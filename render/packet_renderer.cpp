@@ -40,7 +40,11 @@ std::size_t stream_capacity(std::size_t n) {
 template <class... Columns>
 void grow(std::size_t n, Columns&... columns) {
     const std::size_t capacity = stream_capacity(n);
-    ((columns.size() < capacity ? columns.resize(capacity) : void()), ...);
+    // reserve first: resize alone may allocate up to twice the size (libstdc++ grows
+    // geometrically), and scene/limits.cpp counts exactly `capacity` elements.
+    ((columns.size() < capacity ? (columns.reserve(capacity), columns.resize(capacity))
+                                : void()),
+     ...);
 }
 
 struct SampleStorage {
@@ -94,30 +98,87 @@ struct ColorStorage {
     }
 };
 
-// One generation of a tile's ray tree: each ray's color parts and, for secondary rays,
-// the link to the parent whose color they complete.
-struct Generation {
-    std::uint32_t count = 0;
-    ColorStorage color;
+// A tile traces each generation of its ray tree (primary rays, their mirror and refracted
+// children, theirs, ...) in chunks of at most ray_chunk rays (kDefaultRayChunk), depth
+// first. Breadth first, a tile whose every bounce spawns two rays above the weight cut-off
+// would hold 2^depth rays per sample at its deepest generation; in chunks it holds at most
+// a chunk per generation (and per camera-sample stream), whatever the depth and the samples
+// per pixel. Chunking changes no pixel: every ray is traced and shaded alone, and a pixel
+// adds its samples in order.
+
+// Per secondary ray: where its color goes (kernels::ChildLinks).
+struct LinkStorage {
     AlignedVector<std::uint32_t> parent;  // 2 * parent slot + (0 mirror, 1 refracted)
     AlignedVector<float> factor_r, factor_g, factor_b;
-    void reserve_links(std::size_t n) { grow(n, parent, factor_r, factor_g, factor_b); }
-    kernels::ChildLinks links() {
+    void reserve(std::size_t n) { grow(n, parent, factor_r, factor_g, factor_b); }
+    kernels::ChildLinks view() {
         return {parent.data(), factor_r.data(), factor_g.data(), factor_b.data()};
     }
 };
 
-// Per-thread scratch, reused tile after tile.
+// One generation of a tile's ray tree, a chunk of its rays at a time: their colors, kept
+// until their children's colors are known, and the children they spawn with their links.
+struct Level {
+    ColorStorage color;
+    RayStorage next;
+    LinkStorage next_links;
+};
+
+// Per-thread scratch, reused tile after tile (and frame after frame: scratch_for_thread).
 struct TileScratch {
     SampleStorage samples;
-    RayStorage rays, next;
-    HitStorage hits;
-    ShadowStorage shadows;
-    std::vector<Generation> generations;  // grows to the deepest tree seen, never shrinks
-    AlignedVector<std::uint32_t> primary_pixel;  // tile pixel of each primary ray
-    AlignedVector<float> acc_r, acc_g, acc_b;    // the tile's sums of samples
-    RayCounts counts;
+    RayStorage primary;
+    HitStorage hits;            // of the chunk being shaded, at any level
+    ShadowStorage shadows;      // likewise
+    std::vector<Level> levels;  // sized to max_depth + 1 before a tile, never shrinks
+    std::vector<std::uint32_t> pixel_order;    // the tile's pixels in sample order
+    AlignedVector<float> acc_r, acc_g, acc_b;  // the tile's sums of samples
+
+    // What the scratch holds now, in bytes (its high-water mark: it never shrinks).
+    std::uint64_t bytes() const {
+        std::uint64_t total = 0;
+        const auto add = [&](const auto&... columns) {
+            ((total += columns.capacity() * sizeof(columns[0])), ...);
+        };
+        add(samples.x, samples.y, samples.lens_u, samples.lens_v, samples.pixel);
+        add(primary.ox, primary.oy, primary.oz, primary.dx, primary.dy, primary.dz, primary.wr,
+            primary.wg, primary.wb, primary.pixel);
+        add(hits.t, hits.object);
+        add(shadows.ox, shadows.oy, shadows.oz, shadows.dx, shadows.dy, shadows.dz,
+            shadows.t_max, shadows.term_r, shadows.term_g, shadows.term_b, shadows.parent,
+            shadows.occluded);
+        for (const Level& l : levels) {
+            const ColorStorage& c = l.color;
+            add(c.local_r, c.local_g, c.local_b, c.refl_r, c.refl_g, c.refl_b, c.refr_r,
+                c.refr_g, c.refr_b);
+            const RayStorage& r = l.next;
+            add(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, r.wr, r.wg, r.wb, r.pixel);
+            add(l.next_links.parent, l.next_links.factor_r, l.next_links.factor_g,
+                l.next_links.factor_b);
+        }
+        add(pixel_order, acc_r, acc_g, acc_b);
+        return total;
+    }
 };
+
+// This thread's scratch. Kept for the life of the thread, so that a process's frames after
+// the first (an animation, a benchmark, a progressive render's passes) touch no fresh
+// memory: the first touch of a page is a page fault, and the buffers of a tile are
+// rewritten every tile. A thread renders one tile at a time (render_tile calls no
+// parallel code), so the scratch is never shared.
+TileScratch& scratch_for_thread() {
+    thread_local TileScratch scratch;
+    return scratch;
+}
+
+// The rays of `rays` from `first` on: a chunk of a stream (first: a whole packet).
+kernels::RayStream offset(const kernels::RayStream& r, std::uint32_t first) {
+    return {r.ox + first, r.oy + first, r.oz + first, r.dx + first, r.dy + first,
+            r.dz + first, r.wr + first, r.wg + first, r.wb + first, r.pixel + first};
+}
+kernels::ChildLinks offset(const kernels::ChildLinks& l, std::uint32_t first) {
+    return {l.parent + first, l.factor_r + first, l.factor_g + first, l.factor_b + first};
+}
 
 // Adds each unoccluded shadow ray's light term to its parent's color. Shadow rays of one
 // parent come in light order, so the terms are summed in the reference's order.
@@ -219,11 +280,12 @@ constexpr int kBlockHeight = 2;
 class PacketTracer {
   public:
     PacketTracer(const CompiledScene& scene, const kernels::KernelTable& table,
-                 std::uint32_t frame, const SphereBvh* bvh)
+                 std::uint32_t frame, const SphereBvh* bvh, std::uint32_t ray_chunk)
         : scene_(scene),
           view_(bvh ? make_scene_view(scene, *bvh) : make_scene_view(scene)),
           k_(table),
-          frame_(frame) {
+          frame_(frame),
+          ray_chunk_(ray_chunk) {
         // One sample per pixel sits at the pixel center: the film position of a column
         // (row) is the same for every row (column), computed once.
         for (int i = 0; i < scene.width; ++i) center_x_.push_back(film_x(i, 0.5f, scene.width));
@@ -231,12 +293,12 @@ class PacketTracer {
             center_y_.push_back(film_y(j, 0.5f, scene.height));
     }
 
-    void render_tile(const Tile& tile, TileScratch& s, const RenderTarget& target) const {
-        const int spp = scene_.spp;
+    void render_tile(const Tile& tile, TileScratch& s, const RenderTarget& target,
+                     RayCounts& counts) const {
         const int first_sample = target.samples.begin, end_sample = target.samples.end;
+        const auto per_pixel = static_cast<std::uint32_t>(end_sample - first_sample);
         const std::size_t pixels = static_cast<std::size_t>(tile.width) * tile.height;
-        const std::size_t samples =
-            pixels * static_cast<std::size_t>(end_sample - first_sample);
+        const std::size_t samples = pixels * per_pixel;
         s.acc_r.assign(pixels, 0.0f);
         s.acc_g.assign(pixels, 0.0f);
         s.acc_b.assign(pixels, 0.0f);
@@ -252,116 +314,36 @@ class PacketTracer {
                     s.acc_g[p] = start.g;
                     s.acc_b[p] = start.b;
                 }
+        if (s.levels.size() < static_cast<std::size_t>(scene_.max_depth) + 1)
+            s.levels.resize(static_cast<std::size_t>(scene_.max_depth) + 1);
 
-        // Camera samples: block by block, pixel by pixel, sample by sample. Every stream
-        // below keeps this order per pixel, so a pixel's contributions arrive in the same
-        // order whatever the tile size.
-        s.samples.reserve(samples);
-        const bool lens = scene_.camera.type == CameraType::thinlens;
-        float *sx = s.samples.x.data(), *sy = s.samples.y.data();
-        float *su = s.samples.lens_u.data(), *sv = s.samples.lens_v.data();
-        std::uint32_t* spixel = s.samples.pixel.data();
-        std::size_t n = 0;
-        const bool centers = spp == 1 && !lens;  // one sample per pixel, at its center
+        // The tile's pixels block by block (4 x 2 pixels each), row by row in a block; each
+        // pixel's samples follow one another. Every stream below keeps this order per
+        // pixel, so a pixel's contributions arrive in the same order whatever the tile size
+        // and the chunking.
+        s.pixel_order.clear();
+        s.pixel_order.reserve(pixels);
         for (int by = 0; by < tile.height; by += kBlockHeight)
-            for (int bx = 0; bx < tile.width; bx += kBlockWidth) {
-                const int y_end = std::min(by + kBlockHeight, tile.height);
-                const int x_end = std::min(bx + kBlockWidth, tile.width);
-                if (centers) {
-                    for (int y = by; y < y_end; ++y) {
-                        const float fy = center_y_[static_cast<std::size_t>(tile.y0 + y)];
-                        for (int x = bx; x < x_end; ++x, ++n) {
-                            sx[n] = center_x_[static_cast<std::size_t>(tile.x0 + x)];
-                            sy[n] = fy;
-                            su[n] = sv[n] = 0.0f;
-                            spixel[n] = static_cast<std::uint32_t>(y * tile.width + x);
-                        }
-                    }
-                    continue;
-                }
-                for (int y = by; y < y_end; ++y)
-                    for (int x = bx; x < x_end; ++x) {
-                        const int i = tile.x0 + x, j = tile.y0 + y;
-                        const auto ui = static_cast<std::uint32_t>(i);
-                        const auto uj = static_cast<std::uint32_t>(j);
-                        for (int k = first_sample; k < end_sample; ++k, ++n) {
-                            const auto sample = static_cast<std::uint32_t>(k);
-                            const PixelOffset o = pixel_sample_offset(
-                                frame_, ui, uj, sample, static_cast<std::uint32_t>(spp),
-                                scene_.seed);
-                            sx[n] = film_x(i, o.ox, scene_.width);
-                            sy[n] = film_y(j, o.oy, scene_.height);
-                            su[n] = lens ? sample_uniform(frame_, ui, uj, sample, kDimLensU,
-                                                          scene_.seed)
-                                         : 0.0f;
-                            sv[n] = lens ? sample_uniform(frame_, ui, uj, sample, kDimLensV,
-                                                          scene_.seed)
-                                         : 0.0f;
-                            spixel[n] = static_cast<std::uint32_t>(y * tile.width + x);
-                        }
-                    }
-            }
-        // Padding lanes: a harmless film position.
-        for (std::size_t k = n; k < s.samples.x.size(); ++k) {
-            s.samples.x[k] = s.samples.y[k] = s.samples.lens_u[k] = s.samples.lens_v[k] = 0.0f;
-            s.samples.pixel[k] = 0;
-        }
+            for (int bx = 0; bx < tile.width; bx += kBlockWidth)
+                for (int y = by; y < std::min(by + kBlockHeight, tile.height); ++y)
+                    for (int x = bx; x < std::min(bx + kBlockWidth, tile.width); ++x)
+                        s.pixel_order.push_back(static_cast<std::uint32_t>(y * tile.width + x));
 
-        s.rays.reserve(samples);
-        std::uint32_t count = k_.camera_rays(
-            view_, s.samples.view(), static_cast<std::uint32_t>(samples), s.rays.view());
-        s.counts.primary += count;
-
-        s.primary_pixel.assign(s.rays.pixel.begin(), s.rays.pixel.begin() + count);
-
-        // Generations, breadth first: primary rays live on (ε_s, inf), secondary ones on
-        // (0, inf). Each generation's colors are kept until the tree is complete.
-        float t_min = scene_.epsilon;
-        int depth = 0;
-        for (; count > 0; ++depth, t_min = 0.0f) {
-            if (s.generations.size() < static_cast<std::size_t>(depth) + 2)
-                s.generations.resize(static_cast<std::size_t>(depth) + 2);
-            Generation& gen = s.generations[static_cast<std::size_t>(depth)];
-            Generation& children = s.generations[static_cast<std::size_t>(depth) + 1];
-            gen.count = count;
-            s.hits.reserve(count);
-            s.shadows.reserve(static_cast<std::size_t>(count) * scene_.lights.count);
-            gen.color.reserve(count);
-            s.next.reserve(2 * static_cast<std::size_t>(count));
-            children.reserve_links(2 * static_cast<std::size_t>(count));
-
-            const kernels::RayStream rays = s.rays.view();
-            k_.closest_hit(view_, rays, count, t_min, s.hits.view());
-            const kernels::ShadeCounts shaded =
-                k_.shade(view_, kernels::ShadeInput{rays, s.hits.view(), count, depth},
-                         kernels::ShadeOutput{gen.color.view(), s.shadows.view(), s.next.view(),
-                                              children.links()});
-            k_.any_hit(view_, s.shadows.view(), shaded.shadow, s.shadows.occluded.data());
-            s.counts.shadow += shaded.shadow;
-            s.counts.reflected += shaded.reflected;
-            s.counts.refracted += shaded.refracted;
-
-            // Visible light terms join their parent's color in light order.
-            add_visible_terms(s.shadows, shaded.shadow, gen.color.view());
-            std::swap(s.rays, s.next);
-            count = shaded.next;
-        }
-
-        // Resolve the tree last generation first: a ray's color is
-        // ((local + mirror tail) + refraction tail), the reference's order of terms, and a
-        // traced child's tail is factor * (the child's color), as the reference's
-        // factor * trace(child). The images agree bit for bit.
-        for (int d = depth - 1; d >= 1; --d) {
-            Generation& gen = s.generations[static_cast<std::size_t>(d)];
-            resolve_into_parents(gen.color.view(), gen.links(), gen.count,
-                                 s.generations[static_cast<std::size_t>(d) - 1].color.view());
-        }
-        // Primary rays into their pixels, sample after sample.
-        if (depth > 0) {
-            const kernels::SurfaceColor c = s.generations[0].color.view();
-            const std::uint32_t* pixel = s.primary_pixel.data();
+        // Camera samples, primary rays and their trees, a chunk of samples at a time.
+        for (std::size_t first = 0; first < samples; first += ray_chunk_) {
+            const std::size_t n = std::min<std::size_t>(ray_chunk_, samples - first);
+            camera_samples(tile, s, first, n, first_sample, per_pixel);
+            s.primary.reserve(n);
+            const std::uint32_t count = k_.camera_rays(
+                view_, s.samples.view(), static_cast<std::uint32_t>(n), s.primary.view());
+            counts.primary += count;
+            if (count == 0) continue;
+            trace_generation(0, s.primary.view(), count, s, counts);
+            // Primary rays into their pixels, sample after sample.
+            const kernels::SurfaceColor c = s.levels[0].color.view();
+            const std::uint32_t* pixel = s.primary.pixel.data();
             float *acc_r = s.acc_r.data(), *acc_g = s.acc_g.data(), *acc_b = s.acc_b.data();
-            for (std::uint32_t r = 0, n0 = s.generations[0].count; r < n0; ++r) {
+            for (std::uint32_t r = 0; r < count; ++r) {
                 const std::uint32_t p = pixel[r];
                 acc_r[p] += (c.local_r[r] + c.tail_reflect_r[r]) + c.tail_refract_r[r];
                 acc_g[p] += (c.local_g[r] + c.tail_reflect_g[r]) + c.tail_refract_g[r];
@@ -385,10 +367,101 @@ class PacketTracer {
     }
 
   private:
+    // Samples [first, first + n) of the tile's stream (pixel_order, each pixel's samples
+    // [first_sample, first_sample + per_pixel) in turn) into s.samples, padded to a whole
+    // packet with a harmless film position.
+    void camera_samples(const Tile& tile, TileScratch& s, std::size_t first, std::size_t n,
+                        int first_sample, std::uint32_t per_pixel) const {
+        s.samples.reserve(n);
+        const bool lens = scene_.camera.type == CameraType::thinlens;
+        const bool centers = scene_.spp == 1 && !lens;  // one sample per pixel, at its center
+        float *sx = s.samples.x.data(), *sy = s.samples.y.data();
+        float *su = s.samples.lens_u.data(), *sv = s.samples.lens_v.data();
+        std::uint32_t* spixel = s.samples.pixel.data();
+        const std::uint32_t* pixel = s.pixel_order.data();
+        const float* cx = center_x_.data() + tile.x0;
+        const float* cy = center_y_.data() + tile.y0;
+        const auto w = static_cast<std::uint32_t>(tile.width);
+        if (centers) {  // per_pixel == 1
+            for (std::size_t m = 0; m < n; ++m) {
+                const std::uint32_t p = pixel[first + m];
+                sx[m] = cx[p % w];
+                sy[m] = cy[p / w];
+                su[m] = sv[m] = 0.0f;
+                spixel[m] = p;
+            }
+        } else {
+            std::size_t order = first / per_pixel;
+            auto k = static_cast<std::uint32_t>(first % per_pixel);
+            for (std::size_t m = 0; m < n; ++m) {
+                const std::uint32_t p = pixel[order];
+                const int i = tile.x0 + static_cast<int>(p % w);
+                const int j = tile.y0 + static_cast<int>(p / w);
+                const auto ui = static_cast<std::uint32_t>(i);
+                const auto uj = static_cast<std::uint32_t>(j);
+                const auto sample = static_cast<std::uint32_t>(first_sample) + k;
+                const PixelOffset o =
+                    pixel_sample_offset(frame_, ui, uj, sample,
+                                        static_cast<std::uint32_t>(scene_.spp), scene_.seed);
+                sx[m] = film_x(i, o.ox, scene_.width);
+                sy[m] = film_y(j, o.oy, scene_.height);
+                su[m] = lens ? sample_uniform(frame_, ui, uj, sample, kDimLensU, scene_.seed)
+                             : 0.0f;
+                sv[m] = lens ? sample_uniform(frame_, ui, uj, sample, kDimLensV, scene_.seed)
+                             : 0.0f;
+                spixel[m] = p;
+                if (++k == per_pixel) k = 0, ++order;
+            }
+        }
+        for (std::size_t m = n; m < s.samples.x.size(); ++m) {
+            sx[m] = sy[m] = su[m] = sv[m] = 0.0f;
+            spixel[m] = 0;
+        }
+    }
+
+    // Traces `count` rays of generation `depth` (primary rays: 0) and, chunk by chunk,
+    // depth first, the trees below them; leaves their colors in s.levels[depth].color.
+    // Primary rays live on (ε_s, inf), secondary ones on (0, inf).
+    void trace_generation(int depth, const kernels::RayStream& rays, std::uint32_t count,
+                          TileScratch& s, RayCounts& counts) const {
+        Level& level = s.levels[static_cast<std::size_t>(depth)];
+        s.hits.reserve(count);
+        s.shadows.reserve(static_cast<std::size_t>(count) * scene_.lights.count);
+        level.color.reserve(count);
+        level.next.reserve(2 * static_cast<std::size_t>(count));
+        level.next_links.reserve(2 * static_cast<std::size_t>(count));
+
+        const float t_min = depth == 0 ? scene_.epsilon : 0.0f;
+        k_.closest_hit(view_, rays, count, t_min, s.hits.view());
+        const kernels::ShadeCounts shaded =
+            k_.shade(view_, kernels::ShadeInput{rays, s.hits.view(), count, depth},
+                     kernels::ShadeOutput{level.color.view(), s.shadows.view(),
+                                          level.next.view(), level.next_links.view()});
+        k_.any_hit(view_, s.shadows.view(), shaded.shadow, s.shadows.occluded.data());
+        counts.shadow += shaded.shadow;
+        counts.reflected += shaded.reflected;
+        counts.refracted += shaded.refracted;
+        // Visible light terms join their parent's color in light order.
+        add_visible_terms(s.shadows, shaded.shadow, level.color.view());
+
+        // The children, a chunk at a time; a traced child's tail is factor * (the child's
+        // color), as the reference's factor * trace(child), so the images agree bit for
+        // bit. (Shade never spawns children at max_depth: s.levels has room.)
+        const kernels::RayStream next = level.next.view();
+        const kernels::ChildLinks links = level.next_links.view();
+        for (std::uint32_t first = 0; first < shaded.next; first += ray_chunk_) {
+            const std::uint32_t n = std::min(ray_chunk_, shaded.next - first);
+            trace_generation(depth + 1, offset(next, first), n, s, counts);
+            resolve_into_parents(s.levels[static_cast<std::size_t>(depth) + 1].color.view(),
+                                 offset(links, first), n, level.color.view());
+        }
+    }
+
     const CompiledScene& scene_;
     kernels::SceneView view_;
     const kernels::KernelTable& k_;
     std::uint32_t frame_;
+    std::uint32_t ray_chunk_;  // rays traced at once per generation: whole 16-ray packets
     std::vector<float> center_x_, center_y_;
 };
 
@@ -419,35 +492,46 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     }
     const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
     const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
-    tbb::enumerable_thread_specific<TileScratch> scratch;
+    tbb::enumerable_thread_specific<RayCounts> counts;
+    tbb::enumerable_thread_specific<std::uint64_t> scratch_bytes(std::uint64_t{0});
     TileControl control(options);
+    const std::uint32_t ray_chunk =
+        options.ray_chunk == 0
+            ? kDefaultRayChunk
+            : (std::max<std::uint32_t>(options.ray_chunk, 1u) + 15u) / 16u * 16u;
 
     // The spheres' BVH (options.accel), built on the render's threads and timed with it.
     SphereBvh bvh;
     const bool use_bvh = accel_uses_bvh(options.accel, scene.spheres.count);
     const auto render_tiles = [&] {
         if (use_bvh) bvh = build_sphere_bvh(scene.spheres);
-        const PacketTracer tracer(scene, table, options.frame, use_bvh ? &bvh : nullptr);
+        const PacketTracer tracer(scene, table, options.frame, use_bvh ? &bvh : nullptr,
+                                  ray_chunk);
         tbb::parallel_for(
             tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
             [&](const tbb::blocked_range<int>& range) {
-                TileScratch& s = scratch.local();
+                TileScratch& s = scratch_for_thread();
+                RayCounts& c = counts.local();
                 for (int t = range.begin(); t < range.end(); ++t) {
                     if (!control.proceed()) return;
                     const int x0 = rect.x0 + (t % tiles_x) * tw;
                     const int y0 = rect.y0 + (t / tiles_x) * th;
                     const Tile tile{x0, y0, std::min(tw, rect.x1 - x0),
                                     std::min(th, rect.y1 - y0)};
-                    tracer.render_tile(tile, s, target);
+                    tracer.render_tile(tile, s, target, c);
                     control.done(static_cast<std::uint64_t>(tile.width) *
                                  static_cast<std::uint64_t>(tile.height));
                 }
+                std::uint64_t& bytes = scratch_bytes.local();
+                bytes = std::max(bytes, s.bytes());
             },
             tbb::auto_partitioner());
     };
     run_with_threads(options.threads, render_tiles);
     control.finish();
-    for (const TileScratch& s : scratch) result.rays += s.counts;
+    for (const RayCounts& c : counts) result.rays += c;
+    for (std::uint64_t bytes : scratch_bytes)
+        result.scratch_bytes = std::max(result.scratch_bytes, bytes);
     result.bvh_seconds = use_bvh ? bvh.build_seconds : 0.0;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,8 +1,11 @@
 #pragma once
-// The SIMD packet renderer: tiles of 8-wide SoA ray packets traced breadth-first through
-// the kernels of kernels/ (render/README.md, "The packet path"). It implements the same
+// The SIMD packet renderer: tiles of 8-wide SoA ray packets traced generation by
+// generation, in chunks of at most RenderOptions::ray_chunk rays, through the kernels of
+// kernels/ (render/README.md, "The packet path"). It implements the same
 // rendering model as the scalar reference (render/reference.h) and is checked against it
 // by `octray verify` and tests/render/packet_renderer_test.cpp.
+
+#include <cstdint>
 
 #include "kernels/isa.h"
 #include "kernels/kernel_table.h"
@@ -11,6 +14,11 @@
 #include "scene/scene.h"
 
 namespace octray {
+
+// Rays a tile traces at once per generation of its ray tree when RenderOptions::ray_chunk
+// is 0: a multiple of the widest packet (16 rays). A tile's scratch then holds at most this
+// many rays per generation, whatever the depth and the samples per pixel.
+inline constexpr std::uint32_t kDefaultRayChunk = 4096;
 
 // Renders the whole image with the kernels of `isa` (Isa::automatic: the best the CPU
 // has; a forced ISA the CPU lacks throws std::runtime_error). Tiles of

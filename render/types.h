@@ -86,6 +86,11 @@ struct RenderOptions {
     // builds a BVH from kBvhAutoMinSpheres spheres on. The image is the same either way;
     // the scalar reference ignores it (brute force always).
     Accel accel = Accel::automatic;
+    // The SIMD path traces each generation of a tile's ray tree at most this many rays at
+    // a time, depth first (render/README.md, "Bounded memory"), rounded up to a multiple
+    // of 16; 0: kDefaultRayChunk (4096). The image is the same for any value; tests make
+    // it small to cross many chunk boundaries.
+    std::uint32_t ray_chunk = 0;
 };
 
 // Thrown by a render stopped through RenderOptions::cancel: no image is returned.
@@ -111,6 +116,10 @@ struct RenderResult {
     // render did neither: a precompiled scene, no BVH; summed over progressive passes).
     double compile_seconds = 0.0;
     double bvh_seconds = 0.0;
+    // The SIMD path: the largest tile scratch (bytes) of a thread that rendered tiles, after
+    // the render. A thread keeps its scratch from render to render and it never shrinks,
+    // so this is that thread's high-water mark so far. 0 for the scalar reference.
+    std::uint64_t scratch_bytes = 0;
 };
 
 }  // namespace octray

@@ -66,17 +66,22 @@ constexpr std::uint64_t kBvhPageRounding = 8 * (std::uint64_t{2} << 20);
 // while the batch keeps the loaded one.
 constexpr std::uint64_t kAuthoredCopies = 2;
 
-// render/packet_renderer.cpp TileScratch, per camera sample of a tile (S = tile pixels *
-// spp): samples 5 columns; rays and next 10 columns each, each grown to 2 S (next is
-// reserved at twice the live count); hits 2 columns; the primary pixel index.
-constexpr std::uint64_t kTileBytesPerSample = 5 * 4 + 2 * (10 * 4 * 2) + 2 * 4 + 4;
-// Shadow rays: 12 columns per (ray, light).
+// render/packet_renderer.cpp TileScratch. A tile traces each generation of its ray tree
+// in chunks of at most kTileRayChunk rays (its kDefaultRayChunk), depth first; a stream of
+// n rays has n rounded up to a packet plus a spare packet in each column (at most n + 16).
+// Per ray of the camera-sample chunk: samples 5 columns, primary rays 10.
+constexpr std::uint64_t kTileRayChunk = 4096;
+constexpr std::uint64_t kTileStreamSlack = 16;
+constexpr std::uint64_t kTileBytesPerSample = 5 * 4 + 10 * 4;
+// Per ray of the largest chunk of any generation: hits 2 columns; shadow rays 12 columns
+// per (ray, light).
+constexpr std::uint64_t kTileBytesPerChunkRay = 2 * 4;
 constexpr std::uint64_t kTileBytesPerShadowRay = 12 * 4;
-// Per generation of the ray tree (max_depth + 2 generations): 9 color columns per ray
-// and 4 link columns reserved at twice the count.
-constexpr std::uint64_t kTileBytesPerGenerationSample = 9 * 4 + 2 * (4 * 4);
-// The tile's three accumulators per pixel.
-constexpr std::uint64_t kTileBytesPerPixel = 3 * 4;
+// Per ray of a generation's chunk (max_depth + 1 generations): 9 color columns, and its
+// children: 10 ray columns and 4 link columns at twice the count.
+constexpr std::uint64_t kTileBytesPerGenerationRay = 9 * 4 + 2 * (10 * 4 + 4 * 4);
+// The tile's three accumulators and its pixel order, per pixel.
+constexpr std::uint64_t kTileBytesPerPixel = 3 * 4 + 4;
 
 // Measured (peak resident set size of `octray render`, Debian 12, glibc malloc): the
 // process rendering a 1x1 image of a small scene, code, libraries and TBB's threads
@@ -185,12 +190,23 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
             sat_mul(std::min(u64(std::max(params.tile_width, 1)), width),
                     std::min(u64(std::max(params.tile_height, 1)), height));
         const std::uint64_t samples = sat_mul(tile_pixels, u64(scene.image.spp));
-        const std::uint64_t generations = u64(scene.render.max_depth) + 2;
-        std::uint64_t per_sample = kTileBytesPerSample;
-        per_sample = sat_add(per_sample, sat_mul(lights, kTileBytesPerShadowRay));
-        per_sample = sat_add(per_sample, sat_mul(generations, kTileBytesPerGenerationSample));
+        // Generation d holds min(chunk, 2^d C) rays at a time, C the camera-sample chunk.
+        const std::uint64_t first_chunk = std::min(samples, kTileRayChunk);
+        std::uint64_t per_thread =
+            sat_add(sat_mul(first_chunk + kTileStreamSlack, kTileBytesPerSample),
+                    sat_mul(tile_pixels, kTileBytesPerPixel));
+        std::uint64_t largest = 0, chunk = first_chunk;
+        for (int d = 0; d <= std::max(scene.render.max_depth, 0); ++d) {
+            largest = std::max(largest, chunk);
+            per_thread = sat_add(per_thread,
+                                 sat_mul(chunk + kTileStreamSlack, kTileBytesPerGenerationRay));
+            chunk = std::min(sat_mul(chunk, 2), kTileRayChunk);
+        }
+        per_thread =
+            sat_add(per_thread, sat_mul(largest + kTileStreamSlack, kTileBytesPerChunkRay));
         e.per_thread =
-            sat_add(sat_mul(samples, per_sample), sat_mul(tile_pixels, kTileBytesPerPixel));
+            sat_add(per_thread, sat_mul(sat_add(sat_mul(largest, lights), kTileStreamSlack),
+                                        kTileBytesPerShadowRay));
     }
     unsigned threads = params.threads > 0 ? static_cast<unsigned>(params.threads)
                                           : std::thread::hardware_concurrency();

@@ -9,8 +9,9 @@
 // plus the process's own fixed footprint and the parse of a scene file; it is meant to be
 // an upper bound of the peak resident set size (tests/tools/memory_estimate_test.cpp
 // measures it). It errs on the high side: the packet path's per-thread ray streams are
-// sized as if every ray of every generation of a tile lived at once, the BVH's build
-// buffers as if they lived through the render.
+// sized as if every generation of a tile held a full chunk of rays at once
+// (tests/render/packet_renderer_test.cpp checks a thread's scratch against it), the BVH's
+// build buffers as if they lived through the render.
 
 #include <cstdint>
 #include <optional>

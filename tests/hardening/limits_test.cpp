@@ -89,16 +89,23 @@ TEST(RenderMemory, PacketScratchGrowsWithSppLightsDepthAndThreads) {
     EXPECT_EQ(e1.threads, 2u);
     EXPECT_EQ(e1.total, e1.framebuffer + e1.output + e1.scene + e1.fixed + 2 * e1.per_thread);
 
+    // More samples per pixel fill a tile's chunk of rays (16 x 16 x 16 = 4096, a whole
+    // chunk); beyond it, the tile traces more chunks, not bigger ones.
     const RenderMemoryEstimate e16 = estimate_render_memory(image_scene(640, 480, 16), p);
-    EXPECT_GT(e16.per_thread, 15 * e1.per_thread);
+    EXPECT_GT(e16.per_thread, e1.per_thread + (4096u - 256u) * 100u);
+    EXPECT_EQ(estimate_render_memory(image_scene(640, 480, 1000000), p).per_thread,
+              e16.per_thread);
 
     Scene lights = base;
     lights.lights.resize(100, lights.lights.front());
     EXPECT_GT(estimate_render_memory(lights, p).per_thread, e1.per_thread + 256u * 90u * 48u);
 
+    // A generation more, a chunk more (not twice the rays: the chunks bound them).
     Scene deep = base;
     deep.render.max_depth = 64;
-    EXPECT_GT(estimate_render_memory(deep, p).per_thread, e1.per_thread);
+    const std::uint64_t deep_bytes = estimate_render_memory(deep, p).per_thread;
+    EXPECT_GT(deep_bytes, e1.per_thread + 59u * 4096u * 100u);
+    EXPECT_LT(deep_bytes, std::uint64_t{64} << 20);
 
     p.threads = 8;
     EXPECT_EQ(estimate_render_memory(base, p).total, e1.total + 6 * e1.per_thread);
@@ -114,9 +121,9 @@ TEST(RenderMemory, TilesNeverExceedTheImage) {
 }
 
 TEST(RenderMemory, SaturatesInsteadOfOverflowing) {
-    // 2^31 - 1 spp on a 46340 x 46340 image: pixels * spp * bytes is far beyond 2^64.
+    // 2^31 - 1 threads, each with a 46340 x 46340 tile's accumulators: far beyond 2^64.
     RenderMemoryParams p;
-    p.threads = 1 << 20;
+    p.threads = std::numeric_limits<int>::max();
     p.tile_width = 46340;
     p.tile_height = 46340;
     Scene s = image_scene(46340, 46340, std::numeric_limits<int>::max());
@@ -149,15 +156,17 @@ TEST(MemoryLimit, RefusesUpFrontWithTheEstimateInTheMessage) {
     EXPECT_THROW(check_memory_limit(s, e.total - 1, p), SceneError);
 }
 
-TEST(MemoryLimit, HugeSppIsRefusedThroughThePacketScratch) {
-    // A small image, but 16 x 16 tiles of 10^6 samples each: the packet path's per-tile
-    // streams, not the framebuffer, are what would exhaust memory.
+TEST(MemoryLimit, HugeSppIsBoundedByTheTileChunks) {
+    // A small image with 16 x 16 tiles of 10^6 samples each: the packet path traces them a
+    // chunk at a time (render/README.md, "Bounded memory"), so its scratch is that of any
+    // tile with a full chunk, and the render fits where the framebuffer does.
     Scene s = image_scene(64, 64, 1000000);
     RenderMemoryParams p;
     p.threads = 1;
-    EXPECT_THROW(check_memory_limit(s, 16 * kGiB, p), SceneError);
+    EXPECT_LT(estimate_render_memory(s, p).per_thread, 8 * kMiB);
+    EXPECT_NO_THROW(check_memory_limit(s, kGiB, p));
     p.packet_path = false;  // the reference renderer keeps one sample at a time
-    EXPECT_NO_THROW(check_memory_limit(s, 16 * kGiB, p));
+    EXPECT_NO_THROW(check_memory_limit(s, kGiB, p));
 }
 
 TEST(MemorySize, ParsesBinaryUnits) {

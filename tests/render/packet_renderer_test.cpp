@@ -14,10 +14,12 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "kernels/dispatch.h"
 #include "render/reference.h"
+#include "scene/limits.h"
 #include "scene/load.h"
 #include "scene_builders.h"
 
@@ -239,6 +241,79 @@ TEST(PacketRenderer, BitIdenticalForAnyThreadCountAndTileSize) {
             EXPECT_TRUE(r.image == one.image);
             EXPECT_EQ(r.rays.total(), one.rays.total());
         }
+}
+
+// Chunks of a generation (RenderOptions::ray_chunk) change no pixel and no ray count:
+// each ray is traced alone and each pixel adds its samples in order.
+TEST(PacketRenderer, RayChunksChangeNoPixel) {
+    for (CameraType camera : {CameraType::pinhole, CameraType::thinlens}) {
+        Scene s = feature_scene(camera);
+        s.image.spp = 4;
+        s.render.max_depth = 6;
+        const RenderResult whole = render_packet(s, {});
+        for (std::uint32_t chunk : {1u, 16u, 40u, 100u, 4096u}) {
+            SCOPED_TRACE("ray_chunk " + std::to_string(chunk));
+            RenderOptions o;
+            o.ray_chunk = chunk;
+            const RenderResult r = render_packet(s, o);
+            EXPECT_TRUE(r.image == whole.image);
+            EXPECT_EQ(r.rays.shadow, whole.rays.shadow);
+            EXPECT_EQ(r.rays.reflected, whole.rays.reflected);
+            EXPECT_EQ(r.rays.refracted, whole.rays.refracted);
+        }
+    }
+}
+
+// The worst case for a breadth-first tile: every bounce spawns a mirror and a refracted
+// ray that the weight cut-off never stops (reflect = transmit = 1), depth 8, the eye
+// inside nested glass shells. A generation then has up to 2^8 times the tile's samples;
+// in chunks, a thread's scratch stays within scene/limits' per-thread estimate (which
+// assumes one chunk per generation), and the image is still the reference's.
+TEST(PacketRenderer, MirrorAndGlassEverywhereStaysWithinBoundedMemory) {
+    Scene s = empty_scene(16, 16);
+    s.image.spp = 8;
+    s.render.max_depth = 8;
+    s.camera.eye = {0.0f, 0.0f, 0.0f};
+    s.camera.lookat = {0.0f, 0.0f, -1.0f};
+    s.camera.fov = 90.0f;
+    s.ambient = Rgb(0.1f);
+    Material glass = diffuse(Rgb(1.0f), 0.2f);
+    glass.reflect = Rgb(1.0f);
+    glass.transmit = 1.0f;
+    glass.ior = 1.1f;
+    const std::uint32_t m = add_material(s, glass);
+    for (int k = 1; k <= 6; ++k) add_sphere(s, {0, 0, 0}, float(k), m);
+    add_sphere(s, {0.3f, 0.2f, -0.5f}, 0.2f, m);
+    add_point_light(s, {0.5f, 0.5f, 0.5f}, Rgb(1.0f));
+
+    // A fresh thread with threads = 1 renders every tile itself, with a scratch of its own.
+    RenderResult chunked, reference;
+    std::thread([&] {
+        RenderOptions o;
+        o.threads = 1;
+        chunked = render_packet(s, o);
+    }).join();
+    reference = render_reference(s, {});
+    const std::uint64_t samples = 16 * 16 * 8;
+    const std::uint64_t secondary = chunked.rays.reflected + chunked.rays.refracted;
+    std::printf("  %llu secondary rays for %llu samples, scratch %llu bytes\n",
+                static_cast<unsigned long long>(secondary),
+                static_cast<unsigned long long>(samples),
+                static_cast<unsigned long long>(chunked.scratch_bytes));
+    // Breadth first, the deepest generations alone would hold many chunks of rays.
+    EXPECT_GT(secondary, 16 * std::uint64_t{kDefaultRayChunk});
+    EXPECT_TRUE(chunked.image == reference.image);
+    EXPECT_EQ(chunked.rays.reflected, reference.rays.reflected);
+    EXPECT_EQ(chunked.rays.refracted, reference.rays.refracted);
+
+    RenderMemoryParams params;
+    params.threads = 1;
+    const RenderMemoryEstimate estimate = estimate_render_memory(s, params);
+    EXPECT_GT(chunked.scratch_bytes, 0u);
+    EXPECT_LE(chunked.scratch_bytes, estimate.per_thread);
+    // ... and the estimate itself is bounded: a chunk per generation, far below the
+    // secondary rays' 56 bytes each.
+    EXPECT_LT(estimate.per_thread, secondary * 56 / 4);
 }
 
 TEST(PacketRenderer, ForcingAnIsaTheCpuLacksThrows) {
