@@ -620,6 +620,32 @@ ChannelImage read_image(const std::string& path) {
     fail(path, "not an image (neither an OpenEXR nor a PNG signature)");
 }
 
+ExrLayout read_exr_layout(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imf::Header& header = file.header();
+        ExrLayout layout;
+        layout.data_window = from_box(header.dataWindow());
+        layout.compression = from_imf(header.compression());
+        layout.tiled = header.hasTileDescription();
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+            layout.channels.push_back({it.name(), from_imf(it.channel().type)});
+        return layout;
+    } catch (...) {
+        fail_reading_exr(path);
+    }
+}
+
+void check_exr_pixel_data(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        checked_data_window(path, file.header());
+        check_exr_chunks(path, file);
+    } catch (...) {
+        fail_reading_exr(path);
+    }
+}
+
 ExrImage read_exr_image(const std::string& path) {
     const std::vector<unsigned char> signature = read_signature(path);
     if (signature.empty()) fail(path, "empty file, not an OpenEXR image");

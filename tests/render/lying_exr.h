@@ -188,8 +188,9 @@ inline void cut_first_chunk(const std::string& path, bool tiled) {
 
 // A file of HALF data declared FLOAT (declared_float) or of FLOAT data declared HALF.
 inline void write_lying_exr(const std::string& path, Imf::Compression compression,
-                            bool declared_float, bool tiled) {
-    write_smooth_exr(path, compression, declared_float ? Imf::HALF : Imf::FLOAT, tiled);
+                            bool declared_float, bool tiled, int width = 37, int height = 45) {
+    write_smooth_exr(path, compression, declared_float ? Imf::HALF : Imf::FLOAT, tiled, width,
+                     height);
     declare_channels_as(path, declared_float ? Imf::HALF : Imf::FLOAT,
                         declared_float ? Imf::FLOAT : Imf::HALF);
 }
