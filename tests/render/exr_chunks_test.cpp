@@ -112,6 +112,26 @@ TEST_F(ExrChunksTest, HonestMixedChannelFilesRead) {
     }
 }
 
+// Black frames, constant ones and single pixels: runs, flat B44 blocks, one-symbol PIZ.
+TEST_F(ExrChunksTest, ConstantAndTinyImagesRead) {
+    for (const auto& codec : all_exr_codecs()) {
+        for (const Imf::PixelType type : {Imf::HALF, Imf::FLOAT, Imf::UINT}) {
+            for (const float value : {0.0f, 3.0f}) {
+                for (const int size : {1, 3, 64}) {
+                    SCOPED_TRACE(std::string(codec.name) + " type " +
+                                 std::to_string(static_cast<int>(type)) + " value " +
+                                 std::to_string(value) + " size " + std::to_string(size));
+                    const ChannelImage image =
+                        testing::make_image(size, size + 1, {"R", "G", "B", "A"}, value);
+                    testing::write_test_exr(path("flat.exr"), image, type, codec.compression);
+                    const ChannelImage read = read_image(path("flat.exr"));
+                    EXPECT_NEAR(read.at(0, size - 1, size), value, 0.01f);  // B44, DWA: lossy
+                }
+            }
+        }
+    }
+}
+
 TEST(ExrChunkProblem, SizesAgainstTheHeader) {
     ExrChunkShape shape;
     shape.compression = ExrCompression::zip;
