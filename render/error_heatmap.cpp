@@ -53,8 +53,8 @@ constexpr float magma_knots[magma_knot_count][3] = {
 // Table index (0..255) of each knot: 0, 4, ..., 252, then 255.
 constexpr double knot_index(int k) { return k == magma_knot_count - 1 ? 255.0 : 4.0 * k; }
 
-// A 3x5 pixel font for the legend's numbers: each glyph is five rows of three bits, the
-// high bit on the left. Only what "%.3g" prints is here.
+// A 3x5 pixel font for the legend: each glyph is five rows of three bits, the high bit on
+// the left. Only what "%.3g" prints and the scale's names ("linear", "log", "x") are here.
 struct Glyph {
     char c;
     std::uint8_t rows[5];
@@ -64,7 +64,10 @@ constexpr Glyph glyphs[] = {
     {'3', {7, 1, 7, 1, 7}}, {'4', {5, 5, 7, 1, 1}}, {'5', {7, 4, 7, 1, 7}},
     {'6', {7, 4, 7, 5, 7}}, {'7', {7, 1, 1, 1, 1}}, {'8', {7, 5, 7, 5, 7}},
     {'9', {7, 5, 7, 1, 7}}, {'.', {0, 0, 0, 0, 2}}, {'e', {2, 5, 7, 4, 3}},
-    {'-', {0, 0, 7, 0, 0}}, {'+', {0, 2, 7, 2, 0}},
+    {'-', {0, 0, 7, 0, 0}}, {'+', {0, 2, 7, 2, 0}}, {'l', {6, 2, 2, 2, 7}},
+    {'i', {2, 0, 6, 2, 7}}, {'n', {0, 6, 5, 5, 5}}, {'a', {0, 3, 5, 5, 3}},
+    {'r', {0, 5, 6, 4, 4}}, {'o', {0, 2, 5, 5, 2}}, {'g', {3, 4, 5, 5, 3}},
+    {'x', {0, 0, 5, 2, 5}}, {' ', {0, 0, 0, 0, 0}},
 };
 
 constexpr int font_scale = 2;  // each font pixel is 2x2
@@ -121,6 +124,23 @@ std::string label(double value) {
 
 }  // namespace
 
+std::string_view to_string(HeatmapScale scale) {
+    return scale == HeatmapScale::log ? "log" : "linear";
+}
+
+std::optional<HeatmapScale> parse_heatmap_scale(std::string_view name) {
+    if (name == "linear") return HeatmapScale::linear;
+    if (name == "log") return HeatmapScale::log;
+    return std::nullopt;
+}
+
+double heatmap_position(double error, double scale_min, double scale_max, HeatmapScale scale) {
+    if (!(error > 0.0) || !(scale_max > 0.0)) return 0.0;
+    if (scale == HeatmapScale::linear) return std::min(error / scale_max, 1.0);
+    if (error <= scale_min) return 0.0;
+    return std::min(std::log10(error / scale_min) / std::log10(scale_max / scale_min), 1.0);
+}
+
 std::array<std::uint8_t, 3> magma_color(double t) {
     if (!(t > 0.0)) t = 0.0;
     if (t > 1.0) t = 1.0;
@@ -137,10 +157,14 @@ std::array<std::uint8_t, 3> magma_color(double t) {
 }
 
 ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
-                                  const CompareResult& result) {
+                                  const CompareResult& result, const HeatmapOptions& options) {
     ErrorHeatmap map;
     const int width = result.width, height = result.height;
-    map.scale_max = result.overall.max_abs_error;
+    map.scale_max = options.factor > 0.0 ? 1.0 / options.factor : result.overall.max_abs_error;
+    if (options.scale == HeatmapScale::log)
+        map.scale_min = map.scale_max * std::pow(10.0, -heatmap_log_decades);
+    map.legend = std::string(to_string(options.scale));
+    if (options.factor > 0.0) map.legend += " x" + label(options.factor);
     // Enlarge small images so a few pixels are visible, but keep huge ones as they are.
     map.zoom = std::clamp(min_canvas_width / std::max(width, 1), 1, 64);
     map.zoom = std::max(1, std::min(map.zoom, 4096 / std::max(height, 1)));
@@ -149,7 +173,7 @@ ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
     Rgb8Image& image = map.image;
     image.width = std::max(map_w, min_canvas_width);
     const int legend_top = map_h + margin;
-    image.height = legend_top + bar_height + 4 + glyph_height + margin;
+    image.height = legend_top + bar_height + 2 * (4 + glyph_height) + margin;
     image.rgb.resize(3 * static_cast<std::size_t>(image.width) * image.height);
     Canvas canvas(image);
     for (int y = 0; y < image.height; ++y)
@@ -171,14 +195,16 @@ ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
         }
         const std::array<std::uint8_t, 3> color =
             !finite ? heatmap_nonfinite_color
-                    : magma_color(map.scale_max > 0.0 ? error / map.scale_max : 0.0);
+                    : magma_color(
+                          heatmap_position(error, map.scale_min, map.scale_max, options.scale));
         const int x0 = static_cast<int>(i % static_cast<std::size_t>(width)) * map.zoom;
         const int y0 = static_cast<int>(i / static_cast<std::size_t>(width)) * map.zoom;
         for (int dy = 0; dy < map.zoom; ++dy)
             for (int dx = 0; dx < map.zoom; ++dx) canvas.set(x0 + dx, y0 + dy, color);
     }
 
-    // The legend: the ramp from 0 to scale_max, with 0, the middle and the top printed.
+    // The legend: the ramp from its bottom to its top, with the bottom, the middle (the
+    // geometric middle on the log scale) and the top printed, and the scale's name below.
     map.bar_x0 = margin;
     map.bar_x1 = image.width - margin;
     map.bar_y0 = legend_top;
@@ -189,19 +215,26 @@ ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
         for (int y = map.bar_y0; y < map.bar_y1; ++y) canvas.set(x, y, color);
     }
     const int text_y = map.bar_y1 + 4;
-    const std::string low = "0", mid = label(map.scale_max / 2), high = label(map.scale_max);
+    const bool log = options.scale == HeatmapScale::log;
+    const std::string low = label(map.scale_min),
+                      mid = label(log ? std::sqrt(map.scale_min * map.scale_max)
+                                      : map.scale_max / 2),
+                      high = label(map.scale_max);
     canvas.text(map.bar_x0, text_y, low);
     if (map.scale_max > 0.0) {
         canvas.text((map.bar_x0 + map.bar_x1 - text_width(mid)) / 2, text_y, mid);
         canvas.text(map.bar_x1 - text_width(high), text_y, high);
     }
+    canvas.text(map.bar_x0, text_y + glyph_height + 4, map.legend);
     return map;
 }
 
-void write_error_heatmap(const std::string& path, const ChannelImage& a, const ChannelImage& b,
-                         const CompareResult& result) {
-    const ErrorHeatmap map = render_error_heatmap(a, b, result);
+ErrorHeatmap write_error_heatmap(const std::string& path, const ChannelImage& a,
+                                 const ChannelImage& b, const CompareResult& result,
+                                 const HeatmapOptions& options) {
+    const ErrorHeatmap map = render_error_heatmap(a, b, result, options);
     write_png_rgb8(path, map.image.width, map.image.height, map.image.rgb);
+    return map;
 }
 
 }  // namespace octray

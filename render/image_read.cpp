@@ -12,6 +12,7 @@
 #include <ImfRationalAttribute.h>
 #include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
+#include <ImfTileDescription.h>
 #include <ImfVersion.h>
 #include <png.h>
 
@@ -31,6 +32,7 @@
 #include <system_error>
 #include <utility>
 
+#include "render/exr_chunks.h"
 #include "render/image_io.h"
 
 namespace octray {
@@ -221,12 +223,126 @@ std::pair<long long, long long> checked_data_window(const std::string& path,
     return {w, h};
 }
 
+ExrCompression from_imf(Imf::Compression compression) {
+    switch (compression) {
+        case Imf::NO_COMPRESSION:
+            return ExrCompression::none;
+        case Imf::RLE_COMPRESSION:
+            return ExrCompression::rle;
+        case Imf::ZIPS_COMPRESSION:
+            return ExrCompression::zips;
+        case Imf::ZIP_COMPRESSION:
+            return ExrCompression::zip;
+        case Imf::PIZ_COMPRESSION:
+            return ExrCompression::piz;
+        case Imf::PXR24_COMPRESSION:
+            return ExrCompression::pxr24;
+        case Imf::B44_COMPRESSION:
+            return ExrCompression::b44;
+        case Imf::B44A_COMPRESSION:
+            return ExrCompression::b44a;
+        case Imf::DWAA_COMPRESSION:
+            return ExrCompression::dwaa;
+        case Imf::DWAB_COMPRESSION:
+            return ExrCompression::dwab;
+        default:
+            return ExrCompression::zip;  // a codec newer than this list
+    }
+}
+
+ExrPixelType from_imf(Imf::PixelType type) {
+    return type == Imf::HALF    ? ExrPixelType::half
+           : type == Imf::FLOAT ? ExrPixelType::float32
+                                : ExrPixelType::uint32;
+}
+
+// "R, G, B float; id uint": the channels as the header declares them, for messages.
+std::string declared_channels(const Imf::Header& header) {
+    std::string out;
+    std::string names;
+    Imf::PixelType previous = Imf::NUM_PIXELTYPES;
+    int shown = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        if (++shown > 8) {
+            names += ", ...";
+            break;
+        }
+        if (it.channel().type != previous && !names.empty()) {
+            out += (out.empty() ? "" : "; ") + names + " " +
+                   std::string(to_string(from_imf(previous)));
+            names.clear();
+        }
+        names += (names.empty() ? "" : ", ") + std::string(it.name());
+        previous = it.channel().type;
+    }
+    if (!names.empty())
+        out += (out.empty() ? "" : "; ") + names + " " +
+               std::string(to_string(from_imf(previous)));
+    return out;
+}
+
+// Every chunk readPixels() will decode (level 0 of a tiled file) against the size its
+// header implies (render/exr_chunks.h): OpenEXR 3.1 reads a file whose header declares
+// FLOAT channels over ZIP-compressed HALF data as garbage, without an error.
+void check_exr_chunks(const std::string& path, Imf::InputFile& file) {
+    const Imf::Header& header = file.header();
+    ExrChunkShape shape;
+    shape.compression = from_imf(header.compression());
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+        shape.channels.push_back({it.name(), from_imf(it.channel().type)});
+    const Imath::Box2i window = header.dataWindow();
+    const std::int64_t w = std::int64_t{window.max.x} - window.min.x + 1;
+    const std::int64_t h = std::int64_t{window.max.y} - window.min.y + 1;
+    const auto check = [&](const char* data, int size, const std::string& where) {
+        if (size < 0) fail(path, "corrupt OpenEXR file (" + where + " has a negative size)");
+        const std::string problem =
+            exr_chunk_problem(shape, reinterpret_cast<const unsigned char*>(data),
+                              static_cast<std::size_t>(size));
+        if (!problem.empty())
+            fail(path, "corrupt OpenEXR file: " + where + " " + problem +
+                           " (the header declares " + declared_channels(header) + ", " +
+                           std::string(to_string(shape.compression)) + " compression)");
+    };
+    if (header.hasTileDescription()) {
+        const Imf::TileDescription& tiles = header.tileDescription();
+        const std::int64_t tw = tiles.xSize, th = tiles.ySize;
+        if (tw <= 0 || th <= 0) fail(path, "corrupt OpenEXR file (an empty tile size)");
+        for (std::int64_t ty = 0; ty * th < h; ++ty) {
+            for (std::int64_t tx = 0; tx * tw < w; ++tx) {
+                int dx = static_cast<int>(tx), dy = static_cast<int>(ty), lx = 0, ly = 0;
+                const char* data = nullptr;
+                int size = 0;
+                file.rawTileData(dx, dy, lx, ly, data, size);
+                shape.width = std::min(tw, w - tx * tw);
+                shape.height = std::min(th, h - ty * th);
+                check(data, size,
+                      "the tile (" + std::to_string(tx) + ", " + std::to_string(ty) + ")");
+            }
+        }
+        return;
+    }
+    const int lines = exr_lines_per_chunk(shape.compression);
+    shape.width = w;
+    for (std::int64_t y = window.min.y; y <= window.max.y; y += lines) {
+        const char* data = nullptr;
+        int size = 0;
+        file.rawPixelData(static_cast<int>(y), data, size);
+        shape.height = std::min<std::int64_t>(lines, window.max.y - y + 1);
+        const std::int64_t last = y + shape.height - 1;
+        check(data, size,
+              shape.height == 1 ? "the chunk of scan line " + std::to_string(y)
+                                : "the chunk of scan lines " + std::to_string(y) + " to " +
+                                      std::to_string(last));
+    }
+}
+
 ChannelImage read_exr_file(const std::string& path) {
     try {
         Imf::InputFile file(path.c_str());
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
         const auto [w, h] = checked_data_window(path, header);
+        check_exr_chunks(path, file);
 
         std::vector<std::string> names;
         std::set<Imf::PixelType> types;
@@ -258,33 +374,6 @@ ChannelImage read_exr_file(const std::string& path) {
         return image;
     } catch (...) {
         fail_reading_exr(path);
-    }
-}
-
-ExrCompression from_imf(Imf::Compression compression) {
-    switch (compression) {
-        case Imf::NO_COMPRESSION:
-            return ExrCompression::none;
-        case Imf::RLE_COMPRESSION:
-            return ExrCompression::rle;
-        case Imf::ZIPS_COMPRESSION:
-            return ExrCompression::zips;
-        case Imf::ZIP_COMPRESSION:
-            return ExrCompression::zip;
-        case Imf::PIZ_COMPRESSION:
-            return ExrCompression::piz;
-        case Imf::PXR24_COMPRESSION:
-            return ExrCompression::pxr24;
-        case Imf::B44_COMPRESSION:
-            return ExrCompression::b44;
-        case Imf::B44A_COMPRESSION:
-            return ExrCompression::b44a;
-        case Imf::DWAA_COMPRESSION:
-            return ExrCompression::dwaa;
-        case Imf::DWAB_COMPRESSION:
-            return ExrCompression::dwab;
-        default:
-            return ExrCompression::zip;  // a codec newer than this list
     }
 }
 
@@ -338,6 +427,7 @@ ExrImage read_exr_image_file(const std::string& path) {
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
         const auto [w, h] = checked_data_window(path, header);
+        check_exr_chunks(path, file);
         const Imath::Box2i display = header.displayWindow();
         if (static_cast<long long>(display.max.x) < display.min.x ||
             static_cast<long long>(display.max.y) < display.min.y)
@@ -352,9 +442,7 @@ ExrImage read_exr_image_file(const std::string& path) {
         Imf::FrameBuffer frame_buffer;
         for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
             const Imf::PixelType t = it.channel().type;
-            const ExrPixelType type = t == Imf::HALF    ? ExrPixelType::half
-                                      : t == Imf::FLOAT ? ExrPixelType::float32
-                                                        : ExrPixelType::uint32;
+            const ExrPixelType type = from_imf(t);
             const std::size_t element = sample_size(type);
             image.channels.push_back(
                 ExrChannel{it.name(), type, std::vector<unsigned char>(pixels * element)});
@@ -530,6 +618,32 @@ ChannelImage read_image(const std::string& path) {
             break;
     }
     fail(path, "not an image (neither an OpenEXR nor a PNG signature)");
+}
+
+ExrLayout read_exr_layout(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imf::Header& header = file.header();
+        ExrLayout layout;
+        layout.data_window = from_box(header.dataWindow());
+        layout.compression = from_imf(header.compression());
+        layout.tiled = header.hasTileDescription();
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+            layout.channels.push_back({it.name(), from_imf(it.channel().type)});
+        return layout;
+    } catch (...) {
+        fail_reading_exr(path);
+    }
+}
+
+void check_exr_pixel_data(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        checked_data_window(path, file.header());
+        check_exr_chunks(path, file);
+    } catch (...) {
+        fail_reading_exr(path);
+    }
 }
 
 ExrImage read_exr_image(const std::string& path) {

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "render/exr_chunks.h"
 #include "render/image_io.h"
 
 namespace octray {
@@ -66,5 +67,20 @@ ChannelImage read_image(const std::string& path);
 // the same image again. Throws IoError naming the path and the reason, as read_image()
 // does; also for a PNG or a subsampled channel.
 ExrImage read_exr_image(const std::string& path);
+
+// What an OpenEXR file's header declares, read without the pixels: its data window, its
+// channels (in the file's order) and codec, and whether it is tiled.
+struct ExrLayout {
+    PixelRect data_window;
+    std::vector<ExrChunkChannel> channels;
+    ExrCompression compression = ExrCompression::none;
+    bool tiled = false;
+};
+ExrLayout read_exr_layout(const std::string& path);
+
+// The check read_image() and read_exr_image() make before decoding: every chunk they
+// decode (level 0 of a tiled file) holds what its header implies (render/exr_chunks.h).
+// Throws IoError naming the path and the first chunk that does not.
+void check_exr_pixel_data(const std::string& path);
 
 }  // namespace octray

@@ -3,6 +3,7 @@
 // and the exit codes are idiff's; render/COMPARE.md defines them.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <iostream>
@@ -32,6 +33,8 @@ struct CompareArguments {
     CompareOptions options;
     std::string diff;
     std::string heatmap;
+    std::string heatmap_scale = "linear";  // --heatmapscale
+    double scale = -1.0;                   // --scale; < 0: not given
     bool json = false;
 };
 
@@ -48,6 +51,17 @@ void print_json_outcome(const CompareArguments& args, std::string_view verdict, 
 }
 
 void run_compare(const CompareArguments& args) {
+    HeatmapOptions heatmap;
+    heatmap.factor = std::max(args.scale, 0.0);
+    heatmap.scale = parse_heatmap_scale(args.heatmap_scale).value_or(HeatmapScale::linear);
+    if (args.scale == 0.0)
+        throw UsageError(
+            "--scale: expected a factor greater than 0, found 0 (it would map "
+            "every error to black)");
+    if (args.heatmap.empty() && (args.scale >= 0.0 || args.heatmap_scale != "linear"))
+        throw UsageError(std::string(args.scale >= 0.0 ? "--scale" : "--heatmapscale") +
+                         " sets how the --heatmap picture maps errors to colours, and no "
+                         "--heatmap FILE.png was given");
     if (!args.diff.empty())
         require_image_format("--diff", args.diff, /*png_accepted=*/false,
                              "--diff is |A - B| in float; for a PNG picture of the error "
@@ -76,7 +90,8 @@ void run_compare(const CompareArguments& args) {
 
     // The outputs first: a file that cannot be written is exit 4, whatever the verdict.
     if (!args.diff.empty()) write_channel_exr(args.diff, difference_image(a, b, result));
-    if (!args.heatmap.empty()) write_error_heatmap(args.heatmap, a, b, result);
+    ErrorHeatmap map;
+    if (!args.heatmap.empty()) map = write_error_heatmap(args.heatmap, a, b, result, heatmap);
 
     if (args.json) {
         std::cout << format_compare_json(result, args.options, args.a, args.b) << std::flush;
@@ -84,8 +99,8 @@ void run_compare(const CompareArguments& args) {
         // The reason stays the last line, where scripts and people look for it.
         if (!args.diff.empty()) std::cout << "wrote " << args.diff << " (|A - B|, float)\n";
         if (!args.heatmap.empty())
-            std::cout << "wrote " << args.heatmap << " (error heatmap, 0 to "
-                      << result.overall.max_abs_error << ")\n";
+            std::cout << "wrote " << args.heatmap << " (error heatmap, " << map.legend << ": "
+                      << map.scale_min << " to " << map.scale_max << ")\n";
         std::cout << format_compare_report(result, args.options, args.a, args.b) << std::flush;
     }
     if (!std::cout)
@@ -164,6 +179,17 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
                     "Write a PNG heatmap of the largest channel error per pixel (magma,\n"
                     "0 to the max error, legend below; NaN/Inf in green)")
         ->type_name("FILE");
+    cmd->add_option("--heatmapscale", args->heatmap_scale,
+                    "How --heatmap maps errors to colours: linear (0 to the top) or log\n"
+                    "(the 6 decades below the top, so small errors stay visible)")
+        ->type_name("linear|log")
+        ->check(CLI::IsMember({"linear", "log"}).description(""))
+        ->capture_default_str();
+    cmd->add_option("--scale", args->scale,
+                    "Multiply the error by F before --heatmap maps it (as idiff's -scale):\n"
+                    "the top of the ramp is then 1/F, not the largest error (F > 0)")
+        ->type_name("F")
+        ->transform(real_number(0.0, kMaxThreshold, false));
     cmd->add_flag("--json", args->json, "Print the figures as JSON instead of the report");
     cmd->footer(
         "NaN or Inf in either image is an infinite error: the pixel fails and is counted;\n"
@@ -175,6 +201,7 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
         "  octray compare ref.exr out.exr\n"
         "  octray compare ref.exr out.exr --fail 0.004 --failpercent 0.1 --warn 0.001\n"
         "  octray compare ref.exr out.exr --channels R,G,B --heatmap err.png --diff err.exr\n"
+        "  octray compare ref.exr out.exr --heatmap err.png --heatmapscale log --scale 100\n"
         "  octray compare ref.png out.png --json\n\n" +
         compare_exit_code_help());
     cmd->callback([args, &run] { run.action = [args] { run_compare(*args); }; });

@@ -1,9 +1,5 @@
 #include "tools/render_batch.h"
 
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
-#include <OpenEXR/ImfIntAttribute.h>
-#include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
 #include <fcntl.h>
 #include <oneapi/tbb/global_control.h>
@@ -11,12 +7,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <new>
 #include <system_error>
 #include <utility>
@@ -25,6 +23,7 @@
 #include "kernels/dispatch.h"
 #include "render/aov.h"
 #include "render/camera_matrices.h"
+#include "render/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/progressive.h"
 #include "render/reference.h"
@@ -76,33 +75,47 @@ std::pair<std::string, float> capture_date() {
 
 // A finished frame: a non-empty file that is not an unfinished --progressive pass.
 // An empty file is a --placeholders claim; an unfinished pass is a claim of its owner
-// (tools/claim_owner.h) while that run lives.
-enum class Existing { none, claim, finished, unfinished };
+// (tools/claim_owner.h) while that run lives. An OpenEXR file that cannot be read whole
+// (cut off, or its header lying about its pixel data) is damaged: resuming never takes it
+// for a finished frame, nor renders over what it did not write.
+enum class Existing { none, claim, finished, unfinished, damaged };
 
 struct Found {
     Existing kind = Existing::none;
     std::string owner;  // octray.owner of an unfinished pass ("" if it has none)
+    std::string error;  // why a damaged file cannot be read
 };
+
+bool has_exr_signature(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::array<char, 4> magic{};
+    in.read(magic.data(), magic.size());
+    return in.gcount() == 4 && magic == std::array<char, 4>{0x76, 0x2f, 0x31, 0x01};
+}
 
 Found existing_output(const std::string& path) {
     std::error_code error;
-    if (!fs::exists(path, error)) return {Existing::none, {}};
+    if (!fs::exists(path, error)) return {Existing::none, {}, {}};
     const auto size = fs::file_size(path, error);
-    if (error) return {Existing::finished, {}};  // not a regular file: never overwrite it
-    if (size == 0) return {Existing::claim, {}};
+    if (error) return {Existing::finished, {}, {}};  // not a regular file: never overwrite it
+    if (size == 0) return {Existing::claim, {}, {}};
+    // Not an EXR (a PNG preview target): it exists. An EXR gets the checked read that
+    // `compare` and `assemble` use (render/image_read.h), every chunk against its header.
+    if (!has_exr_signature(path)) return {Existing::finished, {}, {}};
+    ExrImage image;
     try {
-        Imf::InputFile file(path.c_str());
-        const auto* samples =
-            file.header().findTypedAttribute<Imf::IntAttribute>(kSamplesSoFarAttribute);
-        if (samples != nullptr) {
-            const auto* owner =
-                file.header().findTypedAttribute<Imf::StringAttribute>(kOwnerAttribute);
-            return {Existing::unfinished, owner != nullptr ? owner->value() : std::string()};
-        }
-    } catch (const std::exception&) {
-        // Not an EXR octray can read (a PNG preview target, or a damaged file): it exists.
+        image = read_exr_image(path);
+    } catch (const IoError& e) {
+        return {Existing::damaged, {}, e.what()};
     }
-    return {Existing::finished, {}};
+    for (const auto& [name, value] : image.attributes.ints) {
+        if (name != kSamplesSoFarAttribute) continue;
+        std::string owner;
+        for (const auto& [key, text] : image.attributes.strings)
+            if (key == kOwnerAttribute) owner = text;
+        return {Existing::unfinished, owner, {}};
+    }
+    return {Existing::finished, {}, {}};
 }
 
 // Takes over a stale unfinished image at `path` for --placeholders: replaces it by an
@@ -277,7 +290,22 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
     if (settings_.skip_existing || settings_.placeholders) {
         const Found found = existing_output(job.output);
         existing = found.kind;
-        if (!job.png.empty()) preview = existing_output(job.png).kind;
+        Found preview_found{preview, {}, {}};
+        if (!job.png.empty()) preview_found = existing_output(job.png);
+        preview = preview_found.kind;
+        const Found* const outputs[] = {&found, &preview_found};
+        for (const Found* damaged : outputs) {
+            if (damaged->kind != Existing::damaged) continue;
+            out.failure = FailureKind::io;
+            out.report.outcome = FrameOutcome::failed;
+            out.report.message = "I/O error: " + damaged->error +
+                                 "; not a finished frame, and left alone: remove it to "
+                                 "render the frame again";
+            progress_.note("octray: frame " + std::to_string(job.frame) + " of " + scene.spec +
+                           " failed: " + out.report.message);
+            progress_.frame_finished(out.report, work);
+            return out;
+        }
         if (existing == Existing::claim || preview == Existing::claim)
             return skip(FrameOutcome::skipped_claimed);
         if (existing == Existing::finished && preview == Existing::finished)

@@ -10,7 +10,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -131,6 +133,58 @@ inline bool check_builtin_spec(const std::string& spec) {
     return true;
 }
 
+// A value OpenEXR can hold in a channel of `type`: any half for HALF (NaN and Inf
+// included), a whole number in [0, 2^32] for UINT (a float rounds 2^32 - 1 up), anything for
+// FLOAT.
+inline bool fits_pixel_type(float v, ExrPixelType type) {
+    if (type == ExrPixelType::float32 || std::isnan(v)) return true;
+    if (type == ExrPixelType::uint32)
+        return v >= 0.0f && v <= 4294967296.0f && std::trunc(v) == v;  // 2^32 - 1 rounds up
+    if (std::isinf(v)) return true;
+    // half: 11 significant bits, exponents -24 (subnormal) to 15.
+    if (v == 0.0f) return true;
+    int exponent = 0;
+    const float mantissa = std::frexp(std::fabs(v), &exponent);  // v = m 2^e, m in [0.5, 1)
+    if (exponent > 16 || exponent < -23) return false;
+    const int bits = std::min(11, exponent + 24);  // subnormals keep fewer
+    const float scaled = std::ldexp(mantissa, bits);
+    return std::trunc(scaled) == scaled;
+}
+
+// An image read from an OpenEXR file agrees with the file's header: the data window, the
+// channels, the formats they were stored in, every value one that the declared type can
+// hold, and (the check behind "files that lie") every chunk unpacking to the size the
+// header implies.
+inline void check_exr_read_matches_header(const std::string& path, const ChannelImage& image) {
+    ExrLayout layout;
+    try {
+        layout = read_exr_layout(path);
+        check_exr_pixel_data(path);
+    } catch (const IoError& e) {
+        throw InvariantBroken("an EXR that reads has chunks matching its header", e.what());
+    }
+    const PixelRect& window = layout.data_window;
+    if (image.width != window.x1 - window.x0 || image.height != window.y1 - window.y0 ||
+        image.origin_x != window.x0 || image.origin_y != window.y0)
+        throw InvariantBroken("an EXR reads with its header's data window", image.format);
+    if (static_cast<std::size_t>(image.channel_count()) != layout.channels.size())
+        throw InvariantBroken("an EXR reads with its header's channels", image.format);
+    for (const ExrChunkChannel& channel : layout.channels) {
+        const int c = image.find_channel(channel.name);
+        if (c < 0)
+            throw InvariantBroken("an EXR reads with its header's channels", channel.name);
+        const std::string type(to_string(channel.type));
+        if (image.format.find(type) == std::string::npos)
+            throw InvariantBroken("the format names every declared type", image.format);
+        const float* plane = image.plane(c);
+        for (std::size_t i = 0; i < image.pixel_count(); ++i)
+            if (!fits_pixel_type(plane[i], channel.type))
+                throw InvariantBroken(
+                    "every value fits its declared type",
+                    channel.name + " (" + type + "): " + std::to_string(plane[i]));
+    }
+}
+
 // read_image on a file holding `bytes`: an IoError, or a consistent image.
 inline void check_image_file(const std::string& path) {
     ChannelImage image;
@@ -154,6 +208,7 @@ inline void check_image_file(const std::string& path) {
             throw InvariantBroken("PNG samples lie in [0, 1]", image.format);
         }
     }
+    if (!png) check_exr_read_matches_header(path, image);
 }
 
 // A private temporary file for the image fuzzer, made once per process, removed at exit.

@@ -1,6 +1,8 @@
 // Writes the seed corpus of fuzz_image_read (tests/fuzz/corpus/fuzz_image_read/): tiny
 // OpenEXR and PNG files covering the layouts render/image_read.h accepts. Written with
 // OpenEXR and libpng directly, so the seeds do not depend on the reader under test.
+// Also files that lie (tests/render/lying_exr.h): HALF data declared FLOAT for every codec,
+// FLOAT declared HALF, tiled ones, and chunks cut short.
 // Usage: octray_make_image_seeds DIR
 
 #include <ImfChannelList.h>
@@ -14,6 +16,8 @@
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "../render/lying_exr.h"
 
 namespace {
 
@@ -118,6 +122,21 @@ int main(int argc, char** argv) {
     exr_rgb_half(dir + "/rgb_half.exr");
     exr_mixed(dir + "/mixed_window.exr");
     exr_tiled(dir + "/tiled_rle.exr");
+    using namespace octray::testing;
+    for (const ExrCodec& codec : all_exr_codecs()) {
+        const std::string name = codec.name;
+        write_lying_exr(dir + "/lie_half_as_float_" + name + ".exr", codec.compression, true,
+                        false, 9, 7);
+        write_lying_exr(dir + "/lie_float_as_half_" + name + ".exr", codec.compression, false,
+                        false, 9, 7);
+    }
+    for (const Imf::Compression c : {Imf::ZIP_COMPRESSION, Imf::PIZ_COMPRESSION,
+                                     Imf::B44A_COMPRESSION, Imf::DWAA_COMPRESSION}) {
+        const std::string name = all_exr_codecs()[static_cast<std::size_t>(c)].name;
+        write_lying_exr(dir + "/lie_tiled_" + name + ".exr", c, true, true, 9, 7);
+        write_smooth_exr(dir + "/cut_" + name + ".exr", c, Imf::HALF, false, 9, 7);
+        cut_first_chunk(dir + "/cut_" + name + ".exr", false);
+    }
     png(dir + "/gray1.png", 5, 3, PNG_COLOR_TYPE_GRAY, 1);
     png(dir + "/gray16.png", 2, 2, PNG_COLOR_TYPE_GRAY, 16);
     png(dir + "/gray_alpha8.png", 2, 2, PNG_COLOR_TYPE_GRAY_ALPHA, 8);

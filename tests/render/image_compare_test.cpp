@@ -395,6 +395,78 @@ TEST(Heatmap, LargeImagesAreNotEnlargedAndZeroErrorIsBlack) {
     EXPECT_EQ(map.image.at(299, 1), magma_color(0.0));
 }
 
+// Issue 26: an error of 0.001 beside one of 1 is all but black on the linear 0..max scale;
+// a factor of 100 or the log scale make it visible.
+TEST(Heatmap, ScaleAndLogMakeSmallErrorsVisible) {
+    ChannelImage a = make_image(8, 4, rgb, 0.5f);
+    ChannelImage b = a;
+    b.at(0, 1, 1) = 1.5f;    // error 1: the largest
+    b.at(1, 2, 2) = 0.501f;  // error 0.001
+    const CompareResult r = compare_images(a, b);
+    const auto small = [&](const HeatmapOptions& options) {
+        const ErrorHeatmap map = render_error_heatmap(a, b, r, options);
+        const auto c = map.image.at(2 * map.zoom + map.zoom / 2, 2 * map.zoom + map.zoom / 2);
+        return std::max({c[0], c[1], c[2]});
+    };
+    EXPECT_LT(small({}), 12);                             // linear 0..1: black
+    EXPECT_GT(small({HeatmapScale::linear, 100.0}), 40);  // 0.1 of the ramp
+    EXPECT_GT(small({HeatmapScale::log, 0.0}), 150);      // the middle of 6 decades
+    EXPECT_GT(small({HeatmapScale::log, 100.0}), 150);
+
+    // The factor fixes the top of the ramp at 1 / F: the large error saturates.
+    const ErrorHeatmap scaled = render_error_heatmap(a, b, r, {HeatmapScale::linear, 100.0});
+    EXPECT_EQ(scaled.scale_max, 0.01);
+    EXPECT_EQ(scaled.image.at(scaled.zoom + 1, scaled.zoom + 1), magma_color(1.0));
+    const ErrorHeatmap log = render_error_heatmap(a, b, r, {HeatmapScale::log, 0.0});
+    EXPECT_EQ(log.scale_max, 1.0);
+    EXPECT_DOUBLE_EQ(log.scale_min, 1e-6);
+}
+
+TEST(Heatmap, TheLegendSaysWhichScale) {
+    ChannelImage a = make_image(8, 4, rgb, 0.5f);
+    ChannelImage b = a;
+    b.at(0, 1, 1) = 0.75f;
+    const CompareResult r = compare_images(a, b);
+    // Lit pixels of the legend's last text row (the scale's name) and of the labels row.
+    const auto lit = [](const ErrorHeatmap& map, int y0, int y1) {
+        int n = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < map.image.width; ++x) n += map.image.at(x, y)[0] > 200;
+        return n;
+    };
+    const auto name_row = [&](const ErrorHeatmap& map) {
+        return lit(map, map.bar_y1 + 14, map.image.height);
+    };
+    const auto labels_row = [&](const ErrorHeatmap& map) {
+        return lit(map, map.bar_y1, map.bar_y1 + 14);
+    };
+    const ErrorHeatmap linear = render_error_heatmap(a, b, r);
+    const ErrorHeatmap log = render_error_heatmap(a, b, r, {HeatmapScale::log, 0.0});
+    const ErrorHeatmap log100 = render_error_heatmap(a, b, r, {HeatmapScale::log, 100.0});
+    EXPECT_EQ(linear.legend, "linear");
+    EXPECT_EQ(log.legend, "log");
+    EXPECT_EQ(log100.legend, "log x100");
+    EXPECT_EQ(render_error_heatmap(a, b, r, {HeatmapScale::linear, 2.5}).legend, "linear x2.5");
+    EXPECT_GT(name_row(linear), 0);
+    EXPECT_NE(name_row(linear), name_row(log));
+    EXPECT_GT(name_row(log100), name_row(log));
+    // The labels: "0 0.125 0.25" on the linear scale, "2.5e-07 0.00025 0.25" on the log.
+    EXPECT_NE(labels_row(linear), labels_row(log));
+}
+
+TEST(Heatmap, PositionOnEachScale) {
+    EXPECT_EQ(heatmap_position(0.0, 0.0, 1.0, HeatmapScale::linear), 0.0);
+    EXPECT_EQ(heatmap_position(0.25, 0.0, 1.0, HeatmapScale::linear), 0.25);
+    EXPECT_EQ(heatmap_position(4.0, 0.0, 1.0, HeatmapScale::linear), 1.0);
+    EXPECT_EQ(heatmap_position(0.0, 1e-6, 1.0, HeatmapScale::log), 0.0);
+    EXPECT_EQ(heatmap_position(1e-7, 1e-6, 1.0, HeatmapScale::log), 0.0);
+    EXPECT_NEAR(heatmap_position(1e-3, 1e-6, 1.0, HeatmapScale::log), 0.5, 1e-12);
+    EXPECT_EQ(heatmap_position(2.0, 1e-6, 1.0, HeatmapScale::log), 1.0);
+    EXPECT_EQ(parse_heatmap_scale("log"), HeatmapScale::log);
+    EXPECT_EQ(parse_heatmap_scale("linear"), HeatmapScale::linear);
+    EXPECT_EQ(parse_heatmap_scale("Log"), std::nullopt);
+}
+
 TEST_F(CompareFiles, HeatmapPngReadsBack) {
     ChannelImage a = make_image(4, 4, rgb);
     ChannelImage b = a;

@@ -324,5 +324,53 @@ TEST_F(CompareCliTest, UsageErrorsExit5NotTheFailStatus) {
     EXPECT_EQ(compare({"a.exr", "b.exr"}).status, 2);
 }
 
+// Issue 26: a small error next to a large one is black on the linear 0..max scale;
+// --scale F (idiff's) and --heatmapscale log make it visible, and the report says which
+// scale the picture uses.
+TEST_F(CompareCliTest, HeatmapScaleAndFactorAreReported) {
+    write_pair(0.125f);
+    RunResult r = compare({"a.exr", "b.exr", "--heatmap", "h.png"});
+    EXPECT_NE(r.output.find("wrote h.png (error heatmap, linear: 0 to 0.125)"),
+              std::string::npos)
+        << r.output;
+    r = compare({"a.exr", "b.exr", "--heatmap", "h.png", "--scale", "100"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("wrote h.png (error heatmap, linear x100: 0 to 0.01)"),
+              std::string::npos)
+        << r.output;
+    r = compare({"a.exr", "b.exr", "--heatmap", "h.png", "--heatmapscale", "log"});
+    EXPECT_NE(r.output.find("wrote h.png (error heatmap, log: 1.25e-07 to 0.125)"),
+              std::string::npos)
+        << r.output;
+    EXPECT_TRUE(testing::fs::exists(dir_ / "h.png"));
+}
+
+TEST_F(CompareCliTest, BadHeatmapScalesAreUsageErrors) {
+    write_pair(0.125f);
+    const std::vector<std::vector<std::string>> bad = {
+        {"--heatmap", "h.png", "--scale", "0"},
+        {"--heatmap", "h.png", "--scale", "-2"},
+        {"--heatmap", "h.png", "--scale", "nan"},
+        {"--heatmap", "h.png", "--scale", "inf"},
+        {"--heatmap", "h.png", "--scale", "0x10"},
+        {"--heatmap", "h.png", "--scale", " 5"},
+        {"--heatmap", "h.png", "--scale", "x"},
+        {"--heatmap", "h.png", "--heatmapscale", "cubic"},
+        {"--scale", "100"},
+        {"--heatmapscale", "log"},
+    };
+    for (std::vector<std::string> args : bad) {
+        const std::string option = args[args.size() - 2];
+        args.insert(args.begin(), {"a.exr", "b.exr"});
+        const RunResult r = compare(args);
+        EXPECT_EQ(r.status, 5) << args.back() << "\n" << r.output;
+        EXPECT_NE(r.output.find(option), std::string::npos) << r.output;
+    }
+    EXPECT_FALSE(testing::fs::exists(dir_ / "h.png"));
+    const RunResult none = compare({"a.exr", "b.exr", "--scale", "100"});
+    EXPECT_NE(none.output.find("no --heatmap FILE.png was given"), std::string::npos)
+        << none.output;
+}
+
 }  // namespace
 }  // namespace octray
