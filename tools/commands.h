@@ -65,7 +65,8 @@ void add_bench_command(CLI::App& app, CommandRunner& run);
 void add_verify_command(CLI::App& app, CommandRunner& run);
 void add_info_command(CLI::App& app, CommandRunner& run);
 void add_assemble_command(CLI::App& app, CommandRunner& run);
-// Last: it describes the commands added before it.
+void add_man_command(CLI::App& app, CommandRunner& run);
+// Last, as it describes the others (so does man, though its pages are made when it runs).
 void add_completion_command(CLI::App& app, CommandRunner& run);
 
 }  // namespace octray::tools
