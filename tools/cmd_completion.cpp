@@ -115,7 +115,8 @@ void add_completion_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  source <(octray completion bash)             # this shell\n"
         "  octray completion bash > ~/.local/share/bash-completion/completions/octray\n"
-        "  octray completion zsh > ~/.zfunc/_octray     # with ~/.zfunc in $fpath\n");
+        "  octray completion zsh > ~/.zfunc/_octray     # with ~/.zfunc in $fpath\n\n" +
+        exit_code_help());
     const CLI::App* top = &app;
     cmd->callback([shell, top, &run] {
         run.action = [shell, top] {

@@ -175,6 +175,13 @@ struct FooterSections {
 FooterSections footer_sections(const std::string& footer) {
     FooterSections s;
     for (const Block& block : blocks_of(footer)) {
+        if (!is_heading(block) && block.front().rfind("Exit codes: ", 0) == 0) {
+            // "Exit codes: 0 within the thresholds ..., 1 otherwise; ...": in prose.
+            std::string text;
+            for (const std::string& line : block) text += line + "\n";
+            s.exit_status += ".SH \"EXIT STATUS\"\n" + roff_paragraph(text.substr(12));
+            continue;
+        }
         if (!is_heading(block)) {
             std::string text;
             for (const std::string& line : block) text += line + "\n";
