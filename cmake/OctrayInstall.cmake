@@ -1,4 +1,4 @@
-# `cmake --install`: the octray binary, the public API (include/octray/, liboctray.a) and
+# `cmake --install`: the octray binary with its man pages and completions, the public API (include/octray/, liboctray.a) and
 # an exported CMake package, so that another project can
 #   find_package(octray CONFIG REQUIRED)
 #   target_link_libraries(app PRIVATE octray::octray)
@@ -17,6 +17,14 @@ foreach(lib core scene kernels render reference imageio compare warnings fp_mode
 endforeach()
 
 install(TARGETS octray RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# Its man pages (octray(1), octray-render(1), ...) and shell completions, generated at build
+# time from the parser's options (target octray_docs, tools/CMakeLists.txt).
+install(DIRECTORY ${OCTRAY_SHARE_DIR}/man/man1 DESTINATION ${CMAKE_INSTALL_MANDIR}
+        FILES_MATCHING PATTERN "*.1")
+install(FILES ${OCTRAY_SHARE_DIR}/bash-completion/completions/octray
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions)
+install(FILES ${OCTRAY_SHARE_DIR}/zsh/vendor-completions/_octray
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/zsh/vendor-completions)
 install(TARGETS octray_api octray_core octray_scene octray_kernels octray_render
                 octray_reference octray_imageio octray_compare
                 octray_warnings octray_fp_model octray_optimize

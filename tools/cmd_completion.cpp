@@ -8,42 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "tools/cli_describe.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
 namespace {
-
-struct OptionInfo {
-    std::vector<std::string> names;  // "-o", "--output"
-    std::string description;         // its first line
-    bool takes_value = false;
-};
-
-struct CommandInfo {
-    std::string name;
-    std::string description;
-    std::vector<OptionInfo> options;
-};
-
-std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
-
-std::vector<CommandInfo> describe(const CLI::App& app) {
-    std::vector<CommandInfo> commands;
-    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
-        CommandInfo c{sub->get_name(), first_line(sub->get_description()), {}};
-        for (const CLI::Option* option : sub->get_options()) {
-            OptionInfo o;
-            for (const std::string& name : option->get_snames()) o.names.push_back("-" + name);
-            for (const std::string& name : option->get_lnames()) o.names.push_back("--" + name);
-            if (o.names.empty()) continue;  // a positional argument
-            o.description = first_line(option->get_description());
-            o.takes_value = option->get_expected_max() > 0;  // flags expect none
-            c.options.push_back(std::move(o));
-        }
-        commands.push_back(std::move(c));
-    }
-    return commands;
-}
 
 std::string bash_script(const std::vector<CommandInfo>& commands) {
     std::string names, labels;
@@ -106,7 +75,7 @@ std::string zsh_script(const std::vector<CommandInfo>& commands) {
         "    local -a commands\n"
         "    commands=(\n";
     for (const CommandInfo& c : commands)
-        out += "        '" + c.name + ":" + zsh_text(c.description) + "'\n";
+        out += "        '" + c.name + ":" + zsh_text(first_line(c.description)) + "'\n";
     out +=
         "        'help:Print the help of a command'\n"
         "    )\n"
@@ -119,8 +88,8 @@ std::string zsh_script(const std::vector<CommandInfo>& commands) {
         out += "        " + c.name + ")\n            _arguments -s \\\n";
         for (const OptionInfo& o : c.options)
             for (const std::string& n : o.names)
-                out += "                '" + n + "[" + zsh_text(o.description) + "]" +
-                       (o.takes_value ? ":value:_files" : "") + "' \\\n";
+                out += "                '" + n + "[" + zsh_text(first_line(o.description)) +
+                       "]" + (o.takes_value ? ":value:_files" : "") + "' \\\n";
         out += "                '*:file:_files'\n            ;;\n";
     }
     out +=
@@ -146,11 +115,12 @@ void add_completion_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  source <(octray completion bash)             # this shell\n"
         "  octray completion bash > ~/.local/share/bash-completion/completions/octray\n"
-        "  octray completion zsh > ~/.zfunc/_octray     # with ~/.zfunc in $fpath\n");
+        "  octray completion zsh > ~/.zfunc/_octray     # with ~/.zfunc in $fpath\n\n" +
+        exit_code_help());
     const CLI::App* top = &app;
     cmd->callback([shell, top, &run] {
         run.action = [shell, top] {
-            const std::vector<CommandInfo> commands = describe(*top);
+            const std::vector<CommandInfo> commands = describe_commands(*top);
             std::cout << (*shell == "bash" ? bash_script(commands) : zsh_script(commands));
         };
     });

@@ -74,6 +74,11 @@ void add_info_command(CLI::App& app, CommandRunner& run) {
         "sphere)");
     cmd->add_option("scene", *scene, "Optional scene: a JSON file or a built-in")
         ->type_name("SCENE");
+    cmd->footer(
+        "Examples:\n"
+        "  octray info                      # the CPU and the kernels --isa auto picks\n"
+        "  octray info random:65536         # and the scene's counts and sphere BVH\n\n" +
+        exit_code_help());
     cmd->callback([scene, &run] { run.action = [scene] { run_info(*scene); }; });
 }
 

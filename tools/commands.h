@@ -65,7 +65,10 @@ void add_bench_command(CLI::App& app, CommandRunner& run);
 void add_verify_command(CLI::App& app, CommandRunner& run);
 void add_info_command(CLI::App& app, CommandRunner& run);
 void add_assemble_command(CLI::App& app, CommandRunner& run);
-// Last: it describes the commands added before it.
+// man and completion describe every command (tools/cli_describe.h) when they run, after
+// all are registered; they come last so that --help lists them after the commands they
+// document.
+void add_man_command(CLI::App& app, CommandRunner& run);
 void add_completion_command(CLI::App& app, CommandRunner& run);
 
 }  // namespace octray::tools

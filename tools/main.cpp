@@ -161,6 +161,7 @@ int main(int argc, char** argv) {
     add_verify_command(app, run);
     add_info_command(app, run);
     add_assemble_command(app, run);
+    add_man_command(app, run);
     add_completion_command(app, run);
 
     std::vector<std::string> args(argv, argv + argc);

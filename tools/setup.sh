@@ -6,6 +6,7 @@
 # tests/tsan/build_tbb.sh fetch and unpack oneTBB's Debian source. slurmctld, slurmd,
 # slurm-client and munge let tests/farm/slurm.sh run a single-node Slurm (it starts the
 # daemons itself, from a temporary folder; installing them starts nothing here).
+# python3-matplotlib draws bench/plot.py's charts; groff-base checks the man pages.
 set -euo pipefail
 
 packages=(
@@ -16,6 +17,7 @@ packages=(
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
     libpng-dev libembree-dev libssl-dev
     slurmctld slurmd slurm-client munge
+    python3-matplotlib groff-base
 )
 
 missing=()

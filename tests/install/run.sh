@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # CI stage (tools/test.sh, after the release stage): install a build into a temporary
-# prefix, build examples/embed against the installed package alone, run it, and check its
-# EXR: readable, and equal to what the installed `octray` renders from the same scene.
+# prefix, check its man pages and shell completions, build examples/embed against the
+# installed package alone, run it, and check its EXR: readable, and equal to what the
+# installed `octray` renders from the same scene.
 #   tests/install/run.sh [BUILD_DIR]     (default build/release, already built)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -13,6 +14,29 @@ cmake --install "$build" --prefix "$tmp/prefix"
 # Only the public header is installed.
 test -f "$tmp/prefix/include/octray/octray.h"
 test "$(find "$tmp/prefix/include" -type f | wc -l)" -eq 1
+
+# The man pages and the shell completions (generated at build time from the parser's
+# options): a page per command the installed octray lists, and both scripts, non-empty.
+prefix=$tmp/prefix
+commands=$("$prefix/bin/octray" --help | sed -n '/^Subcommands:/,/^$/p' | awk 'NR > 1 && NF { print $1 }')
+test -n "$commands"
+test -s "$prefix/share/man/man1/octray.1"
+for command in $commands; do
+  test -s "$prefix/share/man/man1/octray-$command.1" || {
+    echo "tests/install/run.sh: no man page octray-$command.1 installed" >&2; exit 1; }
+done
+test "$(find "$prefix/share/man/man1" -type f | wc -l)" -eq $(($(wc -w <<<"$commands") + 1))
+if command -v man >/dev/null; then
+  man -M "$prefix/share/man" -w octray-render | grep -qx "$prefix/share/man/man1/octray-render.1"
+fi
+test -s "$prefix/share/bash-completion/completions/octray"
+test -s "$prefix/share/zsh/vendor-completions/_octray"
+grep -q '^#compdef octray' "$prefix/share/zsh/vendor-completions/_octray"
+# The installed bash completion completes a command and an option.
+completed=$(bash -c 'source "$1" && COMP_WORDS=(octray ma) COMP_CWORD=1 && _octray &&
+  echo "${COMPREPLY[*]}" && COMP_WORDS=(octray render --thr) COMP_CWORD=2 && _octray &&
+  echo "${COMPREPLY[*]}"' _ "$prefix/share/bash-completion/completions/octray")
+test "$completed" = $'man\n--threads'
 
 cmake -S examples/embed -B "$tmp/embed" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$tmp/prefix"
