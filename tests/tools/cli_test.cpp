@@ -869,7 +869,7 @@ TEST_F(CliTest, SmallFovWarnsThatFovIsInDegrees) {
     const RunResult refused = octray({"render", bad, "-o", "b.exr"});
     EXPECT_EQ(refused.status, 3) << refused.output;
     EXPECT_TRUE(contains(refused.output, bad + ": camera.fov_units: expected one of "
-                                               "\"degrees\", found \"radians\""))
+                                               "\"degrees\", found the string \"radians\""))
         << refused.output;
     EXPECT_FALSE(fs::exists(path("b.exr")));
 }
