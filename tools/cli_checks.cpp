@@ -20,6 +20,7 @@
 #include <system_error>
 #include <vector>
 
+#include "core/decimal.h"
 #include "scene/scene.h"
 #include "scene/suggest.h"
 #include "tools/commands.h"
@@ -62,13 +63,7 @@ std::string format_real(double value) {
 }  // namespace
 
 std::optional<std::uint64_t> parse_decimal_integer(std::string_view text) {
-    if (text.empty() ||
-        !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
-        return std::nullopt;
-    std::uint64_t value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-    return value;
+    return parse_decimal_digits(text);
 }
 
 std::string integer_range_text(std::uint64_t lo, std::uint64_t hi) {

@@ -24,7 +24,8 @@ namespace octray::tools {
 // ---- Numbers on the command line -------------------------------------------------------
 
 // Decimal digits only (as scene files have them): no sign, blank, "0x" prefix, fraction or
-// exponent; nullopt for anything else or above 2^64 - 1 (nothing is clamped).
+// exponent; nullopt for anything else or above 2^64 - 1 (nothing is clamped). The same
+// reading as core/decimal.h's parse_decimal_digits, which the specs of tools/batch.h use.
 std::optional<std::uint64_t> parse_decimal_integer(std::string_view text);
 
 // Limits of integer options that more than one command shares; each option's help text
