@@ -133,6 +133,37 @@ TEST_F(CliOptionsTest, TheWalkFindsTheIntegerOptionsOfEveryCommand) {
         EXPECT_NE(std::find(found.begin(), found.end(), expected), found.end()) << expected;
 }
 
+// An integer option added without decimal_integer would escape the walk above: find it by
+// "1.5", which CLI11's own conversion to an integer refuses (a ConversionError) while a
+// string or real option takes it and a checked option refuses it as a ValidationError.
+TEST_F(CliOptionsTest, NoIntegerOptionBypassesTheCheck) {
+    CommandRunner run;
+    const std::unique_ptr<CLI::App> walk = make_octray_app(run);
+    int probed = 0;
+    for (CLI::App* command : walk->get_subcommands([](CLI::App*) { return true; })) {
+        for (CLI::Option* option : command->get_options()) {
+            if (option->get_lnames().empty() || option->get_expected_max() == 0) continue;
+            if (integer_option_limits(*option)) continue;
+            const std::string name = "--" + option->get_lnames().front();
+            CommandRunner fresh_run;
+            const std::unique_ptr<CLI::App> app = make_octray_app(fresh_run);
+            std::vector<std::string> args = {"octray", command->get_name(), name, "1.5"};
+            std::vector<char*> argv;
+            for (std::string& a : args) argv.push_back(a.data());
+            try {
+                app->parse(static_cast<int>(argv.size()), argv.data());
+            } catch (const CLI::ConversionError& e) {
+                ADD_FAILURE() << command->get_name() << " " << name
+                              << " converts to a number without decimal_integer: " << e.what();
+            } catch (const CLI::ParseError&) {
+                // A checked value (a set of words, a size, a spec): refused by its check.
+            }
+            ++probed;
+        }
+    }
+    EXPECT_GT(probed, 20);
+}
+
 TEST_F(CliOptionsTest, EveryIntegerOptionRefusesAnythingButDecimalDigitsInItsLimits) {
     for (const IntegerOption& o : integer_options()) {
         SCOPED_TRACE(o.command + " " + o.name);
