@@ -148,6 +148,27 @@ CLI::Validator tile_size(std::uint64_t max_side) {
         "");
 }
 
+std::string real_range_text(double lo, double hi, bool allow_infinity) {
+    std::string range = hi == std::numeric_limits<double>::max()
+                            ? ">= " + format_real(lo)
+                            : format_real(lo) + ".." + format_real(hi);
+    return allow_infinity ? range + ", or inf" : range;
+}
+
+std::optional<std::string> real_option_range_text(CLI::Option& option) {
+    static constexpr std::string_view kPrefix = "real_number ";
+    for (int i = 0;; ++i) {
+        const CLI::Validator* validator = nullptr;
+        try {
+            validator = option.get_validator(i);
+        } catch (const CLI::OptionNotFound&) {
+            return std::nullopt;
+        }
+        const std::string& name = validator->get_name();
+        if (name.rfind(kPrefix, 0) == 0) return name.substr(kPrefix.size());
+    }
+}
+
 CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
     std::string range =
         hi == std::numeric_limits<double>::max()
@@ -181,7 +202,7 @@ CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
             }
             return {};
         },
-        "");
+        "", "real_number " + real_range_text(lo, hi, allow_infinity));
 }
 
 void print_scene_warnings(const Scene& scene, bool quiet) {

@@ -65,6 +65,12 @@ CLI::Validator tile_size(std::uint64_t max_side);
 // values that overflow to infinity are refused. Use with CLI::Option::transform.
 CLI::Validator real_number(double lo, double hi, bool allow_infinity);
 
+// The range of such an option for its help: "0..100", ">= 0, or inf" (hi the largest double
+// reads as open). real_option_range_text gives it for an option checked by real_number
+// (nullopt for others), so a test holds each help to its check.
+std::string real_range_text(double lo, double hi, bool allow_infinity);
+std::optional<std::string> real_option_range_text(CLI::Option& option);
+
 // ---- Output files --------------------------------------------------------------------
 
 enum class ImageFormat { exr, png };

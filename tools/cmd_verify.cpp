@@ -180,16 +180,21 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
     cmd->add_option("--fail", args->fail,
-                    "A pixel fails when any channel differs by more than X; 0 = exact")
+                    "A pixel fails when any channel differs by more than X (" +
+                        real_range_text(0.0, std::numeric_limits<double>::max(), true) +
+                        "); 0 = exact")
         ->type_name("X")
         ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();
-    cmd->add_option("--failpercent", args->fail_percent,
-                    "FAIL when more than P% of the pixels fail, 0..100")
+    cmd->add_option(
+           "--failpercent", args->fail_percent,
+           "FAIL when more than P% of the pixels fail, " + real_range_text(0.0, 100.0, false))
         ->type_name("P")
         ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
-    cmd->add_option("--hardfail", args->hard_fail, "FAIL when any one error exceeds H")
+    cmd->add_option("--hardfail", args->hard_fail,
+                    "FAIL when any one error exceeds H (" +
+                        real_range_text(0.0, std::numeric_limits<double>::max(), true) + ")")
         ->type_name("H")
         ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();

@@ -219,6 +219,24 @@ TEST_F(CliOptionsTest, EveryIntegerOptionsHelpStatesItsLimits) {
     EXPECT_TRUE(contains(help.output, "bounces, 0..64;")) << help.output;
 }
 
+// The same for the real options (compare's and verify's thresholds).
+TEST_F(CliOptionsTest, EveryRealOptionsHelpStatesItsLimits) {
+    CommandRunner run;
+    const std::unique_ptr<CLI::App> app = make_octray_app(run);
+    int checked = 0;
+    for (CLI::App* command : app->get_subcommands([](CLI::App*) { return true; })) {
+        for (CLI::Option* option : command->get_options()) {
+            const auto range = octray::tools::real_option_range_text(*option);
+            if (!range) continue;
+            ++checked;
+            EXPECT_TRUE(contains(option->get_description(), *range))
+                << command->get_name() << " " << option->get_name() << ": help lacks \""
+                << *range << "\": " << option->get_description();
+        }
+    }
+    EXPECT_GE(checked, 9);  // compare's six thresholds, verify's three
+}
+
 TEST_F(CliOptionsTest, BenchWarmupZeroIsAllowed) {
     for (const IntegerOption& o : integer_options()) {
         if (o.command != "bench" || o.name != "--warmup") continue;
