@@ -490,21 +490,22 @@ void read_camera(const Reader& r, const Json& j, Camera& camera) {
     if (j.contains("type")) {
         camera.type = static_cast<CameraType>(r.choice(j["type"], "camera.type", types));
     }
-    static constexpr std::array<ForeignKey, 4> foreign = {
+    static constexpr std::array<ForeignKey, 5> foreign = {
         ForeignKey{"fov", "pinhole, thinlens and fisheye cameras"},
+        ForeignKey{"fov_units", "pinhole, thinlens and fisheye cameras"},
         ForeignKey{"width", "orthographic cameras"}, ForeignKey{"aperture", "thinlens cameras"},
         ForeignKey{"focus_distance", "thinlens cameras"}};
     std::vector<std::string_view> allowed = {"type", "eye", "lookat", "up"};
     switch (camera.type) {
         case CameraType::pinhole:
         case CameraType::fisheye:
-            allowed.push_back("fov");
+            allowed.insert(allowed.end(), {"fov", "fov_units"});
             break;
         case CameraType::orthographic:
             allowed.push_back("width");
             break;
         case CameraType::thinlens:
-            allowed.insert(allowed.end(), {"fov", "aperture", "focus_distance"});
+            allowed.insert(allowed.end(), {"fov", "fov_units", "aperture", "focus_distance"});
             break;
     }
     const std::string kind =
@@ -517,6 +518,12 @@ void read_camera(const Reader& r, const Json& j, Camera& camera) {
                            "camera.lookat");
     if (j.contains("up")) camera.up = r.vec3(j["up"], "camera.up");
     if (j.contains("fov")) camera.fov = r.number(j["fov"], "camera.fov");
+    if (j.contains("fov_units")) {
+        // Always degrees: the key states that a small fov (scene_warnings) is meant.
+        static constexpr std::array<std::string_view, 1> units = {"degrees"};
+        static_cast<void>(r.choice(j["fov_units"], "camera.fov_units", units));
+        camera.fov_units_stated = true;
+    }
     if (j.contains("width")) camera.width = r.number(j["width"], "camera.width");
     if (camera.type == CameraType::thinlens) {
         camera.aperture =

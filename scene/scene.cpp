@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "scene/camera.h"
 
@@ -12,6 +15,43 @@ constexpr float kHuge = 3.0e38f;
 }
 
 namespace octray {
+
+namespace {
+
+std::string short_number(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
+}  // namespace
+
+std::vector<std::string> scene_warnings(const Scene& scene) {
+    std::vector<std::string> out;
+    const Camera& camera = scene.camera;
+    if ((camera.type != CameraType::pinhole && camera.type != CameraType::thinlens) ||
+        camera.fov_units_stated)
+        return out;
+    const std::string file = scene.source.empty() ? std::string() : scene.source + ": ";
+    const auto check = [&](const std::string& path, float fov) {
+        if (!(fov < kSmallFovDegrees)) return;
+        const double degrees = static_cast<double>(fov) * 180.0 / std::numbers::pi;
+        out.push_back(file + path + ": fov " + short_number(fov) + " is below " +
+                      short_number(kSmallFovDegrees) +
+                      "; fov is in degrees (were it radians, it would be " +
+                      short_number(degrees) +
+                      " degrees). If the small angle is meant, add \"fov_units\": "
+                      "\"degrees\" to the camera");
+    };
+    check("camera.fov", camera.fov);
+    if (scene.animation) {
+        const std::vector<CameraKey>& keys = scene.animation->camera;
+        for (std::size_t i = 0; i < keys.size(); ++i)
+            if (keys[i].fov)
+                check("animation.camera[" + std::to_string(i) + "].fov", *keys[i].fov);
+    }
+    return out;
+}
 
 float self_intersection_epsilon(const Scene& scene) {
     if (scene.render.epsilon) return *scene.render.epsilon;

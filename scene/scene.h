@@ -25,7 +25,14 @@ struct Camera {
     float width = 2.0f;           // film width in world units (orthographic)
     float aperture = 0.0f;        // lens radius (thinlens)
     float focus_distance = 1.0f;  // distance of the focal plane along the view (thinlens)
+    // "fov_units": "degrees" in the file: a fov below kSmallFovDegrees is meant as given,
+    // so scene_warnings() says nothing about it.
+    bool fov_units_stated = false;
 };
+
+// A pinhole or thin-lens fov below this many degrees is legal but is almost always an
+// angle in radians by mistake: scene_warnings() names it.
+inline constexpr float kSmallFovDegrees = 2.0f;
 
 struct Checker {
     Rgb color;          // Cd2, used where floor(P.T1/size) + floor(P.T2/size) is odd
@@ -107,6 +114,12 @@ struct Scene {
     // authored pose; scene_at_frame() gives the still scene of one frame.
     std::optional<Animation> animation;
 };
+
+// What is legal in `scene` but probably not meant, one message per finding, each naming the
+// file (scene.source) and the JSON path: a pinhole or thin-lens fov (the camera's or an
+// animation key's) below kSmallFovDegrees, unless the camera states "fov_units". The
+// command line prints them on stderr unless --quiet.
+std::vector<std::string> scene_warnings(const Scene& scene);
 
 // ε_s of the self-intersection rule: render.epsilon if set, else
 // 1e-4 * max(1, diagonal of the bounding box of all spheres); planes are ignored.

@@ -99,6 +99,7 @@ Json camera(const Camera& c) {
             j["focus_distance"] = number(c.focus_distance);
             break;
     }
+    if (c.fov_units_stated && c.type != CameraType::orthographic) j["fov_units"] = "degrees";
     return j;
 }
 

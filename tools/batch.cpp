@@ -15,6 +15,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "core/decimal.h"
 #include "scene/builtin.h"
 
 namespace octray::batch {
@@ -71,13 +72,12 @@ std::int64_t parse_number(std::string_view text, std::int64_t max, std::string_v
         throw SpecError(context + "expected " + std::string(what) +
                         " (decimal digits only), found " + quote(t));
     }
-    std::int64_t value = 0;
-    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
-    if (ec != std::errc{} || end != t.data() + t.size() || value > max) {
+    const auto value = parse_decimal_digits(t);  // core/decimal.h, as the options read
+    if (!value || *value > static_cast<std::uint64_t>(max)) {
         throw SpecError(context + "expected " + std::string(what) + " of at most " +
                         std::to_string(max) + ", found " + quote(t));
     }
-    return value;
+    return static_cast<std::int64_t>(*value);
 }
 
 constexpr std::string_view kFrameSpecForms =

@@ -20,6 +20,8 @@
 #include <system_error>
 #include <vector>
 
+#include "core/decimal.h"
+#include "scene/scene.h"
 #include "scene/suggest.h"
 #include "tools/commands.h"
 
@@ -61,35 +63,110 @@ std::string format_real(double value) {
 }  // namespace
 
 std::optional<std::uint64_t> parse_decimal_integer(std::string_view text) {
-    if (text.empty() ||
-        !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
-        return std::nullopt;
-    std::uint64_t value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-    return value;
+    return parse_decimal_digits(text);
 }
 
+std::string integer_range_text(std::uint64_t lo, std::uint64_t hi) {
+    if (hi == kNoIntegerLimit) return std::to_string(lo) + " or more";
+    return std::to_string(lo) + ".." + std::to_string(hi);
+}
+
+namespace {
+
+constexpr std::string_view kIntegerValidatorName = "decimal_integer ";
+constexpr std::string_view kDigitsOnly =
+    "decimal digits only: no sign, blank, 0x prefix, fraction or exponent";
+
+// "an integer from 1 to 65536", or "an integer >= 0" for an open range: the open end reads
+// as no limit, not as 2147483647.
+std::string integer_range_words(std::uint64_t lo, std::uint64_t hi) {
+    return hi == kNoIntegerLimit
+               ? "an integer >= " + std::to_string(lo)
+               : "an integer from " + std::to_string(lo) + " to " + std::to_string(hi);
+}
+
+}  // namespace
+
 CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi) {
-    // "--warmup must be an integer >= 0": the open end of a range reads as no limit, not as
-    // 2147483647 (main.cpp turns CLI11's "--warmup: must be" into "--warmup must be").
-    const bool open =
-        hi == static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max());
-    const std::string range =
-        open ? "an integer >= " + std::to_string(lo)
-             : "an integer from " + std::to_string(lo) + " to " + std::to_string(hi);
+    const std::string range = integer_range_words(lo, hi);
     return CLI::Validator(
         [range, lo, hi](std::string& text) -> std::string {
             const auto value = parse_decimal_integer(text);
-            if (!value || *value < lo || *value > hi)
-                return "must be " + range +
-                       " in decimal digits (no sign, blank, 0x prefix, fraction or exponent), "
-                       "found " +
-                       quote_value(text);
+            const bool digits =
+                !text.empty() && std::all_of(text.begin(), text.end(),
+                                             [](char c) { return c >= '0' && c <= '9'; });
+            if (!digits)
+                return "must be " + range + " (got " + quote_value(text) + "); " +
+                       std::string(kDigitsOnly);
+            if (!value || *value < lo || *value > hi)  // no value: above 2^64 - 1
+                return "must be " + range + " (got " + quote_value(text) + ")";
             text = std::to_string(*value);  // what CLI11 converts: canonical decimal
             return {};
         },
+        "", std::string(kIntegerValidatorName) + std::to_string(lo) + " " + std::to_string(hi));
+}
+
+std::optional<IntegerLimits> integer_option_limits(CLI::Option& option) {
+    for (int i = 0;; ++i) {
+        const CLI::Validator* validator = nullptr;
+        try {
+            validator = option.get_validator(i);
+        } catch (const CLI::OptionNotFound&) {
+            return std::nullopt;
+        }
+        const std::string name = validator->get_name();
+        if (name.rfind(kIntegerValidatorName, 0) != 0) continue;
+        const std::string_view numbers =
+            std::string_view(name).substr(kIntegerValidatorName.size());
+        const std::size_t space = numbers.find(' ');
+        const auto lo = parse_decimal_integer(numbers.substr(0, space));
+        const auto hi = space == std::string_view::npos
+                            ? std::nullopt
+                            : parse_decimal_integer(numbers.substr(space + 1));
+        if (lo && hi) return IntegerLimits{*lo, *hi};
+    }
+}
+
+CLI::Validator tile_size(std::uint64_t max_side) {
+    const std::string expected = "must be WxH or N (NxN) with sides from 1 to " +
+                                 std::to_string(max_side) + ", such as 16x16";
+    return CLI::Validator(
+        [expected, max_side](std::string& text) -> std::string {
+            const std::size_t x = text.find_first_of("xX");
+            const std::string_view all = text;
+            const auto w = parse_decimal_integer(all.substr(0, x));
+            const auto h =
+                x == std::string::npos ? w : parse_decimal_integer(all.substr(x + 1));
+            if (!w || !h)
+                return expected + " (got " + quote_value(text) + "); " +
+                       std::string(kDigitsOnly);
+            if (*w < 1 || *h < 1 || *w > max_side || *h > max_side)
+                return expected + " (got " + quote_value(text) + ")";
+            text = std::to_string(*w) + "x" + std::to_string(*h);
+            return {};
+        },
         "");
+}
+
+std::string real_range_text(double lo, double hi, bool allow_infinity) {
+    std::string range = hi == std::numeric_limits<double>::max()
+                            ? ">= " + format_real(lo)
+                            : format_real(lo) + ".." + format_real(hi);
+    return allow_infinity ? range + ", or inf" : range;
+}
+
+std::optional<std::string> real_option_range_text(CLI::Option& option) {
+    static constexpr std::string_view kPrefix = "real_number ";
+    for (int i = 0;; ++i) {
+        const CLI::Validator* validator = nullptr;
+        try {
+            validator = option.get_validator(i);
+        } catch (const CLI::OptionNotFound&) {
+            return std::nullopt;
+        }
+        const std::string& name = validator->get_name();
+        if (name.rfind(kPrefix, 0) == 0) return name.substr(kPrefix.size());
+    }
 }
 
 CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
@@ -125,7 +202,13 @@ CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
             }
             return {};
         },
-        "");
+        "", "real_number " + real_range_text(lo, hi, allow_infinity));
+}
+
+void print_scene_warnings(const Scene& scene, bool quiet) {
+    if (quiet) return;
+    for (const std::string& warning : scene_warnings(scene))
+        std::cerr << "octray: warning: " << warning << '\n';
 }
 
 std::optional<ImageFormat> image_format_of(std::string_view path) {

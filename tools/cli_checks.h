@@ -11,26 +11,65 @@
 
 namespace CLI {
 class App;
+class Option;
 class Validator;
 }  // namespace CLI
+
+namespace octray {
+struct Scene;
+}
 
 namespace octray::tools {
 
 // ---- Numbers on the command line -------------------------------------------------------
 
 // Decimal digits only (as scene files have them): no sign, blank, "0x" prefix, fraction or
-// exponent; nullopt for anything else or above 2^64 - 1 (nothing is clamped).
+// exponent; nullopt for anything else or above 2^64 - 1 (nothing is clamped). The same
+// reading as core/decimal.h's parse_decimal_digits, which the specs of tools/batch.h use.
 std::optional<std::uint64_t> parse_decimal_integer(std::string_view text);
+
+// Limits of integer options that more than one command shares; each option's help text
+// and its check are both made from them (integer_range_text, decimal_integer).
+inline constexpr std::uint64_t kMaxImageSide = 65536;      // --width, --height
+inline constexpr std::uint64_t kMaxSamples = 1u << 20;     // --spp
+inline constexpr std::uint64_t kMaxThreadCount = 4096;     // --threads
+inline constexpr std::uint64_t kMaxTileSide = 4096;        // --tile WxH
+inline constexpr std::uint64_t kMaxShardCount = 1u << 20;  // --shard-count
+// An upper limit that only says "fits an int": the range reads as open (">= lo").
+inline constexpr std::uint64_t kNoIntegerLimit = 2147483647;
+
+// A range for help text: "1..65536", or "0 or more" for an open one (hi kNoIntegerLimit).
+std::string integer_range_text(std::uint64_t lo, std::uint64_t hi);
 
 // An integer option in [lo, hi], written as parse_decimal_integer reads it. Use with
 // CLI::Option::transform: it hands CLI11 the number in canonical form (CLI11 alone would
-// read "0x10" as 16, "010" as 8, " 5" as 5 and clamp 2^64 to 2^64 - 1).
+// read "0x10" as 16, "010" as 8, " 5" as 5 and clamp 2^64 to 2^64 - 1). With a delimiter
+// (a list option such as --threads 1,2,4) it checks each item. A value refused reads
+// "--spp must be an integer from 1 to 1048576 (got "0x10"); ..." once main() has dropped
+// CLI11's colon.
 CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi);
+
+// The limits of an option checked by decimal_integer, nullopt for any other option: lets
+// a test walk every integer option of the real command line.
+struct IntegerLimits {
+    std::uint64_t lo = 0, hi = 0;
+};
+std::optional<IntegerLimits> integer_option_limits(CLI::Option& option);
+
+// A tile size "WxH", or "N" for NxN, with sides in [1, max_side] written as
+// parse_decimal_integer reads them. A transform: hands CLI11 the canonical "WxH".
+CLI::Validator tile_size(std::uint64_t max_side);
 
 // A real option (a threshold): a decimal number in [lo, hi], or "inf" / "infinity" (any
 // case) when `allow_infinity`. NaN, hex floats, signs other than a leading '-', blanks and
 // values that overflow to infinity are refused. Use with CLI::Option::transform.
 CLI::Validator real_number(double lo, double hi, bool allow_infinity);
+
+// The range of such an option for its help: "0..100", ">= 0, or inf" (hi the largest double
+// reads as open). real_option_range_text gives it for an option checked by real_number
+// (nullopt for others), so a test holds each help to its check.
+std::string real_range_text(double lo, double hi, bool allow_infinity);
+std::optional<std::string> real_option_range_text(CLI::Option& option);
 
 // ---- Output files --------------------------------------------------------------------
 
@@ -56,6 +95,18 @@ std::string output_identity(const std::string& path);
 // The directory part of output_identity: for `dir` ("" is the current directory), a key
 // such that output_identity(dir / name) == directory_identity(dir) + name.
 std::string directory_identity(const std::string& dir);
+
+// ---- Scene warnings ----------------------------------------------------------------------
+
+// Prints scene_warnings(scene) (scene/scene.h: what is legal but probably not meant, such as
+// a fov below 2 degrees) on stderr, one "octray: warning: ..." line each, unless `quiet`
+// (the --quiet of the commands that load scenes).
+void print_scene_warnings(const Scene& scene, bool quiet);
+
+// The help of those --quiet options.
+inline constexpr const char* kQuietHelp =
+    "Print no warnings about the scene (such as a camera fov below 2 degrees:\n"
+    "probably radians, where fov is in degrees)";
 
 // ---- Command-line errors and standard output -------------------------------------------
 

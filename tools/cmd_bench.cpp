@@ -198,8 +198,9 @@ void run_bench_command(const BenchArguments& a) {
     }
 }
 
-// The integer options are ints.
-constexpr std::uint64_t kMaxInt = std::numeric_limits<int>::max();
+// Limits of bench's own integer options (the shared ones are in cli_checks.h).
+constexpr std::uint64_t kMaxPacketLanes = 9;  // 8 lanes: 9 means no packet is traced
+constexpr std::uint64_t kMaxValidateRays = std::numeric_limits<std::uint32_t>::max();
 
 }  // namespace
 
@@ -218,31 +219,40 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         ->delimiter(',')
         ->type_name("LIST");
     cmd->add_option("--threads", a->threads,
-                    "Threads for both systems; a list (1,2,4) is a scaling sweep, rows for "
-                    "each count; 0 = all cores [default: all cores]")
+                    "Threads for both systems, each " + integer_range_text(0, kMaxThreadCount) +
+                        "; a list (1,2,4) is a scaling sweep, rows for each count; 0 = all "
+                        "cores [default: all cores]")
         ->delimiter(',')
         ->type_name("LIST")
-        ->transform(decimal_integer(0, kMaxInt));
-    cmd->add_option("--reps", a->reps, "Timed repetitions per row [default: 5]")
-        ->transform(decimal_integer(1, kMaxInt));
+        ->transform(decimal_integer(0, kMaxThreadCount));
+    cmd->add_option("--reps", a->reps,
+                    "Timed repetitions per row, " + integer_range_text(1, kNoIntegerLimit) +
+                        " [default: 5]")
+        ->transform(decimal_integer(1, kNoIntegerLimit));
     cmd->add_option("--warmup", a->warmup,
-                    "Untimed runs before them, 0 for none (the hits of the last timed run "
-                    "are validated) [default: 1]")
-        ->transform(decimal_integer(0, kMaxInt));
-    cmd->add_option("--width", a->width, "Frame width [default: 1920]")
-        ->transform(decimal_integer(1, kMaxInt));
-    cmd->add_option("--height", a->height, "Frame height [default: 1080]")
-        ->transform(decimal_integer(1, kMaxInt));
+                    "Untimed runs before them, " + integer_range_text(0, kNoIntegerLimit) +
+                        "; 0 for none (the hits of the last timed run are validated) "
+                        "[default: 1]")
+        ->transform(decimal_integer(0, kNoIntegerLimit));
+    cmd->add_option("--width", a->width,
+                    "Frame width, " + integer_range_text(1, kMaxImageSide) + " [default: 1920]")
+        ->transform(decimal_integer(1, kMaxImageSide));
+    cmd->add_option(
+           "--height", a->height,
+           "Frame height, " + integer_range_text(1, kMaxImageSide) + " [default: 1080]")
+        ->transform(decimal_integer(1, kMaxImageSide));
     cmd->add_option("--json", a->json, "Also write the report as JSON")->type_name("FILE");
     cmd->add_option("--csv", a->csv,
                     "Also write the rows as CSV (one line per row, the JSON rows' keys)")
         ->type_name("FILE");
-    cmd->add_option(
-           "--tile", a->tiles,
-           "Tile sizes WxH (tiled order, whole renders); a list is measured in one run "
-           "[default: 16x16]")
+    cmd->add_option("--tile", a->tiles,
+                    "Tile sizes WxH (or N for NxN), sides " +
+                        integer_range_text(1, kMaxTileSide) +
+                        " (tiled order, whole renders); a list is measured in one run "
+                        "[default: 16x16]")
         ->delimiter(',')
-        ->type_name("LIST");
+        ->type_name("LIST")
+        ->transform(tile_size(kMaxTileSide));
     cmd->add_option("--order", a->orders,
                     "Pixel orders of the rays: rowmajor, tiled, morton [default: tiled]")
         ->delimiter(',')
@@ -265,17 +275,19 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         ->delimiter(',')
         ->type_name("LIST");
     cmd->add_option("--packet-lanes", a->packet_lanes,
-                    "With the BVH: packets with fewer live lanes go on ray by ray; 0 packets "
-                    "only, 9 single rays only [default: " +
+                    "With the BVH: packets with fewer live lanes go on ray by ray, each " +
+                        integer_range_text(0, kMaxPacketLanes) + "; 0 packets only, " +
+                        std::to_string(kMaxPacketLanes) + " single rays only [default: " +
                         std::to_string(kBvhPacketMinLanes) + "]")
         ->delimiter(',')
         ->type_name("LIST")
-        ->transform(decimal_integer(0, 9));
+        ->transform(decimal_integer(0, kMaxPacketLanes));
     cmd->add_option(
            "--validate-rays", a->validate_rays,
            "Rays per set checked against the oracles (octray rows: the scalar reference, bit "
-           "for bit; Embree rows: double precision, within 1e-4), 0 for all [default: 65536]")
-        ->transform(decimal_integer(0, std::numeric_limits<std::uint32_t>::max()));
+           "for bit; Embree rows: double precision, within 1e-4), " +
+               integer_range_text(0, kMaxValidateRays) + "; 0 for all [default: 65536]")
+        ->transform(decimal_integer(0, kMaxValidateRays));
     cmd->add_flag("--no-embree", a->no_embree, "Measure octray alone");
     cmd->footer(
         "Examples:\n"

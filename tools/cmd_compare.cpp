@@ -137,32 +137,38 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
 
     CompareOptions& o = args->options;
     cmd->add_option("--fail", o.fail_threshold,
-                    "A pixel fails when any channel differs by more than X (>= 0, or inf)")
+                    "A pixel fails when any channel differs by more than X (" +
+                        real_range_text(0.0, kMaxThreshold, true) + ")")
         ->type_name("X")
         ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
-    cmd->add_option("--failpercent", o.fail_percent,
-                    "FAIL when more than P% of the pixels fail, 0..100")
+    cmd->add_option(
+           "--failpercent", o.fail_percent,
+           "FAIL when more than P% of the pixels fail, " + real_range_text(0.0, 100.0, false))
         ->type_name("P")
         ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
     cmd->add_option("--hardfail", o.hard_fail,
-                    "FAIL when any one error exceeds H (>= 0, or inf: no hard limit)")
+                    "FAIL when any one error exceeds H (" +
+                        real_range_text(0.0, kMaxThreshold, true) + ": no hard limit)")
         ->type_name("H")
         ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
     cmd->add_option("--warn", o.warn_threshold,
-                    "A pixel warns when any channel differs by more than X (>= 0, or inf)")
+                    "A pixel warns when any channel differs by more than X (" +
+                        real_range_text(0.0, kMaxThreshold, true) + ")")
         ->type_name("X")
         ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
-    cmd->add_option("--warnpercent", o.warn_percent,
-                    "WARN when more than P% of the pixels warn, 0..100")
+    cmd->add_option(
+           "--warnpercent", o.warn_percent,
+           "WARN when more than P% of the pixels warn, " + real_range_text(0.0, 100.0, false))
         ->type_name("P")
         ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
     cmd->add_option("--hardwarn", o.hard_warn,
-                    "WARN when any one error exceeds H (>= 0, or inf: no hard limit)")
+                    "WARN when any one error exceeds H (" +
+                        real_range_text(0.0, kMaxThreshold, true) + ": no hard limit)")
         ->type_name("H")
         ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
@@ -187,7 +193,8 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
         ->capture_default_str();
     cmd->add_option("--scale", args->scale,
                     "Multiply the error by F before --heatmap maps it (as idiff's -scale):\n"
-                    "the top of the ramp is then 1/F, not the largest error (F > 0)")
+                    "the top of the ramp is then 1/F, not the largest error (F " +
+                        real_range_text(0.0, kMaxThreshold, false) + ", not 0)")
         ->type_name("F")
         ->transform(real_number(0.0, kMaxThreshold, false));
     cmd->add_flag("--json", args->json, "Print the figures as JSON instead of the report");

@@ -1,5 +1,5 @@
 // `octray completion bash|zsh`: a shell completion script generated from the option
-// definitions the parser itself uses (every command and option registered in main.cpp),
+// definitions the parser itself uses (every command and option registered in app.cpp),
 // so a new option is completed without anyone editing a script.
 
 #include <CLI/CLI.hpp>

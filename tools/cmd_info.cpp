@@ -12,12 +12,13 @@
 #include "scene/bvh.h"
 #include "scene/compile.h"
 #include "scene/load.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
 namespace {
 
-void run_info(const std::string& scene_spec) {
+void run_info(const std::string& scene_spec, bool quiet) {
     const CpuSupport cpu = cpu_support();
     std::printf("octray   %s\n", kVersion);
     std::printf("cpu      sse2 %s, sse4.1 %s, avx2 %s, fma %s\n", cpu.sse2 ? "yes" : "no",
@@ -39,6 +40,7 @@ void run_info(const std::string& scene_spec) {
     if (scene_spec.empty()) return;
 
     const Scene scene = load_scene(scene_spec);
+    print_scene_warnings(scene, quiet);
     const CompiledScene c = compile_scene(scene);
     std::printf("scene    %s: %dx%d, %d spp, max depth %d\n", scene_spec.c_str(),
                 scene.image.width, scene.image.height, scene.image.spp, scene.render.max_depth);
@@ -67,6 +69,7 @@ void run_info(const std::string& scene_spec) {
 
 void add_info_command(CLI::App& app, CommandRunner& run) {
     auto scene = std::make_shared<std::string>();
+    auto quiet = std::make_shared<bool>(false);
     CLI::App* cmd = app.add_subcommand(
         "info",
         "Show the CPU's instruction sets and the kernels octray will use; with a "
@@ -79,7 +82,9 @@ void add_info_command(CLI::App& app, CommandRunner& run) {
         "  octray info                      # the CPU and the kernels --isa auto picks\n"
         "  octray info random:65536         # and the scene's counts and sphere BVH\n\n" +
         exit_code_help());
-    cmd->callback([scene, &run] { run.action = [scene] { run_info(*scene); }; });
+    cmd->add_flag("-q,--quiet", *quiet, kQuietHelp);
+    cmd->callback(
+        [scene, quiet, &run] { run.action = [scene, quiet] { run_info(*scene, *quiet); }; });
 }
 
 }  // namespace octray::tools

@@ -62,6 +62,7 @@ struct RenderArguments {
     bool skip_existing = false;
     bool placeholders = false;
     bool stats = false;
+    bool quiet = false;
     std::string crop;
     std::string aov;
     std::string progress = "auto";
@@ -91,25 +92,16 @@ struct TileSize {
     int width = 0, height = 0;
 };
 
-// "WxH", or "N" for a square tile; both sides in [1, 4096].
+// The --tile value, which its transform (tile_size) has made canonical "WxH" with sides in
+// [1, kMaxTileSide]; nullopt for anything else.
 std::optional<TileSize> parse_tile(const std::string& text) {
-    auto parse_side = [](std::string_view s) -> std::optional<int> {
-        int value = 0;
-        const auto [end, error] = std::from_chars(s.data(), s.data() + s.size(), value);
-        if (error != std::errc() || end != s.data() + s.size() || value < 1 || value > 4096)
-            return std::nullopt;
-        return value;
-    };
-    const std::size_t x = text.find_first_of("xX");
-    if (x == std::string::npos) {
-        const auto side = parse_side(text);
-        if (!side) return std::nullopt;
-        return TileSize{*side, *side};
-    }
-    const auto w = parse_side(std::string_view(text).substr(0, x));
-    const auto h = parse_side(std::string_view(text).substr(x + 1));
-    if (!w || !h) return std::nullopt;
-    return TileSize{*w, *h};
+    const std::size_t x = text.find('x');
+    if (x == std::string::npos) return std::nullopt;
+    const auto w = parse_decimal_integer(std::string_view(text).substr(0, x));
+    const auto h = parse_decimal_integer(std::string_view(text).substr(x + 1));
+    if (!w || !h || *w < 1 || *h < 1 || *w > kMaxTileSide || *h > kMaxTileSide)
+        return std::nullopt;
+    return TileSize{static_cast<int>(*w), static_cast<int>(*h)};
 }
 
 // ---- Pre-flight: everything that can be checked before the first frame ----------------
@@ -449,7 +441,10 @@ void run_render(const RenderArguments& args) {
     }
 
     std::vector<BatchScene> scenes;
-    for (const std::string& spec : args.scenes) scenes.push_back(load_batch_scene(spec, args));
+    for (const std::string& spec : args.scenes) {
+        scenes.push_back(load_batch_scene(spec, args));
+        print_scene_warnings(scenes.back().scene, args.quiet);
+    }
 
     RenderMemoryParams memory;
     memory.threads = args.threads;
@@ -548,9 +543,10 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("i/n|auto");
     args->shard_count_option =
         cmd->add_option("--shard-count", args->shard_count,
-                        "The number of shards for --shard auto with JOB_COMPLETION_INDEX")
+                        "The number of shards for --shard auto with JOB_COMPLETION_INDEX, " +
+                            integer_range_text(1, kMaxShardCount))
             ->type_name("N")
-            ->transform(decimal_integer(1, 1 << 20));
+            ->transform(decimal_integer(1, kMaxShardCount));
     cmd->add_flag("--skip-existing", args->skip_existing,
                   "Resume: leave frames whose outputs (the EXR and the --png preview) all\n"
                   "exist (outputs are written atomically, so an existing file is finished;\n"
@@ -564,6 +560,7 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
     cmd->add_flag("--stats", args->stats,
                   "After each frame, print the seconds of each phase on stderr: load (read,\n"
                   "hash and parse the scene, once per scene), compile, BVH, render, write");
+    cmd->add_flag("-q,--quiet", args->quiet, kQuietHelp);
     cmd->add_option("--crop", args->crop,
                     "Render only pixels x0..x1-1, y0..y1-1 (row 0 on top) into an EXR whose\n"
                     "data window is that region; `octray assemble` stitches regions together")
@@ -590,36 +587,43 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("SIZE");
     args->width_option =
         cmd->add_option("--width", args->width,
-                        "Image width in pixels, 1..65536 (overrides the scene)")
+                        "Image width in pixels, " + integer_range_text(1, kMaxImageSide) +
+                            " (overrides the scene)")
             ->type_name("W")
-            ->transform(decimal_integer(1, 65536));
+            ->transform(decimal_integer(1, kMaxImageSide));
     args->height_option =
         cmd->add_option("--height", args->height,
-                        "Image height in pixels, 1..65536 (overrides the scene)")
+                        "Image height in pixels, " + integer_range_text(1, kMaxImageSide) +
+                            " (overrides the scene)")
             ->type_name("H")
-            ->transform(decimal_integer(1, 65536));
+            ->transform(decimal_integer(1, kMaxImageSide));
     args->spp_option =
         cmd->add_option("--spp", args->spp,
-                        "Samples per pixel, 1..2^20; square counts are stratified, others\n"
-                        "jittered (overrides the scene)")
+                        "Samples per pixel, " + integer_range_text(1, kMaxSamples) +
+                            "; square counts are stratified, others\n"
+                            "jittered (overrides the scene)")
             ->type_name("N")
-            ->transform(decimal_integer(1, 1 << 20));
+            ->transform(decimal_integer(1, kMaxSamples));
     args->max_depth_option =
         cmd->add_option("--max-depth", args->max_depth,
-                        "Reflection/refraction bounces, 0.." + std::to_string(kMaxDepthLimit) +
+                        "Reflection/refraction bounces, " +
+                            integer_range_text(0, kMaxDepthLimit) +
                             "; 0 = primary rays only\n(overrides the scene)")
             ->type_name("D")
             ->transform(decimal_integer(0, kMaxDepthLimit));
     args->seed_option =
         cmd->add_option("--seed", args->seed,
-                        "Seed of the sample jitter, 0..2^64-1 (overrides the scene)")
+                        "Seed of the sample jitter, " +
+                            integer_range_text(0, std::numeric_limits<std::uint64_t>::max()) +
+                            "\n(overrides the scene)")
             ->type_name("S")
             ->transform(decimal_integer(0, std::numeric_limits<std::uint64_t>::max()));
     cmd->add_option("--threads", args->threads,
-                    "Worker threads, 0..4096; 0 = every core available (the image does not\n"
-                    "depend on it)")
+                    "Worker threads, " + integer_range_text(0, kMaxThreadCount) +
+                        "; 0 = every core available (the image does not\n"
+                        "depend on it)")
         ->type_name("N")
-        ->transform(decimal_integer(0, 4096))
+        ->transform(decimal_integer(0, kMaxThreadCount))
         ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer);\n"
@@ -656,13 +660,11 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                 {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})))
             ->capture_default_str();
     cmd->add_option("--tile", args->tile,
-                    "Tile size WxH (or N for NxN) handed to the worker threads; the image\n"
-                    "does not depend on it")
+                    "Tile size WxH (or N for NxN), sides " +
+                        integer_range_text(1, kMaxTileSide) +
+                        ", handed to the worker threads;\nthe image does not depend on it")
         ->type_name("WxH")
-        ->check([](const std::string& text) {
-            return parse_tile(text) ? std::string()
-                                    : "expected WxH with sides 1..4096, e.g. 16x16";
-        })
+        ->transform(tile_size(kMaxTileSide))
         ->capture_default_str();
     cmd->footer(
         "Examples:\n"

@@ -12,6 +12,7 @@
 
 #include "render/image_io.h"
 #include "scene/load.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -20,6 +21,7 @@ namespace {
 struct SceneArguments {
     std::string scene;
     std::string output;  // empty: standard output
+    bool quiet = false;
 };
 
 void write_text(const std::string& path, const std::string& text) {
@@ -31,7 +33,9 @@ void write_text(const std::string& path, const std::string& text) {
 }
 
 void run_scene(const SceneArguments& args) {
-    std::string json = scene_to_json(load_scene(args.scene));
+    const Scene scene = load_scene(args.scene);
+    print_scene_warnings(scene, args.quiet);
+    std::string json = scene_to_json(scene);
     if (json.empty() || json.back() != '\n') json += '\n';
     if (args.output.empty()) {
         std::cout << json << std::flush;
@@ -60,6 +64,7 @@ void add_scene_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option("-o,--output", args->output,
                     "Output JSON file, written atomically [default: standard output]")
         ->type_name("FILE");
+    cmd->add_flag("-q,--quiet", args->quiet, kQuietHelp);
     cmd->footer(
         "Examples:\n"
         "  octray scene random:16 -o random16.json\n"

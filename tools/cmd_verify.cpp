@@ -35,6 +35,7 @@ struct VerifyArguments {
     double fail = 0.0;          // a pixel fails when a channel is off by more
     double fail_percent = 0.0;  // ... and at most this % of the pixels may
     double hard_fail = 0.0;     // no value may be off by more
+    bool quiet = false;
 };
 
 ChannelImage to_channels(const Image& image) {
@@ -106,6 +107,7 @@ void run_verify(const VerifyArguments& args) {
         }
     }
     Scene scene = load_scene(args.scene);
+    print_scene_warnings(scene, args.quiet);
     if (args.width > 0) scene.image.width = args.width;
     if (args.height > 0) scene.image.height = args.height;
     if (args.spp > 0) scene.image.spp = args.spp;
@@ -148,18 +150,26 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option("scene", args->scene, "Scene: a JSON file or a built-in (as for render)")
         ->type_name("SCENE")
         ->capture_default_str();
-    cmd->add_option("--width", args->width, "Image width (overrides the scene)")
+    cmd->add_option(
+           "--width", args->width,
+           "Image width, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
         ->type_name("W")
-        ->transform(decimal_integer(1, 65536));
-    cmd->add_option("--height", args->height, "Image height (overrides the scene)")
+        ->transform(decimal_integer(1, kMaxImageSide));
+    cmd->add_option(
+           "--height", args->height,
+           "Image height, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
         ->type_name("H")
-        ->transform(decimal_integer(1, 65536));
-    cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")
+        ->transform(decimal_integer(1, kMaxImageSide));
+    cmd->add_option("--spp", args->spp,
+                    "Samples per pixel, " + integer_range_text(1, kMaxSamples) +
+                        " (overrides the scene)")
         ->type_name("N")
-        ->transform(decimal_integer(1, 1 << 20));
-    cmd->add_option("--threads", args->threads, "Worker threads; 0 = every core")
+        ->transform(decimal_integer(1, kMaxSamples));
+    cmd->add_option(
+           "--threads", args->threads,
+           "Worker threads, " + integer_range_text(0, kMaxThreadCount) + "; 0 = every core")
         ->type_name("N")
-        ->transform(decimal_integer(0, 4096))
+        ->transform(decimal_integer(0, kMaxThreadCount))
         ->capture_default_str();
     cmd->add_option("--frames", args->frames,
                     "Frames of an animated scene to verify, as render takes them: 5, 1-100,\n"
@@ -170,19 +180,25 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
     cmd->add_option("--fail", args->fail,
-                    "A pixel fails when any channel differs by more than X; 0 = exact")
+                    "A pixel fails when any channel differs by more than X (" +
+                        real_range_text(0.0, std::numeric_limits<double>::max(), true) +
+                        "); 0 = exact")
         ->type_name("X")
         ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();
-    cmd->add_option("--failpercent", args->fail_percent,
-                    "FAIL when more than P% of the pixels fail, 0..100")
+    cmd->add_option(
+           "--failpercent", args->fail_percent,
+           "FAIL when more than P% of the pixels fail, " + real_range_text(0.0, 100.0, false))
         ->type_name("P")
         ->transform(real_number(0.0, 100.0, false))
         ->capture_default_str();
-    cmd->add_option("--hardfail", args->hard_fail, "FAIL when any one error exceeds H")
+    cmd->add_option("--hardfail", args->hard_fail,
+                    "FAIL when any one error exceeds H (" +
+                        real_range_text(0.0, std::numeric_limits<double>::max(), true) + ")")
         ->type_name("H")
         ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();
+    cmd->add_flag("-q,--quiet", args->quiet, kQuietHelp);
     cmd->footer(
         "Examples:\n"
         "  octray verify whitted\n"

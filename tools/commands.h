@@ -1,12 +1,13 @@
 #pragma once
 // The `octray` subcommands. Each lives in its own cmd_<name>.cpp and registers itself with
-// one add_<name>_command() call in main.cpp, so a new command is a new file and one line.
+// one add_<name>_command() call in app.cpp, so a new command is a new file and one line.
 //
 // A command's parse callback only records what to do (CommandRunner::action); main() runs
 // it after the whole command line has parsed, so every command shares one mapping from
 // exceptions to exit codes (run_command below).
 
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -57,6 +58,10 @@ std::string help_hint(const std::string& command);
 // it; a usage error names the command's own help and exits with `usage_status`.
 int run_command(const std::function<void()>& action, const std::string& command,
                 int usage_status);
+
+// The whole `octray` application, every command registered (with `run`) as main() parses
+// with it; tests walk its options.
+std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run);
 
 void add_render_command(CLI::App& app, CommandRunner& run);
 void add_scene_command(CLI::App& app, CommandRunner& run);

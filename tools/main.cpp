@@ -5,63 +5,17 @@
 #include <csignal>
 #include <exception>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "core/version.h"
-#include "render/image_io.h"
-#include "scene/scene_error.h"
 #include "scene/suggest.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
-
-std::string exit_code_help() {
-    return "Exit codes:\n"
-           "  0  success\n"
-           "  1  unexpected internal error (a bug, or out of memory)\n"
-           "  2  usage error: unknown option, bad value, bad combination of options\n"
-           "     (octray compare: 5, as 2 is its FAIL verdict; see its --help)\n"
-           "  3  scene error: the scene file or built-in spec cannot be loaded or is invalid\n"
-           "  4  I/O error: an output file cannot be written (nothing partial is left),\n"
-           "     or standard output cannot be (a closed pipe: EPIPE, not death by SIGPIPE)\n";
-}
-
-std::string help_hint(const std::string& command) {
-    return "Run 'octray " + (command.empty() ? std::string() : command + " ") +
-           "--help' for more information.";
-}
-
-int run_command(const std::function<void()>& action, const std::string& command,
-                int usage_status) {
-    try {
-        action();
-        return kExitSuccess;
-    } catch (const CommandExit& e) {
-        return e.status;
-    } catch (const UsageError& e) {
-        std::cerr << "octray: error: " << e.what() << '\n' << help_hint(command) << '\n';
-        return usage_status;
-    } catch (const SceneError& e) {
-        std::cerr << "octray: scene error: " << e.what() << '\n';
-        return kExitScene;
-    } catch (const IoError& e) {
-        std::cerr << "octray: I/O error: " << e.what() << '\n';
-        return kExitIo;
-    } catch (const std::bad_alloc&) {
-        std::cerr << "octray: out of memory\n";
-        return kExitInternal;
-    } catch (const std::exception& e) {
-        std::cerr << "octray: internal error: " << e.what() << '\n';
-        return kExitInternal;
-    } catch (...) {
-        std::cerr << "octray: internal error: unknown exception\n";
-        return kExitInternal;
-    }
-}
 
 namespace {
 
@@ -137,32 +91,9 @@ int main(int argc, char** argv) {
     // process with status 141.
     std::signal(SIGPIPE, SIG_IGN);
 
-    CLI::App app{"octray renders Whitted-style ray-traced images (OpenEXR, with PNG previews).",
-                 "octray"};
-    app.set_version_flag("-V,--version", std::string("octray ") + octray::kVersion,
-                         "Print the version and exit");
-    app.require_subcommand(1);
-    app.footer(
-        "Examples:\n"
-        "  octray render                                  # the built-in whitted scene -> "
-        "whitted.exr\n"
-        "  octray render whitted -o whitted.exr --png whitted.png\n"
-        "  octray render random:1024,width=640,height=360 --spp 4 -o random.exr\n"
-        "  octray scene random:16 -o random16.json        # a built-in written as JSON\n"
-        "Run 'octray help <command>' (or 'octray <command> --help') for the options of a\n"
-        "command.\n\n" +
-        exit_code_help());
-
     CommandRunner run;
-    add_render_command(app, run);
-    add_scene_command(app, run);
-    add_compare_command(app, run);
-    add_bench_command(app, run);
-    add_verify_command(app, run);
-    add_info_command(app, run);
-    add_assemble_command(app, run);
-    add_man_command(app, run);
-    add_completion_command(app, run);
+    const std::unique_ptr<CLI::App> app_owner = make_octray_app(run);
+    CLI::App& app = *app_owner;
 
     std::vector<std::string> args(argv, argv + argc);
     if (const std::string error = rewrite_help_command(app, args); !error.empty()) {

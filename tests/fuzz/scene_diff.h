@@ -52,6 +52,7 @@ inline std::string first_scene_difference(const Scene& a, const Scene& b) {
     if (!same(ca.width, cb.width)) return "camera.width";
     if (!same(ca.aperture, cb.aperture)) return "camera.aperture";
     if (!same(ca.focus_distance, cb.focus_distance)) return "camera.focus_distance";
+    if (ca.fov_units_stated != cb.fov_units_stated) return "camera.fov_units";
 
     if (a.background.type != b.background.type) return "background.type";
     if (a.background.type == BackgroundType::constant) {

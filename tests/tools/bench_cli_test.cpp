@@ -136,7 +136,7 @@ TEST_F(BenchCliTest, RangeErrorsReadAsTheOptionsLimits) {
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
         {{"--warmup", "-1"}, "--warmup must be an integer >= 0"},
         {{"--reps", "0"}, "--reps must be an integer >= 1"},
-        {{"--threads", "1,x"}, "--threads must be an integer >= 0"},
+        {{"--threads", "1,x"}, "--threads must be an integer from 0 to 4096 (got \"x\")"},
         {{"--packet-lanes", "10"}, "--packet-lanes must be an integer from 0 to 9"},
     };
     for (const auto& [args, message] : cases) {

@@ -814,4 +814,64 @@ TEST_F(CliTest, SimdPathMatchesScalarAndVerifyPasses) {
     EXPECT_TRUE(contains(info.output, "5 spheres")) << info.output;
 }
 
+// Issue 26: a pinhole fov below 2 degrees is probably radians: every command that loads the
+// scene warns on stderr, naming the file and the key; --quiet, or the camera's
+// "fov_units": "degrees", silences it; any other fov_units is a scene error.
+TEST_F(CliTest, SmallFovWarnsThatFovIsInDegrees) {
+    const auto scene = [&](const std::string& name, const std::string& camera_extra) {
+        std::ofstream(path(name))
+            << R"({ "image": { "width": 4, "height": 4 }, "camera": { "eye": [0, 0, 5], )"
+               R"("lookat": [0, 0, 0], )"
+            << camera_extra
+            << R"( }, "objects": [ { "type": "sphere", "center": [0, 0, 0], "radius": 1, )"
+               R"("material": { "color": 0.5 } } ] })";
+        return path(name);
+    };
+    const std::string radians = scene("radians.json", R"("fov": 0.87)");
+    const std::string warning =
+        "octray: warning: " + radians + ": camera.fov: fov 0.87 is below 2; fov is in degrees";
+    const RunResult render = octray({"render", radians, "-o", "r.exr", "--progress", "none"});
+    EXPECT_EQ(render.status, 0) << render.output;
+    EXPECT_TRUE(contains(render.output, warning)) << render.output;
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"scene", radians, "-o", "s.json"},
+          std::vector<std::string>{"verify", radians},
+          std::vector<std::string>{"info", radians}}) {
+        const RunResult r = octray(args);
+        EXPECT_EQ(r.status, 0) << args[0] << "\n" << r.output;
+        EXPECT_TRUE(contains(r.output, warning)) << args[0] << "\n" << r.output;
+        std::vector<std::string> quiet = args;
+        quiet.push_back("--quiet");
+        const RunResult q = octray(quiet);
+        EXPECT_EQ(q.status, 0) << args[0] << "\n" << q.output;
+        EXPECT_FALSE(contains(q.output, "warning")) << args[0] << "\n" << q.output;
+    }
+    // Warnings go to stderr: stdout stays the command's own output.
+    EXPECT_FALSE(contains(octray({"info", radians}, false).output, "warning"));
+
+    const RunResult quiet =
+        octray({"render", radians, "-o", "q.exr", "--progress", "none", "-q"});
+    EXPECT_EQ(quiet.status, 0) << quiet.output;
+    EXPECT_FALSE(contains(quiet.output, "warning")) << quiet.output;
+
+    const RunResult two = octray(
+        {"render", scene("two.json", R"("fov": 2)"), "-o", "t.exr", "--progress", "none"});
+    EXPECT_EQ(two.status, 0) << two.output;
+    EXPECT_FALSE(contains(two.output, "warning")) << two.output;
+
+    const RunResult stated =
+        octray({"render", scene("stated.json", R"("fov": 0.5, "fov_units": "degrees")"), "-o",
+                "d.exr", "--progress", "none"});
+    EXPECT_EQ(stated.status, 0) << stated.output;
+    EXPECT_FALSE(contains(stated.output, "warning")) << stated.output;
+
+    const std::string bad = scene("bad.json", R"("fov": 0.5, "fov_units": "radians")");
+    const RunResult refused = octray({"render", bad, "-o", "b.exr"});
+    EXPECT_EQ(refused.status, 3) << refused.output;
+    EXPECT_TRUE(contains(refused.output, bad + ": camera.fov_units: expected one of "
+                                               "\"degrees\", found the string \"radians\""))
+        << refused.output;
+    EXPECT_FALSE(fs::exists(path("b.exr")));
+}
+
 }  // namespace
