@@ -13,7 +13,7 @@ namespace octray {
 enum class Accel { automatic, bvh, none };
 
 // The sphere count from which Accel::automatic builds a BVH: the crossover measured by
-// `octray bench` (docs/performance-log.md, "BVH: the auto crossover").
+// `octray bench` (docs/performance-log.md, "The `auto` crossover").
 inline constexpr std::uint32_t kBvhAutoMinSpheres = 32;
 
 // "auto", "bvh", "none".
