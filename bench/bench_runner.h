@@ -105,6 +105,10 @@ struct SceneInfo {
     // the spheres), 8-wide nodes, leaves, depth. Absent without spheres.
     std::optional<double> bvh_build_ms, bvh_bytes_per_sphere;
     std::uint32_t bvh_nodes = 0, bvh_leaves = 0, bvh_depth = 0;
+    // Time to first pixel: from the scene spec to the first finished tile of a render with
+    // the bench's threads: load (generate or parse), validate, compile, build the BVH,
+    // trace the tile (the median of three, each from scratch).
+    double first_pixel_ms = 0.0;
     std::uint64_t primary_rays = 0, shadow_rays = 0, secondary_rays = 0;  // ray set sizes
 };
 

@@ -83,6 +83,9 @@ TEST(Report, JsonHasTheContextAndRowsSchema) {
     ASSERT_EQ(j.at("scenes").size(), 1u);
     EXPECT_EQ(j["scenes"][0].at("spheres").get<int>(), 16);
     EXPECT_GT(j["scenes"][0].at("primary_rays").get<int>(), 0);
+    // Time to first pixel: load, compile, BVH and one tile, so more than the compile alone.
+    EXPECT_GT(j["scenes"][0].at("first_pixel_ms").get<double>(), 0.0);
+    EXPECT_EQ(j["scenes"][0]["first_pixel_ms"].get<double>(), report.scenes[0].first_pixel_ms);
 
     const nlohmann::json& rows = j.at("rows");
     ASSERT_TRUE(rows.is_array());
