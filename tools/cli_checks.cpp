@@ -106,25 +106,36 @@ CLI::Validator decimal_integer(std::uint64_t lo, std::uint64_t hi) {
         "", std::string(kIntegerValidatorName) + std::to_string(lo) + " " + std::to_string(hi));
 }
 
-std::optional<IntegerLimits> integer_option_limits(CLI::Option& option) {
+namespace {
+
+// The names of `option`'s validators, in order, that start with `prefix`, the prefix cut.
+std::vector<std::string> validator_arguments(CLI::Option& option, std::string_view prefix) {
+    std::vector<std::string> found;
     for (int i = 0;; ++i) {
         const CLI::Validator* validator = nullptr;
         try {
             validator = option.get_validator(i);
         } catch (const CLI::OptionNotFound&) {
-            return std::nullopt;
+            return found;
         }
-        const std::string name = validator->get_name();
-        if (name.rfind(kIntegerValidatorName, 0) != 0) continue;
-        const std::string_view numbers =
-            std::string_view(name).substr(kIntegerValidatorName.size());
+        const std::string& name = validator->get_name();
+        if (name.rfind(prefix, 0) == 0) found.push_back(name.substr(prefix.size()));
+    }
+}
+
+}  // namespace
+
+std::optional<IntegerLimits> integer_option_limits(CLI::Option& option) {
+    for (const std::string& numbers : validator_arguments(option, kIntegerValidatorName)) {
         const std::size_t space = numbers.find(' ');
-        const auto lo = parse_decimal_integer(numbers.substr(0, space));
+        const std::string_view text(numbers);
+        const auto lo = parse_decimal_integer(text.substr(0, space));
         const auto hi = space == std::string_view::npos
                             ? std::nullopt
-                            : parse_decimal_integer(numbers.substr(space + 1));
+                            : parse_decimal_integer(text.substr(space + 1));
         if (lo && hi) return IntegerLimits{*lo, *hi};
     }
+    return std::nullopt;
 }
 
 CLI::Validator tile_size(std::uint64_t max_side) {
@@ -156,17 +167,9 @@ std::string real_range_text(double lo, double hi, bool allow_infinity) {
 }
 
 std::optional<std::string> real_option_range_text(CLI::Option& option) {
-    static constexpr std::string_view kPrefix = "real_number ";
-    for (int i = 0;; ++i) {
-        const CLI::Validator* validator = nullptr;
-        try {
-            validator = option.get_validator(i);
-        } catch (const CLI::OptionNotFound&) {
-            return std::nullopt;
-        }
-        const std::string& name = validator->get_name();
-        if (name.rfind(kPrefix, 0) == 0) return name.substr(kPrefix.size());
-    }
+    const std::vector<std::string> found = validator_arguments(option, "real_number ");
+    if (found.empty()) return std::nullopt;
+    return found.front();
 }
 
 CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
