@@ -155,7 +155,7 @@ std::pair<Scene, std::string> load_scene_and_digest(const std::string& spec) {
     FileDigest digest;
     const std::string text =
         read_scene_file(spec, [&](std::string_view chunk) { digest.update(chunk); });
-    Scene scene = parse_scene_json(text, spec);
+    Scene scene = parse_scene_json(text, spec, text.capacity());
     return {std::move(scene), digest.hex()};
 }
 
