@@ -489,6 +489,10 @@ void read_objects(od::value& v, Scene& scene, Materials& materials,
     static constexpr std::array<std::string_view, 7> keys = {
         "type", "name", "material", "center", "radius", "point", "normal"};
     static constexpr std::array<std::string_view, 2> types = {"sphere", "plane"};
+    // Counting first (a skim over the structural index) spares the vector's regrowth.
+    const std::size_t count = take(v.count_elements());
+    scene.objects.reserve(count);
+    uses.reserve(count);
     for (auto element : take(v.get_array())) {
         od::value o = take(std::move(element));
         KeySet seen(keys);
