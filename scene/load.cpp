@@ -29,6 +29,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/aligned.h"
 #include "scene/builtin.h"
 #include "scene/camera.h"
 #include "scene/json_rules.h"
@@ -1430,6 +1431,7 @@ std::string read_scene_file(const std::string& path,
     constexpr std::size_t kChunk = std::size_t{1} << 20;
     std::string text;
     text.reserve(static_cast<std::size_t>(info.st_size) + kJsonPadding);
+    offer_huge_pages(text.data(), text.capacity());  // fewer page faults while filled
     std::size_t size = 0;
     for (;;) {
         const std::size_t room = text.capacity() - kJsonPadding - size;

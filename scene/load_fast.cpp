@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/aligned.h"
 #include "scene/json_rules.h"
 #include "scene/load.h"
 
@@ -493,6 +494,8 @@ void read_objects(od::value& v, Scene& scene, Materials& materials,
     const std::size_t count = take(v.count_elements());
     scene.objects.reserve(count);
     uses.reserve(count);
+    // 90 MB for a million spheres: 45 page faults instead of 22,000 (core/aligned.h).
+    offer_huge_pages(scene.objects.data(), count * sizeof(Object));
     for (auto element : take(v.get_array())) {
         od::value o = take(std::move(element));
         KeySet seen(keys);
