@@ -7,16 +7,14 @@
 // the same scene, bit for bit: tests/scene/json_readers_test.cpp and the scene fuzzer
 // check that they do. scene/README.md ("Two readers") lists the rules mirrored here.
 
-#include <locale.h>
+#include <locale.h>  // newlocale
 #include <simdjson.h>
-#include <stdlib.h>
+#include <stdlib.h>  // strtod_l
 
 #include <algorithm>
 #include <array>
-#include <clocale>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -806,7 +804,7 @@ std::optional<Scene> parse_scene_json_fast(std::string_view json_text,
                                            const std::string& source, std::size_t readable) {
     // nlohmann skips a UTF-8 byte order mark at the start; simdjson does not.
     constexpr std::string_view kBom = "\xEF\xBB\xBF";
-    std::size_t skip = json_text.substr(0, kBom.size()) == kBom ? kBom.size() : 0;
+    const std::size_t skip = json_text.substr(0, kBom.size()) == kBom ? kBom.size() : 0;
     // A NUL byte is never JSON text (the diagnosing reader says where it is).
     if (json_text.find('\0') != std::string_view::npos) return std::nullopt;
     try {
