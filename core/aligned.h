@@ -42,6 +42,20 @@ inline void* allocate_aligned(std::size_t bytes, Pages pages = Pages::normal) {
 #endif
     return p;
 }
+// The same offer for storage allocated elsewhere (a std::string or std::vector that is
+// about to be filled): the whole 2 MiB pages inside [p, p + bytes), if it holds 4 MiB or
+// more. Reading the 114 MB scene file of random:1048576 into a string offered this way
+// took 0.06 s instead of 0.11 s. Advice only.
+inline void offer_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (bytes < kHugePageMinBytes) return;
+    const std::size_t mask = kHugePageBytes - 1;
+    const std::size_t begin = (reinterpret_cast<std::size_t>(p) + mask) & ~mask;
+    const std::size_t end = (reinterpret_cast<std::size_t>(p) + bytes) & ~mask;
+    if (end > begin) (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#endif
+}
+
 // The unsized form: clang declares sized deallocation only with -fsized-deallocation.
 inline void free_aligned(void* p, std::size_t bytes, Pages pages = Pages::normal) noexcept {
     ::operator delete(p, storage_alignment(bytes, pages));

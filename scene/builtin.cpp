@@ -4,6 +4,9 @@
 
 #include "scene/builtin.h"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -31,6 +34,9 @@ namespace {
 constexpr std::uint64_t kMaxGeneratedSpheres = std::uint64_t{1} << 24;
 // sum 9^k for k = 0..7 is 5,380,840 spheres; level 8 would be 48 million, over the limit.
 constexpr int kMaxSphereflakeLevel = 7;
+// The big scenes are generated in parallel (oneTBB) in tasks of about this many spheres:
+// enough to outweigh a task's cost, few enough to balance two to a few dozen threads.
+constexpr std::uint64_t kSpheresPerTask = 4096;
 
 std::string quote_text(std::string_view s) { return "\"" + std::string(s) + "\""; }
 
@@ -243,14 +249,20 @@ Scene make_random(std::uint64_t count, std::uint64_t seed) {
     // radius = 0.6 N^(-1/3): the spheres fill about the same fraction of the cube for any N.
     const auto radius =
         static_cast<float>(0.6 * std::pow(static_cast<double>(count), -1.0 / 3.0));
-    SplitMix64 rng(seed);
-    s.objects.reserve(count);
-    for (std::uint64_t i = 0; i < count; ++i) {
-        const float x = 2.0f * rng.next_float() - 1.0f;
-        const float y = 2.0f * rng.next_float() - 1.0f;
-        const float z = 2.0f * rng.next_float() - 1.0f;
-        s.objects.push_back(make_sphere({x, y, z}, radius, material));
-    }
+    // Blocks of spheres in parallel, each from the generator skipped to its first sphere
+    // (three draws per sphere): the same scene for any thread count.
+    s.objects.resize(count, make_sphere({}, radius, material));
+    tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, count, kSpheresPerTask),
+                      [&](const tbb::blocked_range<std::uint64_t>& block) {
+                          SplitMix64 rng(seed);
+                          rng.discard(3 * block.begin());
+                          for (std::uint64_t i = block.begin(); i != block.end(); ++i) {
+                              const float x = 2.0f * rng.next_float() - 1.0f;
+                              const float y = 2.0f * rng.next_float() - 1.0f;
+                              const float z = 2.0f * rng.next_float() - 1.0f;
+                              s.objects[i].center = {x, y, z};
+                          }
+                      });
     return s;
 }
 
@@ -307,23 +319,39 @@ Mat3 rotation_from_z(Dir d) {
     return axis_rotation(Dir{-d.y / len, d.x / len, 0.0}, std::acos(d.z));
 }
 
-// Depth-first, parent before children, as SPD writes them. Positions are computed in
-// double and rounded once, so deep levels do not accumulate float error.
-void add_flake(Scene& s, const std::array<Dir, 9>& directions, Dir center, double radius,
-               Dir axis, int levels_left, std::uint32_t material) {
-    s.objects.push_back(make_sphere({static_cast<float>(center.x), static_cast<float>(center.y),
-                                     static_cast<float>(center.z)},
-                                    static_cast<float>(radius), material));
+// Spheres in a flake of `levels` levels below its root: sum 9^k for k = 0..levels.
+std::uint64_t flake_size(int levels) {
+    std::uint64_t count = 0, level_count = 1;
+    for (int k = 0; k <= levels; ++k, level_count *= 9) count += level_count;
+    return count;
+}
+
+// Depth-first, parent before children, as SPD writes them, into objects[at ...]: each
+// subtree has a known size, so the subtrees of the top levels are written in parallel,
+// at their serial positions. Positions are computed in double and rounded once, so deep
+// levels do not accumulate float error.
+void add_flake(std::vector<Object>& objects, std::size_t at,
+               const std::array<Dir, 9>& directions, Dir center, double radius, Dir axis,
+               int levels_left, std::uint32_t material) {
+    objects[at] = make_sphere({static_cast<float>(center.x), static_cast<float>(center.y),
+                               static_cast<float>(center.z)},
+                              static_cast<float>(radius), material);
     if (levels_left == 0) return;
     const Mat3 m = rotation_from_z(axis);
     // Touching: the child's center lies r + r/3 from the parent's.
     const double distance = radius * (1.0 + 1.0 / 3.0);
-    for (const Dir& d : directions) {
-        const Dir child_axis = apply(m, d);
+    const std::uint64_t child_size = flake_size(levels_left - 1);
+    const auto add_child = [&](std::size_t c) {
+        const Dir child_axis = apply(m, directions[c]);
         const Dir offset = child_axis * distance;
-        add_flake(s, directions,
+        add_flake(objects, at + 1 + c * child_size, directions,
                   Dir{center.x + offset.x, center.y + offset.y, center.z + offset.z},
                   radius / 3.0, child_axis, levels_left - 1, material);
+    };
+    if (child_size >= kSpheresPerTask) {
+        tbb::parallel_for(std::size_t{0}, directions.size(), add_child);
+    } else {
+        for (std::size_t c = 0; c < directions.size(); ++c) add_child(c);
     }
 }
 
@@ -361,11 +389,9 @@ Scene make_sphereflake(int levels) {
 
     // The floor touches the bottom of the root sphere (radius 0.5 at the origin).
     s.objects.push_back(make_plane({0.0f, 0.0f, -0.5f}, {0.0f, 0.0f, 1.0f}, floor_id, "floor"));
-    std::uint64_t count = 0, level_count = 1;
-    for (int k = 0; k <= levels; ++k, level_count *= 9) count += level_count;
-    s.objects.reserve(count + 1);
-    add_flake(s, child_directions(), Dir{0.0, 0.0, 0.0}, 0.5, Dir{0.0, 0.0, 1.0}, levels,
-              flake_id);
+    s.objects.resize(1 + flake_size(levels));
+    add_flake(s.objects, 1, child_directions(), Dir{0.0, 0.0, 0.0}, 0.5, Dir{0.0, 0.0, 1.0},
+              levels, flake_id);
     return s;
 }
 
@@ -377,6 +403,8 @@ std::uint64_t SplitMix64::next() {
 }
 
 float SplitMix64::next_float() { return static_cast<float>(next() >> 40) * 0x1.0p-24f; }
+
+void SplitMix64::discard(std::uint64_t n) { state_ += n * 0x9E3779B97F4A7C15ull; }
 
 bool is_builtin_scene(const std::string& spec) {
     const std::string_view name = builtin_name(spec);

@@ -22,6 +22,9 @@ class SplitMix64 {
     explicit SplitMix64(std::uint64_t state) : state_(state) {}
     std::uint64_t next();
     float next_float();  // (next() >> 40) * 2^-24, in [0, 1)
+    // Skips n outputs in O(1) (the state advances by a constant per output): a block of
+    // spheres is generated from its own copy, in parallel, with the serial values.
+    void discard(std::uint64_t n);
 
   private:
     std::uint64_t state_;

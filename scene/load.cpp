@@ -29,8 +29,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/aligned.h"
 #include "scene/builtin.h"
 #include "scene/camera.h"
+#include "scene/json_rules.h"
 #include "scene/suggest.h"
 
 namespace octray {
@@ -40,19 +42,15 @@ namespace {
 // file lists them, and errors are reported in reading order.
 using Json = nlohmann::ordered_json;
 
-constexpr int kMaxIntValue = std::numeric_limits<int>::max();
+using json_rules::kMaxDepthLimit;
+using json_rules::kMaxIntValue;
 // Recursion is bounded by the scene schema anyway; this only stops absurd files early.
 constexpr std::size_t kMaxNesting = 64;
-// Deeper than this, the kr/kt weight cut-off has long ended every real path; the cap
-// keeps the renderers' recursion (or ray queues) bounded.
-constexpr int kMaxDepthLimit = 64;
 // Pixel indices must fit in an int (the renderers and image writers index with int).
 constexpr std::int64_t kMaxPixels = std::numeric_limits<int>::max();
 constexpr std::int64_t kFramebufferBytesPerPixel = 12;  // three floats
-// Plane normals within this of unit length (squared) are kept bit for bit, so that a
-// written scene reads back identical; float normalisation lands well inside it.
-constexpr double kUnitTolerance = 1e-6;
-// validate_scene is looser: it only has to catch normals that were never normalised.
+// validate_scene is looser than json_rules::kUnitTolerance: it only has to catch normals
+// that were never normalised.
 constexpr double kValidateUnitTolerance = 1e-5;
 // Refraction scales directions by the index ratio (or its inverse); far beyond real
 // materials (1 to about 4) the float refraction vector loses its precision and degenerate
@@ -369,10 +367,7 @@ class Reader {
     float number(const Json& v, const std::string& path) const {
         if (!v.is_number()) fail(path, "expected a number, found " + describe(v));
         const double d = v.get<double>();
-        // Doubles below FLT_MAX + half an ulp round to FLT_MAX (the writer prints FLT_MAX
-        // as 3.4028235e+38, just above it); from there on they would round to infinity.
-        constexpr double kFloatRoundingLimit = 0x1.ffffffp+127;
-        if (!(std::fabs(d) < kFloatRoundingLimit)) {
+        if (!json_rules::fits_float(d)) {
             fail(path,
                  "expected a finite number within float range (magnitude at most "
                  "3.4028235e38), found " +
@@ -532,11 +527,8 @@ void read_camera(const Reader& r, const Json& j, Camera& camera) {
         if (j.contains("focus_distance")) {
             camera.focus_distance = r.number(j["focus_distance"], "camera.focus_distance");
         } else {
-            // Focus on the look-at point: what a photographer means by "looking at" it.
-            const Vec3 d = camera.lookat - camera.eye;
-            camera.focus_distance = static_cast<float>(
-                std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.y) * d.y +
-                          static_cast<double>(d.z) * d.z));
+            camera.focus_distance =
+                json_rules::default_focus_distance(camera.eye, camera.lookat);
         }
     }
 }
@@ -611,17 +603,11 @@ Material read_material(const Reader& r, const Json& j, const std::string& path) 
     return m;
 }
 
-// Normalises a plane normal in double (no overflow or underflow for any float input),
-// keeping normals that are already unit bit for bit so written scenes read back identical.
+// A plane normal made unit length (json_rules::unit_plane_normal), or the error for zero.
 Vec3 normalized_normal(const Reader& r, Vec3 n, const std::string& path) {
-    const double x = n.x, y = n.y, z = n.z;
-    const double len2 = x * x + y * y + z * z;
-    if (!(len2 > 0.0))
-        r.fail(path, "expected a non-zero normal vector, found " + format_vec(n));
-    if (std::fabs(len2 - 1.0) <= kUnitTolerance) return n;
-    const double len = std::sqrt(len2);
-    return {static_cast<float>(x / len), static_cast<float>(y / len),
-            static_cast<float>(z / len)};
+    const std::optional<Vec3> unit = json_rules::unit_plane_normal(n);
+    if (!unit) r.fail(path, "expected a non-zero normal vector, found " + format_vec(n));
+    return *unit;
 }
 
 struct MaterialTable {
@@ -1332,7 +1318,15 @@ class Validator {
 
 }  // namespace
 
-Scene parse_scene_json(std::string_view json_text, const std::string& source) {
+Scene parse_scene_json(std::string_view json_text, const std::string& source,
+                       std::size_t readable) {
+    if (std::optional<Scene> scene = parse_scene_json_fast(json_text, source, readable)) {
+        return std::move(*scene);
+    }
+    return parse_scene_json_diagnosing(json_text, source);
+}
+
+Scene parse_scene_json_diagnosing(std::string_view json_text, const std::string& source) {
     // The JSON library ends its input at a NUL byte, which would let anything after one
     // pass unread; strict JSON means the whole file, and JSON text never holds a NUL.
     if (const std::size_t nul = json_text.find('\0'); nul != std::string_view::npos) {
@@ -1438,24 +1432,47 @@ std::string read_scene_file(const std::string& path,
                          std::string("cannot read scene file: it is ") + kind +
                              "; expected a regular file (a JSON scene)");
     }
+    // Read straight into the string (no bounce buffer), a chunk at a time so that the
+    // caller's hash sees each chunk while it is in cache. The string holds the size fstat
+    // gave plus the padding; it grows only if the file grows while it is read.
+    constexpr std::size_t kChunk = std::size_t{1} << 20;
     std::string text;
-    text.reserve(static_cast<std::size_t>(info.st_size));
-    std::array<char, 1 << 16> buffer;
+    text.reserve(static_cast<std::size_t>(info.st_size) + kJsonPadding);
+    offer_huge_pages(text.data(), text.capacity());  // fewer page faults while filled
+    std::size_t size = 0;
     for (;;) {
-        const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), file.get());
-        text.append(buffer.data(), n);
-        if (on_chunk && n > 0) on_chunk(std::string_view(buffer.data(), n));
-        if (n < buffer.size()) break;
+        const std::size_t room = text.capacity() - kJsonPadding - size;
+        if (room == 0) {
+            // Full: at the end of the file, unless it grew since fstat.
+            char byte = 0;
+            if (std::fread(&byte, 1, 1, file.get()) == 0) break;
+            text.reserve(text.capacity() * 2);
+            text.push_back(byte);
+            if (on_chunk) on_chunk(std::string_view(&text[size], 1));
+            ++size;
+            continue;
+        }
+        const std::size_t want = std::min(kChunk, room);
+        text.resize(size + want);
+        const std::size_t n = std::fread(text.data() + size, 1, want, file.get());
+        if (on_chunk && n > 0) on_chunk(std::string_view(text.data() + size, n));
+        size += n;
+        text.resize(size);
+        if (n < want) break;
     }
     if (std::ferror(file.get())) {
         throw SceneError(path, "",
                          "cannot read scene file: " + std::generic_category().message(errno));
     }
+    // Zeroed padding: the fast reader's blocks past the end read defined bytes.
+    text.append(kJsonPadding, '\0');
+    text.resize(size);
     return text;
 }
 
 Scene load_scene_file(const std::string& path) {
-    return parse_scene_json(read_scene_file(path), path);
+    const std::string text = read_scene_file(path);
+    return parse_scene_json(text, path, text.capacity());
 }
 
 Scene load_scene(const std::string& spec) {

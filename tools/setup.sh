@@ -14,7 +14,7 @@ packages=(
     clang libclang-rt-14-dev clang-format
     dpkg-dev xz-utils
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
-    libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+    libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libsimdjson-dev
     libpng-dev libembree-dev libssl-dev
     slurmctld slurmd slurm-client munge
     python3-matplotlib groff-base

@@ -17,10 +17,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
 
 #include "render/image_io.h"
 #include "render/image_read.h"
@@ -78,12 +80,33 @@ inline void check_loaded_scene(const Scene& scene) {
 }
 
 // parse_scene_json on arbitrary bytes: SceneError, or a scene passing check_loaded_scene.
+// Its two readers must agree: the fast one (simdjson) gives a scene exactly when the
+// diagnosing one (nlohmann) does, and the same scene bit for bit. The fast reader reads
+// the bytes in place with exactly kJsonPadding bytes after them, as from a file, so ASan
+// sees any read beyond its padding.
 inline void check_scene_json(std::string_view text) {
+    std::vector<char> padded(text.size() + kJsonPadding, '\0');
+    std::copy(text.begin(), text.end(), padded.begin());
+    const std::optional<Scene> fast = parse_scene_json_fast(
+        std::string_view(padded.data(), text.size()), "fuzz.json", padded.size());
     Scene scene;
     try {
-        scene = parse_scene_json(text, "fuzz.json");
-    } catch (const SceneError&) {
-        return;  // refused with a located message: the expected outcome for most inputs
+        scene = parse_scene_json_diagnosing(text, "fuzz.json");
+    } catch (const SceneError& e) {
+        // Refused with a located message: the expected outcome for most inputs.
+        if (fast) {
+            throw InvariantBroken("the fast reader refuses what the diagnosing reader refuses",
+                                  e.what());
+        }
+        return;
+    }
+    if (!fast) {
+        throw InvariantBroken("the fast reader accepts what the diagnosing reader accepts",
+                              std::string(text.substr(0, 4096)));
+    }
+    const std::string difference = first_scene_difference(*fast, scene);
+    if (!difference.empty()) {
+        throw InvariantBroken("both readers build the same scene", difference);
     }
     check_loaded_scene(scene);
 }

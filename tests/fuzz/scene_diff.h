@@ -3,10 +3,11 @@
 // ("" when they are the same), for the fuzzers' round-trip invariant and the hardening
 // tests. Floats are compared as bit patterns: scene_to_json promises a scene that reads
 // back identical, so that rendering it gives a bit-identical image (-0 and +0 differ).
-// `source` is not compared (it names where a scene came from).
+// `source` is not compared (it names where a scene came from); the animation block is.
 
 #include <bit>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "scene/scene.h"
@@ -32,6 +33,43 @@ inline std::string material_difference(const Material& a, const Material& b) {
     if (a.checker.has_value() != b.checker.has_value()) return "checker (present)";
     if (a.checker && !same(a.checker->color, b.checker->color)) return "checker.color";
     if (a.checker && !same(a.checker->size, b.checker->size)) return "checker.size";
+    return "";
+}
+
+template <typename T>
+bool same_optional(const std::optional<T>& a, const std::optional<T>& b) {
+    if (a.has_value() != b.has_value()) return false;
+    return !a || same(*a, *b);
+}
+
+inline std::string animation_difference(const Animation& a, const Animation& b) {
+    if (a.frames != b.frames) return "frames";
+    if (std::bit_cast<std::uint64_t>(a.fps) != std::bit_cast<std::uint64_t>(b.fps))
+        return "fps";
+    if (a.camera.size() != b.camera.size()) return "camera (count)";
+    for (std::size_t i = 0; i < a.camera.size(); ++i) {
+        const std::string at = "camera[" + std::to_string(i) + "]";
+        const CameraKey &p = a.camera[i], &q = b.camera[i];
+        if (p.frame != q.frame) return at + ".frame";
+        if (!same_optional(p.eye, q.eye)) return at + ".eye";
+        if (!same_optional(p.lookat, q.lookat)) return at + ".lookat";
+        if (!same_optional(p.up, q.up)) return at + ".up";
+        if (!same_optional(p.fov, q.fov)) return at + ".fov";
+    }
+    if (a.objects.size() != b.objects.size()) return "objects (count)";
+    for (std::size_t i = 0; i < a.objects.size(); ++i) {
+        const std::string at = "objects[" + std::to_string(i) + "]";
+        const ObjectTrack &p = a.objects[i], &q = b.objects[i];
+        if (p.name != q.name) return at + ".name";
+        if (p.object != q.object) return at + ".object";
+        if (p.keys.size() != q.keys.size()) return at + " (key count)";
+        for (std::size_t k = 0; k < p.keys.size(); ++k) {
+            const std::string kat = at + "[" + std::to_string(k) + "]";
+            if (p.keys[k].frame != q.keys[k].frame) return kat + ".frame";
+            if (!same_optional(p.keys[k].center, q.keys[k].center)) return kat + ".center";
+            if (!same_optional(p.keys[k].radius, q.keys[k].radius)) return kat + ".radius";
+        }
+    }
     return "";
 }
 
@@ -106,6 +144,12 @@ inline std::string first_scene_difference(const Scene& a, const Scene& b) {
             if (!same(p.direction, q.direction)) return at + ".direction";
         }
         if (!same(p.color, q.color)) return at + ".color";
+    }
+
+    if (a.animation.has_value() != b.animation.has_value()) return "animation (present)";
+    if (a.animation) {
+        const std::string d = detail::animation_difference(*a.animation, *b.animation);
+        if (!d.empty()) return "animation." + d;
     }
     return "";
 }

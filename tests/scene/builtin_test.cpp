@@ -4,6 +4,7 @@
 #include "scene/builtin.h"
 
 #include <gtest/gtest.h>
+#include <oneapi/tbb/global_control.h>
 
 #include <cmath>
 #include <cstddef>
@@ -15,6 +16,7 @@
 
 #include "scene/camera.h"
 #include "scene/load.h"
+#include "scene_diff.h"
 
 namespace octray {
 namespace {
@@ -344,6 +346,74 @@ TEST(SceneBuiltin, LoadSceneDispatchesToGenerators) {
     EXPECT_EQ(s.objects.size(), 11u);
     EXPECT_EQ(s.image.width, 32);
     EXPECT_EQ(s.source, "sphereflake:1,width=32,height=32");
+}
+
+// The big built-ins are generated in parallel (oneTBB); the scene must not depend on the
+// thread count, and must be the serial definition's.
+
+Scene built_with_threads(const std::string& spec, std::size_t threads) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return make_builtin_scene(spec);
+}
+
+TEST(SceneBuiltin, ParallelGenerationIsTheSameForOneAndTwoThreads) {
+    for (const char* spec : {"random:100000,seed=5", "sphereflake:5"}) {
+        const Scene one = built_with_threads(spec, 1);
+        const Scene two = built_with_threads(spec, 2);
+        EXPECT_EQ(fuzz::first_scene_difference(one, two), "") << spec;
+    }
+}
+
+TEST(SceneBuiltin, ParallelRandomIsTheSerialSequence) {
+    const Scene s = built_with_threads("random:100000,seed=5", 2);
+    ASSERT_EQ(s.objects.size(), 100000u);
+    HandSplitMix rng{5};
+    for (const Object& o : s.objects) {
+        const float x = 2.0f * rng.next_float() - 1.0f;
+        const float y = 2.0f * rng.next_float() - 1.0f;
+        const float z = 2.0f * rng.next_float() - 1.0f;
+        ASSERT_EQ(o.center, (Vec3{x, y, z}));
+    }
+}
+
+TEST(SceneBuiltin, SplitMix64DiscardSkipsOutputs) {
+    SplitMix64 skipped(99);
+    skipped.discard(1000);
+    HandSplitMix rng{99};
+    for (int i = 0; i < 1000; ++i) (void)rng.next();
+    for (int i = 0; i < 10; ++i) EXPECT_EQ(skipped.next(), rng.next());
+}
+
+// In depth-first order the children of the sphere at p (with `left` levels below it) are
+// at p + 1 + c * size(left - 1): each touches its parent at a third of its radius. Level 5
+// is generated in parallel from the root's children down.
+TEST(SceneBuiltin, ParallelSphereflakeKeepsTheDepthFirstOrder) {
+    const Scene s = built_with_threads("sphereflake:5", 2);
+    const auto size = [](int levels) {
+        std::size_t n = 0, k = 1;
+        for (int l = 0; l <= levels; ++l, k *= 9) n += k;
+        return n;
+    };
+    ASSERT_EQ(s.objects.size(), 1 + size(5));
+    std::size_t checked = 0;
+    const std::function<void(std::size_t, int)> visit = [&](std::size_t p, int left) {
+        const Object& parent = s.objects[p];
+        if (left == 0) return;
+        for (std::size_t c = 0; c < 9; ++c) {
+            const std::size_t at = p + 1 + c * size(left - 1);
+            const Object& child = s.objects[at];
+            EXPECT_FLOAT_EQ(child.radius, parent.radius / 3.0f) << at;
+            const Vec3 d = child.center - parent.center;
+            // Centers are rounded to float once: a few ulps of coordinates near 1.
+            EXPECT_NEAR(std::sqrt(dot(d, d)), parent.radius * 4.0f / 3.0f,
+                        4e-7f + 1e-5f * parent.radius)
+                << at;
+            ++checked;
+            visit(at, left - 1);
+        }
+    };
+    visit(1, 5);
+    EXPECT_EQ(checked, size(5) - 1);
 }
 
 }  // namespace
