@@ -282,9 +282,11 @@ void read_image(od::value& v, ImageSettings& image) {
 }
 
 void read_camera(od::value& v, Camera& camera) {
-    enum { kType, kEye, kLookat, kUp, kFov, kWidth, kAperture, kFocus };
-    static constexpr std::array<std::string_view, 8> keys = {
-        "type", "eye", "lookat", "up", "fov", "width", "aperture", "focus_distance"};
+    enum { kType, kEye, kLookat, kUp, kFov, kWidth, kAperture, kFocus, kFovUnits };
+    static constexpr std::array<std::string_view, 9> keys = {
+        "type",  "eye",      "lookat",         "up",       "fov",
+        "width", "aperture", "focus_distance", "fov_units"};
+    static constexpr std::array<std::string_view, 1> units = {"degrees"};
     static constexpr std::array<std::string_view, 4> types = {"pinhole", "orthographic",
                                                               "thinlens", "fisheye"};
     KeySet seen(keys);
@@ -313,6 +315,11 @@ void read_camera(od::value& v, Camera& camera) {
             case kAperture:
                 camera.aperture = float_of(value);
                 break;
+            case kFovUnits:
+                // Always degrees: the key states that a small fov (scene_warnings) is meant.
+                static_cast<void>(choice_of(value, units));
+                camera.fov_units_stated = true;
+                break;
             default:
                 camera.focus_distance = float_of(value);
         }
@@ -320,7 +327,7 @@ void read_camera(od::value& v, Camera& camera) {
     if (!seen.has(kEye) || !seen.has(kLookat)) throw Decline{};
     const bool thinlens = camera.type == CameraType::thinlens;
     const bool has_fov = camera.type != CameraType::orthographic;
-    if ((seen.has(kFov) && !has_fov) ||
+    if (((seen.has(kFov) || seen.has(kFovUnits)) && !has_fov) ||
         (seen.has(kWidth) && camera.type != CameraType::orthographic) ||
         (seen.has(kAperture) && !thinlens) || (seen.has(kFocus) && !thinlens)) {
         throw Decline{};

@@ -128,6 +128,9 @@ TEST(JsonReaders, AgreeOnUnusualButValidForms) {
                         {"type": "point", "position": [1, 2, 3], "falloff": "inverse-square"}],
              "objects": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 3, 4],
                           "material": {"checker": {"size": 2, "color": 0}}}]})"},
+        {"a tiny fov stated in degrees (fov_units)",
+         R"({"camera": {"fov_units": "degrees", "eye": [0, 0, 5], "lookat": [0, 0, 0],
+                        "fov": 0.5, "type": "thinlens", "aperture": 0.1}})"},
         {"an orthographic camera with animated camera keys",
          R"({"camera": {"type": "orthographic", "eye": [0, 0, 5], "lookat": [0, 0, 0],
                         "width": 4, "up": [0, 1, 0]},
@@ -147,6 +150,8 @@ TEST(JsonReaders, AgreeOnUnusualButValidForms) {
     EXPECT_EQ(s.render.seed, 18446744073709551615u);
     EXPECT_EQ(s.objects[0].center.z, -9223372036854775809.0f);
     EXPECT_EQ(s.objects[1].center.x, 10.0f);
+    EXPECT_TRUE(
+        parse_scene_json_fast(cases[5].second, "valid.json").value().camera.fov_units_stated);
 }
 
 // Hostile input: the fast reader declines, and parse_scene_json gives the diagnosing
@@ -173,6 +178,15 @@ std::vector<Hostile> hostile_inputs() {
         {"a second document", "{" + camera + "} {}", "", {"line 1, column"}},
         {"trailing comma", "{" + camera + ",}", "", {"invalid JSON at line 1"}},
         {"a comment", "{" + camera + " // eye\n}", "", {"invalid JSON at line 1"}},
+        {"fov_units other than degrees",
+         R"({"camera": {"eye": [0, 0, 5], "lookat": [0, 0, 0], "fov_units": "radians"}})",
+         "camera.fov_units",
+         {"degrees"}},
+        {"fov_units on an orthographic camera",
+         R"({"camera": {"type": "orthographic", "eye": [0, 0, 5], "lookat": [0, 0, 0],
+                        "fov_units": "degrees"}})",
+         "camera.fov_units",
+         {"fov_units"}},
         {"a NUL after the object",
          "{" + camera + "}\n\n" + std::string(1, '\0'),
          "",
