@@ -37,18 +37,22 @@ Lanes sphere_lanes(const EmbreeSphereData& s, unsigned prim, const int* valid, f
     const F dy = F::load_unaligned(ray + 5 * n + i);
     const F dz = F::load_unaligned(ray + 6 * n + i);
     const F tfar = F::load_unaligned(ray + 8 * n + i);
-    const F a = xsimd::fma(dx, dx, xsimd::fma(dy, dy, dz * dz));
-    const F b = xsimd::fma(ox, dx, xsimd::fma(oy, dy, oz * dz));
+    // octray's operations in octray's order (kernels/packet_kernels.h, sphere_quadratic and
+    // sphere_roots), without FMA: the same t bit for bit. With FMA the roots moved by an ulp
+    // or two, enough to flip shadow rays at sphereflake's touching spheres: 1.4 % of an
+    // Embree frame's pixels off by more than 0.01, which failed its validation.
+    const F a = dx * dx + dy * dy + dz * dz;
+    const F b = ox * dx + oy * dy + oz * dz;
     const F bt = b / a;
-    const F lx = xsimd::fnma(bt, dx, ox), ly = xsimd::fnma(bt, dy, oy),
-            lz = xsimd::fnma(bt, dz, oz);
-    const F disc = a * (r2 - xsimd::fma(lx, lx, xsimd::fma(ly, ly, lz * lz)));
+    const F lx = ox - dx * bt, ly = oy - dy * bt, lz = oz - dz * bt;
+    const F disc = a * (r2 - (lx * lx + ly * ly + lz * lz));
     const F root = xsimd::sqrt(disc);  // NaN where disc < 0: every test below fails
-    const F q = xsimd::select(b >= F(0.0f), -b - root, root - b);
+    const F q = xsimd::select(b >= F(0.0f), -b - root, -b + root);
     const F t_q = q / a;
-    const F c = xsimd::fma(ox, ox, xsimd::fma(oy, oy, xsimd::fms(oz, oz, r2)));
+    const F c = (ox * ox + oy * oy + oz * oz) - r2;
     const F t_c = xsimd::select(q != F(0.0f), c / q, t_q);
-    const F t_near = xsimd::min(t_c, t_q), t_far = xsimd::max(t_c, t_q);
+    const auto swap = t_c < t_q;
+    const F t_near = xsimd::select(swap, t_c, t_q), t_far = xsimd::select(swap, t_q, t_c);
     const auto near_ok = t_near > tnear && t_near < tfar;
     const auto far_ok = t_far > tnear && t_far < tfar;
     // valid[] is -1 for an active lane, 0 otherwise.
@@ -78,12 +82,12 @@ void intersect_spheres(const RTCIntersectFunctionNArguments* args) {
         const auto ihit =
             xsimd::bitwise_cast<I>(xsimd::select(l.hit, F(1.0f), F(0.0f))) != I(0);
         merge(ray + 8 * n, i, l.hit, l.t);
-        const F px = xsimd::fma(l.t, F::load_unaligned(ray + 4 * n + i),
-                                F::load_unaligned(ray + 0 * n + i)),
-                py = xsimd::fma(l.t, F::load_unaligned(ray + 5 * n + i),
-                                F::load_unaligned(ray + 1 * n + i)),
-                pz = xsimd::fma(l.t, F::load_unaligned(ray + 6 * n + i),
-                                F::load_unaligned(ray + 2 * n + i));
+        const F px = F::load_unaligned(ray + 0 * n + i) +
+                     l.t * F::load_unaligned(ray + 4 * n + i),
+                py = F::load_unaligned(ray + 1 * n + i) +
+                     l.t * F::load_unaligned(ray + 5 * n + i),
+                pz = F::load_unaligned(ray + 2 * n + i) +
+                     l.t * F::load_unaligned(ray + 6 * n + i);
         merge(hit + 0 * n, i, l.hit, px - F(s.cx[prim]));
         merge(hit + 1 * n, i, l.hit, py - F(s.cy[prim]));
         merge(hit + 2 * n, i, l.hit, pz - F(s.cz[prim]));
