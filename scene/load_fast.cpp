@@ -257,6 +257,18 @@ class KeySet {
     std::uint32_t seen_ = 0;
 };
 
+// Calls read(key, value) for each field of the JSON object `v` (a value or the document)
+// in file order, `key` the field's index among `seen`'s keys (an unknown or repeated key
+// declines).
+template <class Object, std::size_t N, class Read>
+void read_fields(Object& v, KeySet<N>& seen, Read&& read) {
+    for (auto f : take(v.get_object())) {
+        od::field field = take(std::move(f));
+        const std::size_t key = seen.see(key_of(field));
+        read(key, field.value());
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // The sections. Keys arrive in file order; each reader collects them, then applies the
 // rules that depend on several (a type's own keys, required keys) at the end.
@@ -290,10 +302,8 @@ void read_camera(od::value& v, Camera& camera) {
     static constexpr std::array<std::string_view, 4> types = {"pinhole", "orthographic",
                                                               "thinlens", "fisheye"};
     KeySet seen(keys);
-    for (auto f : take(v.get_object())) {
-        od::field field = take(std::move(f));
-        od::value& value = field.value();
-        switch (seen.see(key_of(field))) {
+    read_fields(v, seen, [&](std::size_t which, od::value& value) {
+        switch (which) {
             case kType:
                 camera.type = static_cast<CameraType>(choice_of(value, types));
                 break;
@@ -323,7 +333,7 @@ void read_camera(od::value& v, Camera& camera) {
             default:
                 camera.focus_distance = float_of(value);
         }
-    }
+    });
     if (!seen.has(kEye) || !seen.has(kLookat)) throw Decline{};
     const bool thinlens = camera.type == CameraType::thinlens;
     const bool has_fov = camera.type != CameraType::orthographic;
@@ -346,10 +356,8 @@ void read_background(od::value& v, Background& bg) {
     static constexpr std::array<std::string_view, 4> keys = {"type", "color", "bottom", "top"};
     static constexpr std::array<std::string_view, 2> types = {"constant", "gradient"};
     KeySet seen(keys);
-    for (auto f : take(v.get_object())) {
-        od::field field = take(std::move(f));
-        od::value& value = field.value();
-        switch (seen.see(key_of(field))) {
+    read_fields(v, seen, [&](std::size_t which, od::value& value) {
+        switch (which) {
             case kType:
                 bg.type = static_cast<BackgroundType>(choice_of(value, types));
                 break;
@@ -362,7 +370,7 @@ void read_background(od::value& v, Background& bg) {
             default:
                 bg.top = color_of(value);
         }
-    }
+    });
     if (!seen.has(kType)) throw Decline{};
     const bool constant = bg.type == BackgroundType::constant;
     if (constant != seen.has(kColor) || !constant != seen.has(kBottom) ||
@@ -374,10 +382,8 @@ void read_background(od::value& v, Background& bg) {
 void read_render(od::value& v, RenderSettings& render) {
     static constexpr std::array<std::string_view, 3> keys = {"max_depth", "seed", "epsilon"};
     KeySet seen(keys);
-    for (auto f : take(v.get_object())) {
-        od::field field = take(std::move(f));
-        od::value& value = field.value();
-        switch (seen.see(key_of(field))) {
+    read_fields(v, seen, [&](std::size_t which, od::value& value) {
+        switch (which) {
             case 0:
                 render.max_depth =
                     static_cast<int>(integer_of(value, 0, json_rules::kMaxDepthLimit));
@@ -388,7 +394,7 @@ void read_render(od::value& v, RenderSettings& render) {
             default:
                 render.epsilon = float_of(value);
         }
-    }
+    });
 }
 
 Material read_material(od::value& v) {
@@ -397,10 +403,8 @@ Material read_material(od::value& v) {
         "color", "kd", "ks", "shininess", "reflect", "transmit", "ior", "checker"};
     KeySet seen(keys);
     Material m;
-    for (auto f : take(v.get_object())) {
-        od::field field = take(std::move(f));
-        od::value& value = field.value();
-        switch (seen.see(key_of(field))) {
+    read_fields(v, seen, [&](std::size_t which, od::value& value) {
+        switch (which) {
             case kColor:
                 m.color = color_of(value);
                 break;
@@ -439,7 +443,7 @@ Material read_material(od::value& v) {
                 m.checker = checker;
             }
         }
-    }
+    });
     return m;
 }
 
@@ -506,10 +510,8 @@ void read_objects(od::value& v, Scene& scene, Materials& materials,
         KeySet seen(keys);
         Object obj;
         MaterialUse use{MaterialUse::by_default, 0};
-        for (auto f : take(o.get_object())) {
-            od::field field = take(std::move(f));
-            od::value& value = field.value();
-            switch (seen.see(key_of(field))) {
+        read_fields(o, seen, [&](std::size_t which, od::value& value) {
+            switch (which) {
                 case kType:
                     obj.type = static_cast<ObjectType>(choice_of(value, types));
                     break;
@@ -538,7 +540,7 @@ void read_objects(od::value& v, Scene& scene, Materials& materials,
                 default:
                     obj.normal = vec3_of(value);
             }
-        }
+        });
         if (!seen.has(kType)) throw Decline{};
         if (obj.type == ObjectType::sphere) {
             if (!seen.has(kCenter) || !seen.has(kRadius) || seen.has(kPoint) ||
@@ -599,10 +601,8 @@ void read_lights(od::value& v, Scene& scene) {
         od::value l = take(std::move(element));
         KeySet seen(keys);
         Light light;
-        for (auto f : take(l.get_object())) {
-            od::field field = take(std::move(f));
-            od::value& value = field.value();
-            switch (seen.see(key_of(field))) {
+        read_fields(l, seen, [&](std::size_t which, od::value& value) {
+            switch (which) {
                 case kType:
                     light.type = static_cast<LightType>(choice_of(value, types));
                     break;
@@ -618,7 +618,7 @@ void read_lights(od::value& v, Scene& scene) {
                 default:
                     light.direction = vec3_of(value);
             }
-        }
+        });
         if (!seen.has(kType)) throw Decline{};
         const bool point = light.type == LightType::point;
         if (point ? (!seen.has(kPosition) || seen.has(kDirection))
@@ -640,10 +640,8 @@ std::vector<CameraKey> read_camera_keys(od::value& v) {
         od::value k = take(std::move(element));
         KeySet seen(keys);
         CameraKey key;
-        for (auto f : take(k.get_object())) {
-            od::field field = take(std::move(f));
-            od::value& value = field.value();
-            switch (seen.see(key_of(field))) {
+        read_fields(k, seen, [&](std::size_t which, od::value& value) {
+            switch (which) {
                 case kFrame:
                     key.frame = static_cast<int>(integer_of(value, 0, kMaxIntValue));
                     break;
@@ -659,7 +657,7 @@ std::vector<CameraKey> read_camera_keys(od::value& v) {
                 default:
                     key.fov = float_of(value);
             }
-        }
+        });
         if (!seen.has(kFrame)) throw Decline{};
         out.push_back(key);
     }
@@ -681,10 +679,8 @@ std::vector<ObjectTrack> read_object_tracks(od::value& v) {
             od::value k = take(std::move(element));
             KeySet seen(keys);
             ObjectKey key;
-            for (auto kf : take(k.get_object())) {
-                od::field kfield = take(std::move(kf));
-                od::value& value = kfield.value();
-                switch (seen.see(key_of(kfield))) {
+            read_fields(k, seen, [&](std::size_t which, od::value& value) {
+                switch (which) {
                     case kFrame:
                         key.frame = static_cast<int>(integer_of(value, 0, kMaxIntValue));
                         break;
@@ -694,7 +690,7 @@ std::vector<ObjectTrack> read_object_tracks(od::value& v) {
                     default:
                         key.radius = float_of(value);
                 }
-            }
+            });
             if (!seen.has(kFrame)) throw Decline{};
             track.keys.push_back(key);
         }
@@ -709,10 +705,8 @@ Animation read_animation(od::value& v) {
                                                              "objects"};
     KeySet seen(keys);
     Animation a;
-    for (auto f : take(v.get_object())) {
-        od::field field = take(std::move(f));
-        od::value& value = field.value();
-        switch (seen.see(key_of(field))) {
+    read_fields(v, seen, [&](std::size_t which, od::value& value) {
+        switch (which) {
             case kFrames:
                 a.frames = static_cast<int>(integer_of(value, 1, kMaxAnimationFrames));
                 break;
@@ -725,7 +719,7 @@ Animation read_animation(od::value& v) {
             default:
                 a.objects = read_object_tracks(value);
         }
-    }
+    });
     if (!seen.has(kFrames)) throw Decline{};
     return a;
 }
@@ -765,10 +759,8 @@ Scene read_scene(od::document& doc, const std::string& source) {
     scene.source = source;
     Materials materials;
     std::vector<MaterialUse> uses;
-    for (auto f : take(doc.get_object())) {
-        od::field field = take(std::move(f));
-        od::value& value = field.value();
-        switch (seen.see(key_of(field))) {
+    read_fields(doc, seen, [&](std::size_t which, od::value& value) {
+        switch (which) {
             case kImage:
                 read_image(value, scene.image);
                 break;
@@ -796,7 +788,7 @@ Scene read_scene(od::document& doc, const std::string& source) {
             default:
                 scene.animation = read_animation(value);
         }
-    }
+    });
     // Nothing may follow the top-level object but whitespace.
     if (doc.current_location().error() != simdjson::OUT_OF_BOUNDS) throw Decline{};
     if (!seen.has(kCamera)) throw Decline{};
