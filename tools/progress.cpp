@@ -228,6 +228,12 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
                                     {"write_seconds", report.write_seconds},
                                     {"rays", report.rays},
                                     {"mrays_per_second", mrays}};
+            if (report.outcome == FrameOutcome::rendered)
+                event["phases"] = {{"load_seconds", report.load_seconds},
+                                   {"compile_seconds", report.compile_seconds},
+                                   {"bvh_seconds", report.bvh_seconds},
+                                   {"render_seconds", report.render_seconds},
+                                   {"write_seconds", report.write_seconds}};
             if (!report.preview.empty()) event["preview"] = report.preview;
             if (!report.message.empty()) event["message"] = report.message;
             std::printf("%s\n", event.dump().c_str());

@@ -40,6 +40,9 @@ struct FrameReport {
     double write_seconds = 0.0;  // EXR and PNG encoding and writing (every progressive pass)
     std::uint64_t rays = 0;      // rendered frames
     std::string message;         // failed frames: the reason
+    // Rendered frames, the phases of `--stats`: the scene's load (once per scene, on each
+    // of its frames), compile, BVH build and the render itself (parts of trace_seconds).
+    double load_seconds = 0.0, compile_seconds = 0.0, bvh_seconds = 0.0, render_seconds = 0.0;
 };
 
 struct BatchSummary {

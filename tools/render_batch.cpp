@@ -372,14 +372,18 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
             std::chrono::duration<double>(Clock::now() - trace_started).count() - write_seconds;
         timed_write(result, posed.image.spp);
         out.report.write_seconds = write_seconds;
+        out.report.load_seconds = scene.load_seconds;
+        out.report.compile_seconds = result.compile_seconds;
+        out.report.bvh_seconds = result.bvh_seconds;
+        out.report.render_seconds =
+            result.seconds - result.compile_seconds - result.bvh_seconds;
         if (settings_.stats)  // the scene is loaded once for all its frames: on each line
             std::fprintf(stderr,
                          "stats: %s frame %d: load %.3f s, compile %.3f s, BVH %.3f s, "
                          "render %.3f s, write %.3f s\n",
-                         scene.name.c_str(), job.frame, scene.load_seconds,
-                         result.compile_seconds, result.bvh_seconds,
-                         result.seconds - result.compile_seconds - result.bvh_seconds,
-                         write_seconds);
+                         scene.name.c_str(), job.frame, out.report.load_seconds,
+                         out.report.compile_seconds, out.report.bvh_seconds,
+                         out.report.render_seconds, write_seconds);
         out.report.rays = result.rays.total();
         out.report.outcome = FrameOutcome::rendered;
     } catch (const RenderCancelled&) {

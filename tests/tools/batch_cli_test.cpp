@@ -204,6 +204,21 @@ TEST_F(BatchCliTest, FrameLinesReportTraceAndWriteTimesInAFixedOrder) {
         EXPECT_LE(event["trace_seconds"].get<double>() + event["write_seconds"].get<double>(),
                   event["seconds"].get<double>() + 1e-3)
             << line;
+        if (event["event"] == "frame") {
+            // The phases of --stats: compile, BVH and render within the trace time; the
+            // write time the frame's own.
+            const nlohmann::json& phases = event.at("phases");
+            double traced = 0.0;
+            for (const char* key : {"compile_seconds", "bvh_seconds", "render_seconds"}) {
+                ASSERT_TRUE(phases.at(key).is_number()) << key << "\n" << line;
+                EXPECT_GE(phases[key].get<double>(), 0.0) << key;
+                traced += phases[key].get<double>();
+            }
+            EXPECT_GT(phases["render_seconds"].get<double>(), 0.0) << line;
+            EXPECT_LE(traced, event["trace_seconds"].get<double>() + 1e-3) << line;
+            EXPECT_GT(phases.at("load_seconds").get<double>(), 0.0) << line;
+            EXPECT_EQ(phases.at("write_seconds"), event["write_seconds"]) << line;
+        }
         ++checked;
     }
     EXPECT_EQ(checked, 2) << r.output;  // the frame and the summary
