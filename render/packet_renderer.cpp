@@ -124,14 +124,19 @@ struct Level {
     LinkStorage next_links;
 };
 
+// A pixel of a tile, from its corner.
+struct TilePixel {
+    std::uint32_t x, y;
+};
+
 // Per-thread scratch, reused tile after tile (and frame after frame: scratch_for_thread).
 struct TileScratch {
     SampleStorage samples;
     RayStorage primary;
-    HitStorage hits;            // of the chunk being shaded, at any level
-    ShadowStorage shadows;      // likewise
-    std::vector<Level> levels;  // sized to max_depth + 1 before a tile, never shrinks
-    std::vector<std::uint32_t> pixel_order;    // the tile's pixels in sample order
+    HitStorage hits;                     // of the chunk being shaded, at any level
+    ShadowStorage shadows;               // likewise
+    std::vector<Level> levels;           // sized to max_depth + 1 before a tile, never shrinks
+    std::vector<TilePixel> pixel_order;  // the tile's pixels in sample order
     AlignedVector<float> acc_r, acc_g, acc_b;  // the tile's sums of samples
 
     // What the scratch holds now, in bytes (its high-water mark: it never shrinks).
@@ -327,7 +332,8 @@ class PacketTracer {
             for (int bx = 0; bx < tile.width; bx += kBlockWidth)
                 for (int y = by; y < std::min(by + kBlockHeight, tile.height); ++y)
                     for (int x = bx; x < std::min(bx + kBlockWidth, tile.width); ++x)
-                        s.pixel_order.push_back(static_cast<std::uint32_t>(y * tile.width + x));
+                        s.pixel_order.push_back(
+                            {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y)});
 
         // Camera samples, primary rays and their trees, a chunk of samples at a time.
         for (std::size_t first = 0; first < samples; first += ray_chunk_) {
@@ -378,25 +384,25 @@ class PacketTracer {
         float *sx = s.samples.x.data(), *sy = s.samples.y.data();
         float *su = s.samples.lens_u.data(), *sv = s.samples.lens_v.data();
         std::uint32_t* spixel = s.samples.pixel.data();
-        const std::uint32_t* pixel = s.pixel_order.data();
+        const TilePixel* pixel = s.pixel_order.data();
         const float* cx = center_x_.data() + tile.x0;
         const float* cy = center_y_.data() + tile.y0;
         const auto w = static_cast<std::uint32_t>(tile.width);
         if (centers) {  // per_pixel == 1
             for (std::size_t m = 0; m < n; ++m) {
-                const std::uint32_t p = pixel[first + m];
-                sx[m] = cx[p % w];
-                sy[m] = cy[p / w];
+                const TilePixel p = pixel[first + m];
+                sx[m] = cx[p.x];
+                sy[m] = cy[p.y];
                 su[m] = sv[m] = 0.0f;
-                spixel[m] = p;
+                spixel[m] = p.y * w + p.x;
             }
         } else {
             std::size_t order = first / per_pixel;
             auto k = static_cast<std::uint32_t>(first % per_pixel);
             for (std::size_t m = 0; m < n; ++m) {
-                const std::uint32_t p = pixel[order];
-                const int i = tile.x0 + static_cast<int>(p % w);
-                const int j = tile.y0 + static_cast<int>(p / w);
+                const TilePixel p = pixel[order];
+                const int i = tile.x0 + static_cast<int>(p.x),
+                          j = tile.y0 + static_cast<int>(p.y);
                 const auto ui = static_cast<std::uint32_t>(i);
                 const auto uj = static_cast<std::uint32_t>(j);
                 const auto sample = static_cast<std::uint32_t>(first_sample) + k;
@@ -409,7 +415,7 @@ class PacketTracer {
                              : 0.0f;
                 sv[m] = lens ? sample_uniform(frame_, ui, uj, sample, kDimLensV, scene_.seed)
                              : 0.0f;
-                spixel[m] = p;
+                spixel[m] = p.y * w + p.x;
                 if (++k == per_pixel) k = 0, ++order;
             }
         }

@@ -80,8 +80,8 @@ constexpr std::uint64_t kTileBytesPerShadowRay = 12 * 4;
 // Per ray of a generation's chunk (max_depth + 1 generations): 9 color columns, and its
 // children: 10 ray columns and 4 link columns at twice the count.
 constexpr std::uint64_t kTileBytesPerGenerationRay = 9 * 4 + 2 * (10 * 4 + 4 * 4);
-// The tile's three accumulators and its pixel order, per pixel.
-constexpr std::uint64_t kTileBytesPerPixel = 3 * 4 + 4;
+// The tile's three accumulators and its pixel order (x and y), per pixel.
+constexpr std::uint64_t kTileBytesPerPixel = 3 * 4 + 2 * 4;
 
 // Measured (peak resident set size of `octray render`, Debian 12, glibc malloc): the
 // process rendering a 1x1 image of a small scene, code, libraries and TBB's threads
