@@ -1,5 +1,9 @@
 #include "tools/render_batch.h"
 
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
 #include <fcntl.h>
 #include <oneapi/tbb/global_control.h>
@@ -75,9 +79,9 @@ std::pair<std::string, float> capture_date() {
 
 // A finished frame: a non-empty file that is not an unfinished --progressive pass.
 // An empty file is a --placeholders claim; an unfinished pass is a claim of its owner
-// (tools/claim_owner.h) while that run lives. An OpenEXR file that cannot be read whole
-// (cut off, or its header lying about its pixel data) is damaged: resuming never takes it
-// for a finished frame, nor renders over what it did not write.
+// (tools/claim_owner.h) while that run lives. An OpenEXR file whose chunks do not hold
+// what its header implies (cut off, or its header lying about its pixel data) is damaged:
+// resuming never takes it for a finished frame, nor renders over what it did not write.
 enum class Existing { none, claim, finished, unfinished, damaged };
 
 struct Found {
@@ -99,21 +103,25 @@ Found existing_output(const std::string& path) {
     const auto size = fs::file_size(path, error);
     if (error) return {Existing::finished, {}, {}};  // not a regular file: never overwrite it
     if (size == 0) return {Existing::claim, {}, {}};
-    // Not an EXR (a PNG preview target): it exists. An EXR gets the checked read that
-    // `compare` and `assemble` use (render/image_read.h), every chunk against its header.
+    // Not an EXR (a PNG preview target): it exists. An EXR gets the check that `compare` and
+    // `assemble` make before decoding (render/image_read.h): every chunk against its
+    // header. Its pixels are not decoded: resuming a long sequence only needs to know the
+    // file is whole.
     if (!has_exr_signature(path)) return {Existing::finished, {}, {}};
-    ExrImage image;
     try {
-        image = read_exr_image(path);
+        check_exr_pixel_data(path);
+        Imf::InputFile file(path.c_str());
+        const Imf::Header& header = file.header();
+        if (header.findTypedAttribute<Imf::IntAttribute>(kSamplesSoFarAttribute) != nullptr) {
+            const auto* owner =
+                header.findTypedAttribute<Imf::StringAttribute>(kOwnerAttribute);
+            return {
+                Existing::unfinished, owner != nullptr ? owner->value() : std::string(), {}};
+        }
     } catch (const IoError& e) {
         return {Existing::damaged, {}, e.what()};
-    }
-    for (const auto& [name, value] : image.attributes.ints) {
-        if (name != kSamplesSoFarAttribute) continue;
-        std::string owner;
-        for (const auto& [key, text] : image.attributes.strings)
-            if (key == kOwnerAttribute) owner = text;
-        return {Existing::unfinished, owner, {}};
+    } catch (const std::exception& e) {  // OpenEXR's own, after the check passed
+        return {Existing::damaged, {}, "cannot read '" + path + "': " + e.what()};
     }
     return {Existing::finished, {}, {}};
 }
