@@ -33,23 +33,6 @@ std::optional<PixelOrder> parse_pixel_order(std::string_view name) {
     return std::nullopt;
 }
 
-std::optional<TileSize> parse_tile_size(std::string_view text) {
-    const std::size_t x = text.find('x');
-    if (x == std::string_view::npos) return std::nullopt;
-    TileSize t;
-    const auto parse = [](std::string_view s, int& out) {
-        const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-        return ec == std::errc() && end == s.data() + s.size() && out >= 1;
-    };
-    if (!parse(text.substr(0, x), t.width) || !parse(text.substr(x + 1), t.height))
-        return std::nullopt;
-    return t;
-}
-
-std::string tile_size_name(TileSize tile) {
-    return std::to_string(tile.width) + "x" + std::to_string(tile.height);
-}
-
 namespace {
 
 // The even bits of a Morton code: x of (x, y) interleaved as y1 x1 y0 x0.

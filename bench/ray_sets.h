@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/aligned.h"
+#include "core/pixel_rect.h"
 #include "kernels/kernel_types.h"
 #include "render/reference.h"
 #include "scene/compile.h"
@@ -28,16 +29,8 @@ enum class PixelOrder {
     morton,    // Z-order over the whole frame: a packet is a 4 x 2 block
 };
 
-struct TileSize {
-    int width = 16;
-    int height = 16;
-};
-
 const char* pixel_order_name(PixelOrder order);
 std::optional<PixelOrder> parse_pixel_order(std::string_view name);
-// "WxH" with W, H >= 1.
-std::optional<TileSize> parse_tile_size(std::string_view text);
-std::string tile_size_name(TileSize tile);
 
 // Every pixel index y * width + x exactly once, in the visiting order. `tile` is used by
 // PixelOrder::tiled only.

@@ -10,19 +10,6 @@
 
 namespace octray {
 
-inline std::string to_string(const PixelRect& r) {
-    std::string s = "(";
-    s += std::to_string(r.x0);
-    s += ", ";
-    s += std::to_string(r.y0);
-    s += ")-(";
-    s += std::to_string(r.x1);
-    s += ", ";
-    s += std::to_string(r.y1);
-    s += ")";
-    return s;
-}
-
 // The pixels a render covers: options.crop, or the whole width x height image. Throws
 // std::invalid_argument for an empty crop or one that reaches outside the image.
 inline PixelRect render_rect(const RenderOptions& options, int width, int height) {

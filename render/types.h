@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/image.h"
+#include "core/pixel_rect.h"
 #include "scene/accel.h"
 
 namespace octray {
@@ -27,34 +28,6 @@ struct RayCounts {
         return *this;
     }
 };
-
-// A half-open rectangle of pixels [x0, x1) x [y0, y1) of the full image, row 0 on top
-// (pixel (x, y) is column x, row y). A crop, an EXR data window, a part of `assemble`.
-struct PixelRect {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-
-    int width() const { return x1 - x0; }
-    int height() const { return y1 - y0; }
-    bool empty() const { return x1 <= x0 || y1 <= y0; }
-    std::size_t pixel_count() const {
-        return empty() ? 0
-                       : static_cast<std::size_t>(width()) * static_cast<std::size_t>(height());
-    }
-    bool contains(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
-    // True if `r` lies wholly inside this rectangle (an empty `r` never does).
-    bool contains(const PixelRect& r) const {
-        return !r.empty() && r.x0 >= x0 && r.y0 >= y0 && r.x1 <= x1 && r.y1 <= y1;
-    }
-    friend bool operator==(const PixelRect&, const PixelRect&) = default;
-};
-
-// The pixels two rectangles share (empty() when none).
-inline PixelRect intersection(const PixelRect& a, const PixelRect& b) {
-    PixelRect r{a.x0 > b.x0 ? a.x0 : b.x0, a.y0 > b.y0 ? a.y0 : b.y0, a.x1 < b.x1 ? a.x1 : b.x1,
-                a.y1 < b.y1 ? a.y1 : b.y1};
-    if (r.empty()) r = PixelRect{};
-    return r;
-}
 
 // A range [begin, end) of the sample indices 0 .. spp-1 of every pixel (progressive passes).
 struct SampleRange {

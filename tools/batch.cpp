@@ -388,7 +388,7 @@ std::vector<int> select_shard(const std::vector<int>& frames, Shard shard) {
     return out;
 }
 
-CropRect parse_crop(std::string_view text, int image_width, int image_height) {
+PixelRect parse_crop(std::string_view text, int image_width, int image_height) {
     const std::string head = "crop " + quote(text) + ": ";
     std::vector<std::string_view> fields;
     std::size_t start = 0;

@@ -14,6 +14,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/pixel_rect.h"
+
 namespace octray::batch {
 
 struct SpecError : std::runtime_error {
@@ -73,14 +75,8 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
 // 0 ... count - 1 of one list are disjoint and together hold every frame once.
 std::vector<int> select_shard(const std::vector<int>& frames, Shard shard);
 
-// A rectangle of pixels, half-open: columns x0 ... x1 - 1, rows y0 ... y1 - 1, with row 0
-// the top row (as in the image file).
-struct CropRect {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-};
-
 // "x0,y0,x1,y1" with 0 <= x0 < x1 <= image_width and 0 <= y0 < y1 <= image_height.
-CropRect parse_crop(std::string_view text, int image_width, int image_height);
+PixelRect parse_crop(std::string_view text, int image_width, int image_height);
 
 // The name of a scene for {scene} and default output names: the built-in's name with ':'
 // turned into '-' and options dropped ("random:8,width=32" -> "random-8"), or a file's

@@ -149,7 +149,8 @@ void run_bench_command(const BenchArguments& a) {
     if (!a.scenes.empty()) o.scenes = a.scenes;
     o.workloads =
         parse_list<bench::Workload>(a.rays, "--rays", bench::parse_workload, o.workloads);
-    o.tiles = parse_list<bench::TileSize>(a.tiles, "--tile", bench::parse_tile_size, o.tiles);
+    o.tiles = parse_list<TileSize>(
+        a.tiles, "--tile", [](std::string_view s) { return parse_tile_size(s); }, o.tiles);
     o.orders =
         parse_list<bench::PixelOrder>(a.orders, "--order", bench::parse_pixel_order, o.orders);
     o.isas = parse_list<Isa>(a.isas, "--isa", parse_isa, o.isas);

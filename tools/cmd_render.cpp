@@ -90,22 +90,6 @@ struct RenderArguments {
     CLI::Option* compression_option = nullptr;
 };
 
-struct TileSize {
-    int width = 0, height = 0;
-};
-
-// The --tile value, which its transform (tile_size) has made canonical "WxH" with sides in
-// [1, kMaxTileSide]; nullopt for anything else.
-std::optional<TileSize> parse_tile(const std::string& text) {
-    const std::size_t x = text.find('x');
-    if (x == std::string::npos) return std::nullopt;
-    const auto w = parse_decimal_integer(std::string_view(text).substr(0, x));
-    const auto h = parse_decimal_integer(std::string_view(text).substr(x + 1));
-    if (!w || !h || *w < 1 || *h < 1 || *w > kMaxTileSide || *h > kMaxTileSide)
-        return std::nullopt;
-    return TileSize{static_cast<int>(*w), static_cast<int>(*h)};
-}
-
 // ---- Pre-flight: everything that can be checked before the first frame ----------------
 
 // The scene's identity for the EXR: SHA-256 of the file's bytes (what `sha256sum` prints),
@@ -397,7 +381,7 @@ void run_render(const RenderArguments& args) {
             throw UsageError(std::string("--isa: ") + e.what());
         }
     }
-    const auto tile = parse_tile(args.tile);
+    const auto tile = parse_tile_size(args.tile);
     if (!tile) throw UsageError("--tile: expected WxH, e.g. 16x16");
     settings.options.tile_width = tile->width;
     settings.options.tile_height = tile->height;
@@ -478,9 +462,8 @@ void run_render(const RenderArguments& args) {
     for (BatchScene& scene : scenes) {
         if (!args.crop.empty()) {
             try {
-                const batch::CropRect c = batch::parse_crop(args.crop, scene.scene.image.width,
-                                                            scene.scene.image.height);
-                scene.crop = PixelRect{c.x0, c.y0, c.x1, c.y1};
+                scene.crop = batch::parse_crop(args.crop, scene.scene.image.width,
+                                               scene.scene.image.height);
             } catch (const batch::SpecError& e) {
                 throw UsageError("--crop for " + scene.spec + ": " + e.what());
             }

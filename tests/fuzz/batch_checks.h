@@ -116,7 +116,7 @@ inline void check_crop_spec(std::string_view input) {
     static constexpr int sizes[][2] = {{64, 48}, {1, 1}, {INT_MAX, INT_MAX}};
     for (const auto& size : sizes) {
         try {
-            const CropRect c = parse_crop(input, size[0], size[1]);
+            const PixelRect c = parse_crop(input, size[0], size[1]);
             if (!(0 <= c.x0 && c.x0 < c.x1 && c.x1 <= size[0] && 0 <= c.y0 && c.y0 < c.y1 &&
                   c.y1 <= size[1])) {
                 throw BatchInvariantBroken("a parsed crop lies inside the image", input);

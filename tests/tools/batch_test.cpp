@@ -322,7 +322,7 @@ TEST(Shard, ShardsAreDisjointAndCoverEveryFrame) {
 // Crops
 
 TEST(Crop, Parse) {
-    CropRect c = parse_crop("0,0,64,48", 64, 48);
+    PixelRect c = parse_crop("0,0,64,48", 64, 48);
     EXPECT_EQ(c.x0, 0);
     EXPECT_EQ(c.y0, 0);
     EXPECT_EQ(c.x1, 64);
