@@ -38,16 +38,6 @@
 
 namespace octray::bench {
 
-const char* trace_path_name(TracePath path) {
-    return path == TracePath::simd ? "simd" : "scalar";
-}
-
-std::optional<TracePath> parse_trace_path(std::string_view name) {
-    if (name == "simd") return TracePath::simd;
-    if (name == "scalar") return TracePath::scalar;
-    return std::nullopt;
-}
-
 const char* workload_name(Workload workload) {
     switch (workload) {
         case Workload::primary:
@@ -652,8 +642,8 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                     }
                 }
 #endif
-                for (TracePath path : o.paths) {
-                    if (path == TracePath::scalar) {
+                for (RenderPath path : o.paths) {
+                    if (path == RenderPath::scalar) {
                         BenchRow row = base_row(w, v);
                         row.system = "octray";
                         row.mode = "single";
@@ -683,9 +673,9 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
         if (wants(Workload::whitted)) {
             std::map<std::pair<Isa, bool>, std::pair<bool, std::string>> render_validation;
             for (TileSize tile : o.tiles) {
-                for (TracePath path : o.paths) {
+                for (RenderPath path : o.paths) {
                     const std::vector<Isa> path_isas =
-                        path == TracePath::simd ? isas : std::vector<Isa>{Isa::automatic};
+                        path == RenderPath::simd ? isas : std::vector<Isa>{Isa::automatic};
                     // Whole renders take --accel (one row each; the packet switch is the
                     // renderer's default).
                     std::vector<const SimdConfig*> configs;
@@ -693,17 +683,17 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                         if (std::none_of(configs.begin(), configs.end(),
                                          [&](const SimdConfig* k) { return k->bvh == c.bvh; }))
                             configs.push_back(&c);
-                    if (path == TracePath::scalar || configs.empty()) configs = {nullptr};
+                    if (path == RenderPath::scalar || configs.empty()) configs = {nullptr};
                     for (Isa isa : path_isas)
                         for (const SimdConfig* config : configs) {
                             const Accel accel = config ? config->accel : Accel::none;
                             BenchRow row =
                                 base_row(Workload::whitted, Variant{PixelOrder::tiled, tile});
                             row.system = "octray";
-                            row.mode = path == TracePath::simd ? "packet8" : "single";
-                            row.isa = path == TracePath::simd ? isa_name(isa) : "scalar";
+                            row.mode = path == RenderPath::simd ? "packet8" : "single";
+                            row.isa = path == RenderPath::simd ? isa_name(isa) : "scalar";
                             if (config) row.accel = config->bvh ? "bvh" : "none";
-                            if (path == TracePath::simd) {
+                            if (path == RenderPath::simd) {
                                 const auto key = std::make_pair(isa, config && config->bvh);
                                 auto it = render_validation.find(key);
                                 if (it == render_validation.end()) {
@@ -725,7 +715,7 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
                             ro.tile_height = tile.height;
                             ro.accel = accel;
                             const auto render = [&] {
-                                return path == TracePath::simd
+                                return path == RenderPath::simd
                                            ? render_packet(compiled, ro, isa)
                                            : render_reference(scene, ro);
                             };

@@ -19,11 +19,6 @@
 
 namespace octray::bench {
 
-// Which intersection code octray runs: the SIMD packet kernels, or the scalar reference.
-enum class TracePath { simd, scalar };
-const char* trace_path_name(TracePath path);
-std::optional<TracePath> parse_trace_path(std::string_view name);
-
 // What a row measures: one kind of ray set, or the whole Whitted render of the frame.
 enum class Workload { primary, shadow, secondary, whitted };
 const char* workload_name(Workload workload);
@@ -42,7 +37,7 @@ struct BenchOptions {
     std::vector<TileSize> tiles{TileSize{16, 16}};
     std::vector<PixelOrder> orders{PixelOrder::tiled};
     std::vector<Isa> isas{Isa::automatic};
-    std::vector<TracePath> paths{TracePath::simd};
+    std::vector<RenderPath> paths{RenderPath::simd};  // which renderer (render/types.h)
     // The SIMD path's sphere acceleration (auto: a BVH from kBvhAutoMinSpheres spheres on)
     // and, with a BVH, the live lanes below which a packet goes on ray by ray.
     std::vector<Accel> accels{Accel::automatic};

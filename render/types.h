@@ -6,12 +6,27 @@
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
+#include <string_view>
 
 #include "core/image.h"
 #include "core/pixel_rect.h"
 #include "scene/accel.h"
 
 namespace octray {
+
+// Which renderer traces a frame: the SIMD packet path (render/packet_renderer.h) or the
+// scalar reference (render/reference.h). `--path simd|scalar` of `render` and `bench`.
+enum class RenderPath { simd, scalar };
+
+inline const char* render_path_name(RenderPath path) {
+    return path == RenderPath::simd ? "simd" : "scalar";
+}
+
+inline std::optional<RenderPath> parse_render_path(std::string_view name) {
+    if (name == "simd") return RenderPath::simd;
+    if (name == "scalar") return RenderPath::scalar;
+    return std::nullopt;
+}
 
 struct RayCounts {
     std::uint64_t primary = 0;

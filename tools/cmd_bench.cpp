@@ -154,7 +154,7 @@ void run_bench_command(const BenchArguments& a) {
     o.orders =
         parse_list<bench::PixelOrder>(a.orders, "--order", bench::parse_pixel_order, o.orders);
     o.isas = parse_list<Isa>(a.isas, "--isa", parse_isa, o.isas);
-    o.paths = parse_list<bench::TracePath>(a.paths, "--path", bench::parse_trace_path, o.paths);
+    o.paths = parse_list<RenderPath>(a.paths, "--path", parse_render_path, o.paths);
     o.accels = parse_list<Accel>(a.accels, "--accel", parse_accel, o.accels);
     if (!a.packet_lanes.empty()) o.packet_lanes = a.packet_lanes;
     for (Isa isa : o.isas)

@@ -373,7 +373,7 @@ batch::Shard resolve_shard(const RenderArguments& args) {
 void run_render(const RenderArguments& args) {
     // Everything about the command line first: no render time is spent on a bad one.
     BatchSettings settings;
-    settings.path = args.path == "simd" ? RenderPath::simd : RenderPath::scalar;
+    settings.path = *parse_render_path(args.path);  // CLI11 allowed only these two
     if (settings.path == RenderPath::simd) {
         try {
             settings.isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));

@@ -56,10 +56,6 @@ struct FrameResult {
     FailureKind failure = FailureKind::none;
 };
 
-std::string_view path_name(RenderPath path) {
-    return path == RenderPath::scalar ? "scalar" : "simd";
-}
-
 RenderResult render_still(const BatchSettings& settings, const Scene& scene,
                           const RenderOptions& options) {
     if (settings.path == RenderPath::scalar) return render_reference(scene, options);
@@ -205,7 +201,7 @@ class BatchRunner {
 ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
                                       const RenderResult& result, int samples_so_far) const {
     const auto [date, utc_offset] = capture_date();
-    std::string path = std::string(path_name(settings_.path));
+    std::string path = std::string(render_path_name(settings_.path));
     if (settings_.path == RenderPath::simd)
         path.append(" (").append(isa_name(settings_.isa)).append(")");
     ExrAttributes a;
@@ -442,7 +438,7 @@ void print_header(const std::vector<BatchScene>& scenes, const std::vector<Batch
     }
     const std::size_t threads =
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-    std::string path(path_name(settings.path));
+    std::string path(render_path_name(settings.path));
     if (settings.path == RenderPath::simd)
         path.append(" (").append(isa_name(settings.isa)).append(")");
     std::printf("render   %s path, %zu threads, %dx%d tiles\n", path.c_str(), threads,

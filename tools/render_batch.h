@@ -19,8 +19,6 @@
 
 namespace octray::tools {
 
-enum class RenderPath { scalar, simd };
-
 struct BatchScene {
     std::string spec;               // as given on the command line
     std::string name;               // {scene} in output patterns

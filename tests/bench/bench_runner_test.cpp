@@ -63,7 +63,7 @@ BenchReport small_run() {
     o.validate_rays = 0;
     o.validate_width = 48;
     o.validate_height = 24;
-    o.paths = {TracePath::simd, TracePath::scalar};
+    o.paths = {RenderPath::simd, RenderPath::scalar};
     o.command_line = "test";
     return run_bench(o);
 }
