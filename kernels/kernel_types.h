@@ -80,7 +80,7 @@ struct SceneView {
     // A packet with fewer live lanes than this goes on ray by ray (single-ray traversal);
     // 0 or 1: packets all the way, 9: single rays only.
     std::uint32_t bvh_packet_min_lanes;
-    // Shadow rays are regrouped by origin and direction before tracing (bvh_kernels.h,
+    // Shadow rays are regrouped by origin and direction before tracing (hit_kernels.h,
     // any_hit) in BVHs of at least this many spheres.
     std::uint32_t bvh_shadow_sort_min_spheres;
 };

@@ -3,11 +3,10 @@
 // checked. Everything here lives in namespace octray::kernels::sse2.
 
 #define OCTRAY_KERNEL_NAMESPACE sse2
+#include "kernels/camera_rays.h"
+#include "kernels/hit_kernels.h"
 #include "kernels/kernel_table.h"
-#include "kernels/packet_kernels.h"
-// Uses packet_kernels.h, so it comes after it (its own block keeps clang-format from
-// sorting it first).
-#include "kernels/bvh_kernels.h"
+#include "kernels/shading.h"
 
 namespace octray::kernels {
 

@@ -1,4 +1,5 @@
-// The sphere BVH (scene/bvh.h) and its traversal (kernels/bvh_kernels.h).
+// The sphere BVH (scene/bvh.h) and its traversal (kernels/hit_kernels.h and the bvh_*.h
+// headers it includes).
 // Builder: every sphere in exactly one leaf, leaves of 1-8 spheres, every child box holds
 // its spheres (the exact spheres, in double precision) and its children's boxes, empty
 // slots last and never entered, the same bytes for any thread count, leaves that are small

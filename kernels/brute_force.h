@@ -1,0 +1,130 @@
+#pragma once
+// Closest hit and any hit against every sphere and plane, without a BVH.
+//
+// Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
+// (packet_math.h; kernels/README.md, "the ODR rule").
+
+#ifndef OCTRAY_KERNEL_NAMESPACE
+#error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"
+#endif
+
+#include <cstdint>
+
+#include "kernels/packet_math.h"
+#include "kernels/plane_test.h"
+#include "kernels/sphere_test.h"
+
+namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
+
+// Closest hit over all spheres and planes, brute force (reference:
+// ReferenceTracer::intersect); closest_hit() in kernels/hit_kernels.h calls it when the
+// scene has no BVH.
+// Spheres are broadcast one at a time against the packet. An object's candidate is its
+// first root above t_min; the hit is the smallest candidate, ties to the lower file index
+// (the reference walks objects in file order and keeps a hit only when strictly nearer).
+template <class Arch>
+void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t count,
+                     float t_min, const HitStream& hits) {
+    using F = xsimd::batch<float, Arch>;
+    using M = xsimd::batch_bool<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    constexpr std::uint32_t K = kPacketWidth / W;
+    const F tmin(t_min);
+    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+        V3<F> o[K], d[K];
+        F a[K], best_t[K], best_id[K];
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = base + k * W;
+            o[k] = load3<F>(rays.ox, rays.oy, rays.oz, at);
+            d[k] = load3<F>(rays.dx, rays.dy, rays.dz, at);
+            a[k] = dot(d[k], d[k]);
+            best_t[k] = F(kInf);
+            best_id[k] = F(-1.0f);
+        }
+        for (std::uint32_t i = 0; i < s.sphere_count; ++i) {
+            const V3<F> c{F(s.sphere_cx[i]), F(s.sphere_cy[i]), F(s.sphere_cz[i])};
+            const F r2(s.sphere_r2[i]);
+            SphereQuadratic<F> quad[K];
+            M any_root = F(0.0f) != F(0.0f);  // all false
+            for (std::uint32_t k = 0; k < K; ++k) {
+                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                any_root = any_root || quad[k].disc >= F(0.0f);
+            }
+            if (xsimd::none(any_root)) continue;
+            const F id(static_cast<float>(s.sphere_object[i]));
+            for (std::uint32_t k = 0; k < K; ++k) {
+                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
+                const M near_ok = t_near > tmin && t_near < best_t[k];
+                const M far_ok = t_far > tmin && t_far < best_t[k];
+                const M hit = near_ok || far_ok;
+                best_t[k] =
+                    xsimd::select(hit, xsimd::select(near_ok, t_near, t_far), best_t[k]);
+                best_id[k] = xsimd::select(hit, id, best_id[k]);
+            }
+        }
+        for (std::uint32_t k = 0; k < K; ++k)
+            closest_planes(s, o[k], d[k], tmin, best_t[k], best_id[k]);
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = base + k * W;
+            best_t[k].store_aligned(hits.t + at);
+            xsimd::to_int(best_id[k]).store_aligned(hits.object + at);  // exact: ids < 2^24
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Any hit for shadow rays on (0, t_max), brute force (reference: ReferenceTracer::occluded);
+// any_hit() in kernels/hit_kernels.h calls it when the scene has no BVH. A packet
+// stops testing objects once every live lane is occluded. occluded[i] is 1 or 0.
+template <class Arch>
+void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
+                 std::uint32_t* occluded) {
+    using F = xsimd::batch<float, Arch>;
+    using M = xsimd::batch_bool<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    constexpr std::uint32_t K = kPacketWidth / W;
+    const F zero(0.0f);
+    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+        V3<F> o[K], d[K];
+        F a[K], t_max[K];
+        M done[K];  // occluded, or a dead lane
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = base + k * W;
+            o[k] = load3<F>(rays.ox, rays.oy, rays.oz, at);
+            d[k] = load3<F>(rays.dx, rays.dy, rays.dz, at);
+            t_max[k] = F::load_aligned(rays.t_max + at);
+            a[k] = dot(d[k], d[k]);
+            done[k] = at < count ? !live_lanes<F>(at, count) : (zero == zero);
+        }
+        const auto all_done = [&] {
+            for (std::uint32_t k = 0; k < K; ++k)
+                if (!xsimd::all(done[k])) return false;
+            return true;
+        };
+        for (std::uint32_t i = 0; i < s.sphere_count && !all_done(); ++i) {
+            const V3<F> c{F(s.sphere_cx[i]), F(s.sphere_cy[i]), F(s.sphere_cz[i])};
+            const F r2(s.sphere_r2[i]);
+            SphereQuadratic<F> quad[K];
+            M any_root = zero != zero;
+            for (std::uint32_t k = 0; k < K; ++k) {
+                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                any_root = any_root || (quad[k].disc >= zero && !done[k]);
+            }
+            if (xsimd::none(any_root)) continue;
+            for (std::uint32_t k = 0; k < K; ++k) {
+                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
+                done[k] = done[k] || (t_near > zero && t_near < t_max[k]) ||
+                          (t_far > zero && t_far < t_max[k]);
+            }
+        }
+        if (!all_done())
+            for (std::uint32_t k = 0; k < K; ++k)
+                done[k] = done[k] || any_plane(s, o[k], d[k], t_max[k]);
+        // Dead lanes come out as 1; nobody reads them.
+        for (std::uint32_t k = 0; k < K; ++k)
+            xsimd::to_int(xsimd::select(done[k], F(1.0f), zero))
+                .store_aligned(reinterpret_cast<std::int32_t*>(occluded + base + k * W));
+    }
+}
+
+}  // namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE

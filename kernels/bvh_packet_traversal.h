@@ -1,0 +1,260 @@
+#pragma once
+// BVH traversal by packets (closest hit and occlusion), going on ray by ray
+// (bvh_single_ray.h) where a packet's live lanes drop below
+// SceneView::bvh_packet_min_lanes.
+//
+// Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
+// (packet_math.h; kernels/README.md, "the ODR rule").
+
+#ifndef OCTRAY_KERNEL_NAMESPACE
+#error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"
+#endif
+
+#include <cstdint>
+
+#include "kernels/bvh_frustum.h"
+#include "kernels/bvh_packet.h"
+#include "kernels/bvh_single_ray.h"
+#include "kernels/sphere_test.h"
+
+namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
+
+// Packets: the 8 rays against one child box at a time.
+
+// Lanes of the packet whose widened box of child j meets the ray on [t_near, t_far[lane]].
+// Always inlined: a node runs it for each of its 8 children, and as a call (which GCC
+// chose) each one also paid for the call and a vzeroupper.
+template <class F>
+[[gnu::always_inline]] inline std::uint32_t packet_child_lanes(const BvhNode8& n,
+                                                               std::uint32_t j,
+                                                               const BvhPacket& p,
+                                                               const F& t_near,
+                                                               const float* t_far) {
+    constexpr std::uint32_t W = F::size;
+    const F min_x(n.min_x[j]), max_x(n.max_x[j]), min_y(n.min_y[j]), max_y(n.max_y[j]);
+    const F min_z(n.min_z[j]), max_z(n.max_z[j]);
+    std::uint32_t bits = 0;
+    for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
+        const F ix = F::load_aligned(p.inv_x + at), iy = F::load_aligned(p.inv_y + at),
+                iz = F::load_aligned(p.inv_z + at);
+        // Either slab plane may be the near one (lanes differ in sign): sort per lane.
+        const F ax = xsimd::fms(min_x, ix, F::load_aligned(p.lo_off_x + at));
+        const F bx = xsimd::fms(max_x, ix, F::load_aligned(p.hi_off_x + at));
+        const F ay = xsimd::fms(min_y, iy, F::load_aligned(p.lo_off_y + at));
+        const F by = xsimd::fms(max_y, iy, F::load_aligned(p.hi_off_y + at));
+        const F az = xsimd::fms(min_z, iz, F::load_aligned(p.lo_off_z + at));
+        const F bz = xsimd::fms(max_z, iz, F::load_aligned(p.hi_off_z + at));
+        const F tn = xsimd::max(xsimd::max(xsimd::min(ax, bx), xsimd::min(ay, by)),
+                                xsimd::max(xsimd::min(az, bz), t_near));
+        const F tf = xsimd::min(xsimd::min(xsimd::max(ax, bx), xsimd::max(ay, by)),
+                                xsimd::min(xsimd::max(az, bz), F::load_aligned(t_far + at)));
+        bits |= mask_bits<F>(tn <= tf) << at;
+    }
+    return bits;
+}
+
+// Where lane `rep` of the packet enters each of the 8 children (children in lanes): the
+// order in which the packet visits them. Only an order: it decides no hit.
+template <class F>
+void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep, float* key) {
+    constexpr std::uint32_t W = F::size;
+    const F ix(p.inv_x[rep]), iy(p.inv_y[rep]), iz(p.inv_z[rep]);
+    const F lo_x(p.lo_off_x[rep]), lo_y(p.lo_off_y[rep]), lo_z(p.lo_off_z[rep]);
+    const F hi_x(p.hi_off_x[rep]), hi_y(p.hi_off_y[rep]), hi_z(p.hi_off_z[rep]);
+    for (std::uint32_t at = 0; at < kBvhWidth; at += W) {
+        const F ax = xsimd::fms(F::load_aligned(n.min_x + at), ix, lo_x);
+        const F bx = xsimd::fms(F::load_aligned(n.max_x + at), ix, hi_x);
+        const F ay = xsimd::fms(F::load_aligned(n.min_y + at), iy, lo_y);
+        const F by = xsimd::fms(F::load_aligned(n.max_y + at), iy, hi_y);
+        const F az = xsimd::fms(F::load_aligned(n.min_z + at), iz, lo_z);
+        const F bz = xsimd::fms(F::load_aligned(n.max_z + at), iz, hi_z);
+        const F entry =
+            xsimd::max(xsimd::max(xsimd::min(ax, bx), xsimd::min(ay, by)), xsimd::min(az, bz));
+        // Ranks need a total order: a NaN (never expected) sorts as the farthest.
+        xsimd::select(entry == entry, entry, F(kInf)).store_aligned(key + at);
+    }
+}
+
+// Pushes the children of `n` that some lane of `mask` enters, nearest on top: nearest
+// where the bundle enters them, or, without a bundle, along the representative lane. Only
+// the children the bundle enters get the per-lane tests (none, for a bundle from one
+// origin: each child takes all of `mask`); these are independent (no branch between them,
+// so the CPU overlaps them), and the entered children are then placed by rank, without a
+// data-dependent branch: child j goes below every entered child nearer than it (ties: the
+// lower index nearer). The leaves among them start loading (prefetch_leaf).
+template <class F, bool kNearestFirst = true>
+void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket& p,
+                          const PacketFrustum<F>& fr, std::uint32_t mask, const F& t_near,
+                          const float* t_far, BvhStacks& st, std::uint32_t& sp) {
+    constexpr std::uint32_t W = F::size;
+    std::uint32_t lanes[kBvhWidth] = {}, entered = 0;
+    alignas(64) float key[kBvhWidth];
+    const std::uint32_t candidates =
+        fr.valid ? frustum_children<F>(n, fr, t_near, F(masked_max<F>(t_far, mask)), key)
+                 : used_children(n);
+    if (fr.one_origin) {
+        for (std::uint32_t j = 0; j < kBvhWidth; ++j) lanes[j] = mask;
+        entered = candidates;
+    } else {
+        for (std::uint32_t bits = candidates; bits != 0; bits &= bits - 1) {
+            const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
+            lanes[j] = packet_child_lanes(n, j, p, t_near, t_far) & mask;
+            entered |= static_cast<std::uint32_t>(lanes[j] != 0) << j;
+        }
+    }
+    if (entered == 0) return;
+    for (std::uint32_t bits = entered; bits != 0; bits &= bits - 1) {
+        const std::uint32_t child = n.child[__builtin_ctz(bits)];
+        if ((child & kBvhLeafBit) != 0) prefetch_leaf(s, child);
+    }
+    const auto count = static_cast<std::uint32_t>(__builtin_popcount(entered));
+    if (count == 1 || !kNearestFirst) {
+        // One child, or any hit (which needs no order): node order (largest box first, the
+        // likeliest occluder), the first on top.
+        for (std::uint32_t bits = entered, slot = sp + count; bits != 0; bits &= bits - 1) {
+            const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
+            st.packet_node[--slot] = n.child[j];
+            st.packet_mask[slot] = static_cast<std::uint8_t>(lanes[j]);
+        }
+        sp += count;
+        return;
+    }
+    if (!fr.valid)
+        packet_child_keys<F>(n, p, static_cast<std::uint32_t>(__builtin_ctz(mask)), key);
+    alignas(64) static constexpr float kIndex[kBvhWidth] = {0, 1, 2, 3, 4, 5, 6, 7};
+    for (std::uint32_t bits = entered; bits != 0; bits &= bits - 1) {
+        const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
+        const F kj(key[j]), index_j(static_cast<float>(j));
+        std::uint32_t nearer = 0;  // entered children that must be pushed after j
+        for (std::uint32_t at = 0; at < kBvhWidth; at += W) {
+            const F k = F::load_aligned(key + at), index = F::load_aligned(kIndex + at);
+            nearer |= mask_bits<F>(k < kj || (k == kj && index < index_j)) << at;
+        }
+        const std::uint32_t slot =
+            sp + count - 1 - static_cast<std::uint32_t>(__builtin_popcount(nearer & entered));
+        st.packet_node[slot] = n.child[j];
+        st.packet_mask[slot] = static_cast<std::uint8_t>(lanes[j]);
+    }
+    sp += count;
+}
+
+// Closest hits of the packet `p` (lanes `live`, not empty: packet_frustum) among the BVH's
+// spheres.
+template <class Arch>
+void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, float t_min,
+                        BvhStacks& st) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    constexpr std::uint32_t K = kPacketWidth / W;
+    const F tmin(t_min), zero(0.0f);
+    const PacketFrustum<F> fr = packet_frustum<F>(p, live);
+    std::uint32_t sp = 0;
+    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
+    while (sp > 0) {
+        --sp;
+        const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp];
+        if (static_cast<std::uint32_t>(__builtin_popcount(mask)) < s.bvh_packet_min_lanes) {
+            for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1)
+                bvh_closest_ray<Arch>(s, p, static_cast<std::uint32_t>(__builtin_ctz(bits)),
+                                      node, t_min, st.ray_node);
+            continue;
+        }
+        if ((node & kBvhLeafBit) == 0) {
+            push_packet_children(s, s.bvh_nodes[node], p, fr, mask, tmin, p.best_t, st, sp);
+            continue;
+        }
+        // A leaf: each sphere broadcast against the packet, as the brute-force kernel does,
+        // with ties to the lower file index.
+        V3<F> o[K], d[K];
+        F a[K], best_t[K], best_id[K];
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = k * W;
+            o[k] = load3<F>(p.ox, p.oy, p.oz, at);
+            d[k] = load3<F>(p.dx, p.dy, p.dz, at);
+            a[k] = F::load_aligned(p.a + at);
+            best_t[k] = F::load_aligned(p.best_t + at);
+            best_id[k] = F::load_aligned(p.best_id + at);
+        }
+        const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
+        for (std::uint32_t i = first; i < end; ++i) {
+            const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
+            const F r2(s.bvh_r2[i]);
+            SphereQuadratic<F> quad[K];
+            auto any_root = zero != zero;
+            for (std::uint32_t k = 0; k < K; ++k) {
+                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                any_root = any_root || quad[k].disc >= zero;
+            }
+            if (xsimd::none(any_root)) continue;
+            const F id(static_cast<float>(s.bvh_object[i]));
+            for (std::uint32_t k = 0; k < K; ++k) {
+                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
+                const F t = xsimd::select(t_near > tmin, t_near, t_far);
+                const auto hit =
+                    t > tmin && (t < best_t[k] || (t == best_t[k] && id < best_id[k]));
+                best_t[k] = xsimd::select(hit, t, best_t[k]);
+                best_id[k] = xsimd::select(hit, id, best_id[k]);
+            }
+        }
+        for (std::uint32_t k = 0; k < K; ++k) {
+            best_t[k].store_aligned(p.best_t + k * W);
+            best_id[k].store_aligned(p.best_id + k * W);
+        }
+    }
+}
+
+// Sets bit i of the result for each lane of `live` (not empty: packet_frustum) that a sphere
+// occludes on (0, t_max).
+template <class Arch>
+std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::uint32_t live,
+                                  BvhStacks& st) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    constexpr std::uint32_t K = kPacketWidth / W;
+    const F zero(0.0f);
+    const PacketFrustum<F> fr = packet_frustum<F>(p, live);
+    std::uint32_t done = 0, sp = 0;
+    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
+    while (sp > 0 && done != live) {
+        --sp;
+        const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp] & ~done;
+        if (mask == 0) continue;
+        if (static_cast<std::uint32_t>(__builtin_popcount(mask)) < s.bvh_packet_min_lanes) {
+            for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1) {
+                const auto lane = static_cast<std::uint32_t>(__builtin_ctz(bits));
+                if (bvh_occluded_ray<Arch>(s, p, lane, node, st.ray_node)) done |= 1u << lane;
+            }
+            continue;
+        }
+        if ((node & kBvhLeafBit) == 0) {
+            push_packet_children<F, false>(s, s.bvh_nodes[node], p, fr, mask, zero, p.best_t,
+                                           st, sp);
+            continue;
+        }
+        V3<F> o[K], d[K];
+        F a[K], t_max[K];
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = k * W;
+            o[k] = load3<F>(p.ox, p.oy, p.oz, at);
+            d[k] = load3<F>(p.dx, p.dy, p.dz, at);
+            a[k] = F::load_aligned(p.a + at);
+            t_max[k] = F::load_aligned(p.best_t + at);
+        }
+        const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
+        for (std::uint32_t i = first; i < end && (done & mask) != mask; ++i) {
+            const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
+            const F r2(s.bvh_r2[i]);
+            for (std::uint32_t k = 0; k < K; ++k) {
+                const SphereQuadratic<F> quad = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                if (xsimd::none(quad.disc >= zero)) continue;
+                const auto [t_near, t_far] = sphere_roots(quad, a[k]);
+                const auto hit =
+                    (t_near > zero && t_near < t_max[k]) || (t_far > zero && t_far < t_max[k]);
+                done |= (mask_bits<F>(hit) << (k * W)) & mask;
+            }
+        }
+    }
+    return done;
+}
+
+}  // namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE

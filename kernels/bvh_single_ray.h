@@ -1,0 +1,209 @@
+#pragma once
+// BVH traversal one ray at a time (closest hit and occlusion), the hybrid traversal's
+// second half (bvh_packet.h).
+//
+// Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
+// (packet_math.h; kernels/README.md, "the ODR rule").
+
+#ifndef OCTRAY_KERNEL_NAMESPACE
+#error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"
+#endif
+
+#include <cstdint>
+
+#include "kernels/bvh_packet.h"
+#include "kernels/sphere_test.h"
+
+namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
+
+// Single ray: one ray against the 8 children of a node at once.
+
+// The ray of one lane, with its near and far planes chosen by its direction's signs.
+template <class F>
+struct BvhRay {
+    using Plane = const float (BvhNode8::*)[kBvhWidth];
+    Plane near_x, near_y, near_z, far_x, far_y, far_z;
+    F inv_x, inv_y, inv_z;
+    F near_off_x, near_off_y, near_off_z, far_off_x, far_off_y, far_off_z;
+    V3<F> o, d;
+    F a;
+
+    BvhRay(const BvhPacket& p, std::uint32_t lane) {
+        const auto axis = [&](float inv, float lo_off, float hi_off, Plane& near, Plane& far,
+                              F& near_off, F& far_off, Plane min, Plane max) {
+            // Positive direction: enter through min - m, leave through max + m.
+            const bool positive = inv >= 0.0f;
+            near = positive ? min : max;
+            far = positive ? max : min;
+            near_off = F(positive ? lo_off : hi_off);
+            far_off = F(positive ? hi_off : lo_off);
+        };
+        axis(p.inv_x[lane], p.lo_off_x[lane], p.hi_off_x[lane], near_x, far_x, near_off_x,
+             far_off_x, &BvhNode8::min_x, &BvhNode8::max_x);
+        axis(p.inv_y[lane], p.lo_off_y[lane], p.hi_off_y[lane], near_y, far_y, near_off_y,
+             far_off_y, &BvhNode8::min_y, &BvhNode8::max_y);
+        axis(p.inv_z[lane], p.lo_off_z[lane], p.hi_off_z[lane], near_z, far_z, near_off_z,
+             far_off_z, &BvhNode8::min_z, &BvhNode8::max_z);
+        inv_x = F(p.inv_x[lane]), inv_y = F(p.inv_y[lane]), inv_z = F(p.inv_z[lane]);
+        o = {F(p.ox[lane]), F(p.oy[lane]), F(p.oz[lane])};
+        d = {F(p.dx[lane]), F(p.dy[lane]), F(p.dz[lane])};
+        a = F(p.a[lane]);
+    }
+
+    // Bit i set when child i's widened box meets the ray on [t_near, t_far]; entry[i] is
+    // where the ray enters it (unless entry is null: any hit needs no order).
+    std::uint32_t test(const BvhNode8& n, const F& t_near, const F& t_far, float* entry) const {
+        constexpr std::uint32_t W = F::size;
+        std::uint32_t bits = 0;
+        for (std::uint32_t at = 0; at < kBvhWidth; at += W) {
+            const F tnx = xsimd::fms(F::load_aligned((n.*near_x) + at), inv_x, near_off_x);
+            const F tny = xsimd::fms(F::load_aligned((n.*near_y) + at), inv_y, near_off_y);
+            const F tnz = xsimd::fms(F::load_aligned((n.*near_z) + at), inv_z, near_off_z);
+            const F tfx = xsimd::fms(F::load_aligned((n.*far_x) + at), inv_x, far_off_x);
+            const F tfy = xsimd::fms(F::load_aligned((n.*far_y) + at), inv_y, far_off_y);
+            const F tfz = xsimd::fms(F::load_aligned((n.*far_z) + at), inv_z, far_off_z);
+            const F tn = xsimd::max(xsimd::max(tnx, tny), xsimd::max(tnz, t_near));
+            const F tf = xsimd::min(xsimd::min(tfx, tfy), xsimd::min(tfz, t_far));
+            bits |= mask_bits<F>(tn <= tf) << at;
+            if (entry != nullptr) tn.store_aligned(entry + at);
+        }
+        return bits;
+    }
+};
+
+// A ray against spheres i ... i + W - 1 of a leaf (lanes at ... of its `count`): the
+// brute-force arithmetic of sphere_test.h (sphere_quadratic, sphere_roots), so the BVH
+// finds the same t as brute force. `live`: lanes holding a sphere with real roots.
+template <class F>
+struct LeafRoots {
+    typename F::batch_bool_type live;
+    F t_near, t_far;
+};
+
+template <class F>
+LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t i,
+                        std::uint32_t at, std::uint32_t count) {
+    const F zero(0.0f);
+    const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
+                  F::load_unaligned(s.bvh_cz + i)};
+    const SphereQuadratic<F> quad =
+        sphere_quadratic(sub(ray.o, c), ray.d, ray.a, F::load_unaligned(s.bvh_r2 + i));
+    const auto live = live_lanes<F>(at, count) && quad.disc >= zero;
+    if (xsimd::none(live)) return {live, zero, zero};
+    const SphereRoots<F> roots = sphere_roots(quad, ray.a);
+    return {live, roots.t_near, roots.t_far};
+}
+
+// Children of `n` in `bits`, nearest first by `entry`: the nearest is returned, the rest
+// pushed farthest first.
+inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
+                                   std::uint32_t* stack, std::uint32_t& sp) {
+    std::uint32_t order[kBvhWidth];
+    std::uint32_t count = 0;
+    while (bits != 0) {
+        const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
+        bits &= bits - 1;
+        std::uint32_t k = count++;
+        for (; k > 0 && entry[order[k - 1]] < entry[j]; --k) order[k] = order[k - 1];
+        order[k] = j;  // descending entry
+    }
+    for (std::uint32_t k = 0; k + 1 < count; ++k) stack[sp++] = n.child[order[k]];
+    return n.child[order[count - 1]];
+}
+
+// Children of `n` in `bits` in the node's order (the builder's: largest box first, the
+// likeliest to occlude): the first is returned, the rest pushed last first.
+inline std::uint32_t push_children_in_order(const BvhNode8& n, std::uint32_t bits,
+                                            std::uint32_t* stack, std::uint32_t& sp) {
+    const auto first = static_cast<std::uint32_t>(__builtin_ctz(bits));
+    for (bits &= bits - 1; bits != 0; bits &= ~(1u << (31 - __builtin_clz(bits))))
+        stack[sp++] = n.child[31 - __builtin_clz(bits)];
+    return n.child[first];
+}
+
+// Closest hit of lane `lane` of `p` in the subtree `start`, on (t_min, best_t].
+template <class Arch>
+void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::uint32_t start,
+                     float t_min, std::uint32_t* stack) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    const BvhRay<F> ray(p, lane);
+    const F tmin(t_min), zero(0.0f);
+    float& best_t = p.best_t[lane];
+    float& best_id = p.best_id[lane];
+    alignas(64) float entry[kBvhWidth];
+    std::uint32_t sp = 0, node = start;
+    for (;;) {
+        if ((node & kBvhLeafBit) == 0) {
+            const BvhNode8& n = s.bvh_nodes[node];
+            const std::uint32_t bits = ray.test(n, tmin, F(best_t), entry);
+            if (bits != 0) {
+                node = push_children(n, bits, entry, stack, sp);
+                continue;
+            }
+        } else {
+            // Up to 8 spheres against the ray, the brute-force arithmetic per lane.
+            const std::uint32_t first = leaf_first(node), count = leaf_count(node);
+            for (std::uint32_t at = 0; at < count; at += W) {
+                const std::uint32_t i = first + at;
+                const LeafRoots<F> r = leaf_roots(s, ray, i, at, count);
+                if (xsimd::none(r.live)) continue;
+                const auto& live = r.live;
+                const F& t_near = r.t_near;
+                const F& t_far = r.t_far;
+                // The sphere's candidate is its first root above t_min.
+                const F t = xsimd::select(t_near > tmin, t_near, t_far);
+                std::uint32_t bits = mask_bits<F>(live && t > tmin && t <= F(best_t));
+                if (bits == 0) continue;
+                alignas(64) float ts[W];
+                t.store_aligned(ts);
+                for (; bits != 0; bits &= bits - 1) {
+                    const auto l = static_cast<std::uint32_t>(__builtin_ctz(bits));
+                    const auto id = static_cast<float>(s.bvh_object[i + l]);
+                    if (ts[l] < best_t || (ts[l] == best_t && id < best_id))
+                        best_t = ts[l], best_id = id;
+                }
+            }
+        }
+        if (sp == 0) return;
+        node = stack[--sp];
+    }
+}
+
+// Whether lane `lane` of `p` hits a sphere of the subtree `start` on (0, t_max).
+template <class Arch>
+bool bvh_occluded_ray(const SceneView& s, const BvhPacket& p, std::uint32_t lane,
+                      std::uint32_t start, std::uint32_t* stack) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    const BvhRay<F> ray(p, lane);
+    const F zero(0.0f), t_max(p.best_t[lane]);
+    std::uint32_t sp = 0, node = start;
+    for (;;) {
+        if ((node & kBvhLeafBit) == 0) {
+            const BvhNode8& n = s.bvh_nodes[node];
+            const std::uint32_t bits = ray.test(n, zero, t_max, nullptr);
+            if (bits != 0) {
+                node = push_children_in_order(n, bits, stack, sp);
+                continue;
+            }
+        } else {
+            const std::uint32_t first = leaf_first(node), count = leaf_count(node);
+            for (std::uint32_t at = 0; at < count; at += W) {
+                const std::uint32_t i = first + at;
+                const LeafRoots<F> r = leaf_roots(s, ray, i, at, count);
+                if (xsimd::none(r.live)) continue;
+                const auto& live = r.live;
+                const F& t_near = r.t_near;
+                const F& t_far = r.t_far;
+                if (xsimd::any(live && ((t_near > zero && t_near < t_max) ||
+                                        (t_far > zero && t_far < t_max))))
+                    return true;
+            }
+        }
+        if (sp == 0) return false;
+        node = stack[--sp];
+    }
+}
+
+}  // namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE

@@ -1,0 +1,197 @@
+#pragma once
+// The closest_hit and any_hit entry points of the kernel table: the BVH when the scene
+// view has one (bvh_packet_traversal.h), else brute force (brute_force.h); planes stay
+// outside the tree. Shadow rays are sorted into coherent packets first in large BVHs.
+//
+// Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
+// (packet_math.h; kernels/README.md, "the ODR rule").
+
+#ifndef OCTRAY_KERNEL_NAMESPACE
+#error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"
+#endif
+
+#include <cstdint>
+
+#include "kernels/brute_force.h"
+#include "kernels/bvh_packet.h"
+#include "kernels/bvh_packet_traversal.h"
+#include "kernels/plane_test.h"
+
+namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
+
+// Lanes [base, base + 8) below count, as bits.
+inline std::uint32_t live_bits(std::uint32_t base, std::uint32_t count) {
+    const std::uint32_t left = count - base;
+    return left >= kPacketWidth ? (1u << kPacketWidth) - 1u : (1u << left) - 1u;
+}
+
+// The kernel table's entry points: the BVH when the scene view has one, else brute force.
+
+template <class Arch>
+void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count, float t_min,
+                 const HitStream& hits) {
+    if (s.bvh_nodes == nullptr) return closest_hit_all<Arch>(s, rays, count, t_min, hits);
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    BvhPacket p;
+    BvhStacks st;
+    const F tmin(t_min);
+    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+        const std::uint32_t live = live_bits(base, count);
+        if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
+                                nullptr, base, p) &
+             live) != live) {
+            // Box tests would overflow: this packet against every sphere.
+            const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
+                                rays.dx + base,   rays.dy + base, rays.dz + base,
+                                rays.wr + base,   rays.wg + base, rays.wb + base,
+                                rays.pixel + base};
+            closest_hit_all<Arch>(s, one,
+                                  count - base < kPacketWidth ? count - base : kPacketWidth,
+                                  t_min, HitStream{hits.t + base, hits.object + base});
+            continue;
+        }
+        bvh_closest_packet<Arch>(s, p, live, t_min, st);
+        // Planes stay outside the tree.
+        for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
+            F best_t = F::load_aligned(p.best_t + at),
+              best_id = F::load_aligned(p.best_id + at);
+            closest_planes(s, load3<F>(p.ox, p.oy, p.oz, at), load3<F>(p.dx, p.dy, p.dz, at),
+                           tmin, best_t, best_id);
+            best_t.store_aligned(hits.t + base + at);
+            xsimd::to_int(best_id).store_aligned(hits.object + base + at);  // ids < 2^24
+        }
+    }
+}
+
+// Whether each live lane of the 8 rays from `base` of `rays` is occluded, as bits.
+template <class Arch>
+std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std::uint32_t base,
+                              std::uint32_t live, BvhPacket& p, BvhStacks& st) {
+    using F = xsimd::batch<float, Arch>;
+    constexpr std::uint32_t W = F::size;
+    if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t_max,
+                            base, p) &
+         live) != live) {
+        // Box tests would overflow: this packet against every sphere.
+        const ShadowStream one{rays.ox + base,     rays.oy + base,     rays.oz + base,
+                               rays.dx + base,     rays.dy + base,     rays.dz + base,
+                               rays.t_max + base,  rays.term_r + base, rays.term_g + base,
+                               rays.term_b + base, rays.parent + base};
+        std::uint32_t flags[kPacketWidth] = {};
+        any_hit_all<Arch>(s, one, static_cast<std::uint32_t>(32 - __builtin_clz(live)), flags);
+        std::uint32_t bits = 0;
+        for (std::uint32_t i = 0; i < kPacketWidth; ++i) bits |= (flags[i] & 1u) << i;
+        return bits & live;
+    }
+    // Planes first: a lane they occlude needs no traversal.
+    std::uint32_t done = 0;
+    for (std::uint32_t at = 0; at < kPacketWidth; at += W)
+        done |= mask_bits<F>(any_plane(s, load3<F>(p.ox, p.oy, p.oz, at),
+                                       load3<F>(p.dx, p.dy, p.dz, at),
+                                       F::load_aligned(p.best_t + at)))
+                << at;
+    done &= live;
+    if (done == live) return done;  // no lane left to trace
+    return done | bvh_occluded_packet<Arch>(s, p, live & ~done, st);
+}
+
+// Shadow rays are traced in batches of up to this many, regrouped into packets of rays
+// whose origins lie close together (in BVHs of SceneView::bvh_shadow_sort_min_spheres
+// spheres or more); smaller calls are traced in the order given.
+constexpr std::uint32_t kShadowBatch = 4096;
+constexpr std::uint32_t kShadowSortMin = 64;
+
+// The sort keys of shadow rays [at, at + W) (lanes past the stream's end read its
+// padding, and their keys go unused): each ray's direction octant (3 sign bits: rays of
+// one packet then mostly share their signs, so the packet's frustum test applies), then
+// the cell of the BVH's root box (32 per axis, clamped) that holds its origin, as a
+// 15-bit Morton code (neighbouring cells get neighbouring codes).
+template <class F>
+void shadow_keys(const SceneView& s, const ShadowStream& rays, std::uint32_t at,
+                 std::uint32_t* key) {
+    using I = xsimd::batch<std::int32_t, typename F::arch_type>;
+    const float* const o[3] = {rays.ox + at, rays.oy + at, rays.oz + at};
+    const float* const d[3] = {rays.dx + at, rays.dy + at, rays.dz + at};
+    I code(0);
+    for (int a = 0; a < 3; ++a) {
+        const float extent = s.bvh_hi[a] - s.bvh_lo[a];
+        const F scale(extent > 0.0f && 32.0f / extent < kInf ? 32.0f / extent : 0.0f);
+        // max(NaN, 0) is 0 (the second operand): below the box or NaN, cell 0.
+        const F f = xsimd::max((F::load_unaligned(o[a]) - F(s.bvh_lo[a])) * scale, F(0.0f));
+        I q = xsimd::to_int(xsimd::min(f, F(31.0f)));
+        q = (q | (q << 8)) & I(0x0300F);  // 5 bits spread to every third bit
+        q = (q | (q << 4)) & I(0x030C3);
+        q = (q | (q << 2)) & I(0x09249);
+        // The direction's sign bit.
+        const I sign = (xsimd::bitwise_cast<I>(F::load_unaligned(d[a])) >> 31) & I(1);
+        code = code | (q << a) | (sign << (15 + a));
+    }
+    code.store_unaligned(reinterpret_cast<std::int32_t*>(key));
+}
+
+template <class Arch>
+void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
+             std::uint32_t* occluded) {
+    if (s.bvh_nodes == nullptr) return any_hit_all<Arch>(s, rays, count, occluded);
+    BvhPacket p;
+    BvhStacks st;
+    if (count < kShadowSortMin || s.sphere_count < s.bvh_shadow_sort_min_spheres) {
+        for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+            const std::uint32_t live = live_bits(base, count);
+            const std::uint32_t bits = occluded_packet<Arch>(s, rays, base, live, p, st);
+            for (std::uint32_t i = 0; i < kPacketWidth; ++i)
+                occluded[base + i] = (bits >> i) & 1u;
+        }
+        return;
+    }
+    // Packets of neighbouring pixels' shadow rays start on surfaces at any depth and may
+    // head for different lights, and their traversals share little. Sorted by direction
+    // octant and origin cell, rays from one neighbourhood towards one light travel
+    // together (docs/performance-log.md: shadow rays 7-13 % faster on random:65536,
+    // random:1048576 and sphereflake:5). Each ray's answer is exact whatever its packet,
+    // so the order changes no result. The sort is a counting sort of words holding the key
+    // (18 bits) above the ray's index in the batch (12 bits), two passes of 9 bits.
+    static_assert(kShadowBatch <= 4096);
+    alignas(64) std::uint32_t order[kShadowBatch], sorted[kShadowBatch];
+    struct Gathered {
+        alignas(64) float ox[kPacketWidth], oy[kPacketWidth], oz[kPacketWidth];
+        alignas(64) float dx[kPacketWidth], dy[kPacketWidth], dz[kPacketWidth];
+        alignas(64) float t_max[kPacketWidth], term[kPacketWidth];
+        std::uint32_t parent[kPacketWidth];
+    } g;
+    const ShadowStream packet{g.ox,    g.oy,   g.oz,   g.dx,   g.dy,    g.dz,
+                              g.t_max, g.term, g.term, g.term, g.parent};
+    for (std::uint32_t first = 0; first < count; first += kShadowBatch) {
+        const std::uint32_t n = count - first < kShadowBatch ? count - first : kShadowBatch;
+        using F = xsimd::batch<float, Arch>;
+        for (std::uint32_t i = 0; i < n; i += F::size)
+            shadow_keys<F>(s, rays, first + i, order + i);
+        for (std::uint32_t i = 0; i < n; ++i) order[i] = order[i] << 12 | i;
+        std::uint32_t* from = order;
+        std::uint32_t* to = sorted;
+        for (std::uint32_t shift = 12; shift < 30; shift += 9, std::swap(from, to)) {
+            std::uint32_t start[513] = {};
+            for (std::uint32_t i = 0; i < n; ++i) ++start[((from[i] >> shift) & 511u) + 1];
+            for (std::uint32_t k = 1; k < 513; ++k) start[k] += start[k - 1];
+            for (std::uint32_t i = 0; i < n; ++i)
+                to[start[(from[i] >> shift) & 511u]++] = from[i];
+        }
+        for (std::uint32_t i = 0; i < n; ++i) order[i] = from[i] & 4095u;  // from == order
+        for (std::uint32_t k = 0; k < n; k += kPacketWidth) {
+            const std::uint32_t live = live_bits(k, n);
+            for (std::uint32_t l = 0; l < kPacketWidth; ++l) {
+                // Dead lanes repeat the first ray: finite values, never read back.
+                const std::uint32_t r = first + order[(live >> l & 1u) != 0 ? k + l : k];
+                g.ox[l] = rays.ox[r], g.oy[l] = rays.oy[r], g.oz[l] = rays.oz[r];
+                g.dx[l] = rays.dx[r], g.dy[l] = rays.dy[r], g.dz[l] = rays.dz[r];
+                g.t_max[l] = rays.t_max[r], g.term[l] = 0.0f, g.parent[l] = 0;
+            }
+            const std::uint32_t bits = occluded_packet<Arch>(s, packet, 0, live, p, st);
+            for (std::uint32_t l = 0; l < kPacketWidth && k + l < n; ++l)
+                occluded[first + order[k + l]] = (bits >> l) & 1u;
+        }
+    }
+}
+
+}  // namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE
