@@ -1,0 +1,140 @@
+// Tracing ray sets and whole frames for `octray bench`, timed: every system reads the same
+// ray arrays and is scheduled the same way, chunks of kChunkRays rays spread over one TBB
+// arena of the bench's threads.
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <optional>
+
+#include "bench/bench_detail.h"
+
+namespace octray::bench::detail {
+
+namespace {
+
+// Rays per task: large enough to amortise scheduling, small enough to balance two cores.
+constexpr std::uint32_t kChunkRays = 4096;
+static_assert(kChunkRays % kernels::kPacketWidth == 0);
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// f(first, n) over [0, count) in chunks, on the arena's threads.
+void for_chunks(tbb::task_arena& arena, std::uint32_t count,
+                const std::function<void(std::uint32_t, std::uint32_t)>& f) {
+    const std::uint32_t chunks = (count + kChunkRays - 1) / kChunkRays;
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<std::uint32_t>(0, chunks, 1),
+            [&](const tbb::blocked_range<std::uint32_t>& r) {
+                for (std::uint32_t c = r.begin(); c < r.end(); ++c) {
+                    const std::uint32_t first = c * kChunkRays;
+                    f(first, std::min(kChunkRays, count - first));
+                }
+            },
+            tbb::simple_partitioner());
+    });
+}
+
+}  // namespace
+
+// Warm-up runs, then `reps` timed runs; the hits of the last run stay in `hits`.
+std::vector<double> time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits, int warmup,
+                              int reps) {
+    for (int i = 0; i < warmup; ++i) trace(rays, hits);
+    std::vector<double> seconds;
+    for (int i = 0; i < reps; ++i) {
+        const auto start = Clock::now();
+        trace(rays, hits);
+        seconds.push_back(seconds_since(start));
+    }
+    return seconds;
+}
+
+// octray's packet kernels over the set: closest_hit, or any_hit into the occluded flags.
+Tracer octray_simd_tracer(tbb::task_arena& arena, const kernels::KernelTable& table,
+                          const kernels::SceneView& view) {
+    return [&arena, &table, view](const RaySet& rays, HitSet& hits) {
+        if (rays.kind == RayKind::shadow) {
+            // any_hit writes 0 / 1 per ray (whole packets); mapped to kNoHit / kOccluded
+            // after timing by occluded_to_hits().
+            auto* flags = reinterpret_cast<std::uint32_t*>(hits.object.data());
+            for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+                table.any_hit(view, rays.shadow_stream(first), n, flags + first);
+            });
+            return;
+        }
+        for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+            table.closest_hit(view, rays.ray_stream(first), n, rays.t_min, hits.stream(first));
+        });
+    };
+}
+
+void occluded_to_hits(HitSet& hits, std::uint32_t count) {
+    for (std::uint32_t i = 0; i < count; ++i)
+        hits.object[i] = hits.object[i] != 0 ? kOccluded : kernels::kNoHit;
+}
+
+// The scalar reference, one ray at a time.
+Tracer octray_scalar_tracer(tbb::task_arena& arena, const ReferenceTracer& tracer) {
+    return [&arena, &tracer](const RaySet& rays, HitSet& hits) {
+        const bool any = rays.kind == RayKind::shadow;
+        for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+            for (std::uint32_t i = first; i < first + n; ++i) {
+                const Ray ray = rays.ray(i);
+                if (any) {
+                    hits.object[i] = tracer.occluded(ray) ? kOccluded : kernels::kNoHit;
+                    continue;
+                }
+                const std::optional<SurfaceHit> hit = tracer.intersect(ray);
+                hits.t[i] = hit ? hit->t : kInfinity;
+                hits.object[i] = hit ? static_cast<std::int32_t>(hit->object) : kernels::kNoHit;
+            }
+        });
+    };
+}
+
+#if OCTRAY_HAVE_EMBREE
+Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMode mode) {
+    return [&arena, &scene, mode](const RaySet& rays, HitSet& hits) {
+        // Camera rays are coherent; shadow and mirror rays are traced as incoherent.
+        const bool coherent = rays.kind == RayKind::primary;
+        const bool any = rays.kind == RayKind::shadow;
+        for_chunks(arena, rays.count, [&](std::uint32_t first, std::uint32_t n) {
+            if (any)
+                scene.occluded(mode, rays, first, n, hits, coherent);
+            else
+                scene.intersect(mode, rays, first, n, hits, coherent);
+        });
+    };
+}
+#endif
+
+// A whole-frame row: warm-up frames, then o.reps timed ones (each frame's own seconds),
+// the last frame's ray counts, the rates and frames per second.
+void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
+                 const BenchOptions& o) {
+    RenderResult last;
+    for (int i = 0; i < o.warmup; ++i) last = render();
+    for (int i = 0; i < o.reps; ++i) {
+        last = render();
+        row.seconds.push_back(last.seconds);
+    }
+    row.counts = last.rays;
+    row.rays = last.rays.total();
+    row.hit_fraction = std::nan("");
+    row.timing = summarize(row.seconds, row.rays);
+    row.frames_per_second =
+        row.timing.seconds_median > 0.0 ? 1.0 / row.timing.seconds_median : 0.0;
+}
+
+}  // namespace octray::bench::detail
