@@ -25,8 +25,6 @@ inline std::uint32_t live_bits(std::uint32_t base, std::uint32_t count) {
     return left >= kPacketWidth ? (1u << kPacketWidth) - 1u : (1u << left) - 1u;
 }
 
-// The kernel table's entry points: the BVH when the scene view has one, else brute force.
-
 template <class Arch>
 void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count, float t_min,
                  const HitStream& hits) {
