@@ -29,7 +29,7 @@
 #include "bench/embree_frames.h"
 #include "core/version.h"
 #include "kernels/dispatch.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/bvh.h"

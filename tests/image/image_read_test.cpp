@@ -1,4 +1,4 @@
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "render/image_io.h"
-#include "tests/render/compare_fixtures.h"
+#include "render/image/image_io.h"
+#include "tests/image/compare_fixtures.h"
 
 namespace octray {
 namespace {

@@ -1,4 +1,4 @@
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
