@@ -12,9 +12,9 @@
 
 #include "core/version.h"
 #include "kernels/dispatch.h"
-#include "render/image_compare.h"
-#include "render/image_io.h"
-#include "render/image_read.h"
+#include "render/image/image_compare.h"
+#include "render/image/image_io.h"
+#include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/animation.h"

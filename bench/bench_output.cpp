@@ -14,7 +14,7 @@
 
 #include "bench/bench_detail.h"
 #include "bench/bench_runner.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 
 namespace octray::bench {
 

@@ -12,7 +12,7 @@ include(CMakePackageConfigHelpers)
 set(OCTRAY_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/octray)
 
 # Exported names: octray_scene -> octray::scene, ...
-foreach(lib core scene kernels render reference imageio compare warnings fp_model optimize)
+foreach(lib core scene kernels render reference image warnings fp_model optimize)
   set_target_properties(octray_${lib} PROPERTIES EXPORT_NAME ${lib})
 endforeach()
 
@@ -26,7 +26,7 @@ install(FILES ${OCTRAY_SHARE_DIR}/bash-completion/completions/octray
 install(FILES ${OCTRAY_SHARE_DIR}/zsh/vendor-completions/_octray
         DESTINATION ${CMAKE_INSTALL_DATADIR}/zsh/vendor-completions)
 install(TARGETS octray_api octray_core octray_scene octray_kernels octray_render
-                octray_reference octray_imageio octray_compare
+                octray_reference octray_image
                 octray_warnings octray_fp_model octray_optimize
         EXPORT octrayTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

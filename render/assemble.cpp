@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "render/crop.h"
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 
 namespace octray {
 namespace {

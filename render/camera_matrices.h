@@ -13,7 +13,7 @@
 
 #include <optional>
 
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "scene/scene.h"
 
 namespace octray {

@@ -91,7 +91,7 @@ struct RenderResult {
     Image image;  // the pixels of `rect` (crop-sized); (0, 0) is pixel (rect.x0, rect.y0)
     // Which pixels of the full_width x full_height image `image` holds: the crop, or the
     // whole image. An EXR writer makes `rect` the data window and the full image the
-    // display window (render/image_io.h, make_exr_image).
+    // display window (render/image/image_io.h, make_exr_image).
     PixelRect rect;
     int full_width = 0;
     int full_height = 0;

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/version.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "scene/scene_error.h"
 #include "tools/commands.h"
 

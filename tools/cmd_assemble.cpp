@@ -9,8 +9,8 @@
 
 #include "core/image.h"
 #include "render/assemble.h"
-#include "render/image_io.h"
-#include "render/image_read.h"
+#include "render/image/image_io.h"
+#include "render/image/image_read.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 

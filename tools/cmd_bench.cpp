@@ -15,7 +15,7 @@
 #include "bench/bench_runner.h"
 #include "bench/embree_baseline.h"
 #include "kernels/dispatch.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 

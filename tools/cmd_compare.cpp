@@ -1,6 +1,6 @@
 // `octray compare`: idiff-style numeric comparison of two images (OpenEXR or PNG), with an
 // optional difference EXR, an error heatmap and JSON output. The figures, the thresholds
-// and the exit codes are idiff's; render/COMPARE.md defines them.
+// and the exit codes are idiff's; render/image/COMPARE.md defines them.
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "render/error_heatmap.h"
-#include "render/image_compare.h"
-#include "render/image_io.h"
-#include "render/image_read.h"
+#include "render/image/error_heatmap.h"
+#include "render/image/image_compare.h"
+#include "render/image/image_io.h"
+#include "render/image/image_read.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 
@@ -203,7 +203,7 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
         "the error figures are over the finite values. Equal infinities (+inf against\n"
         "+inf, as a depth AOV's background) are equal. Thresholds are decimal numbers\n"
         "(or inf); NaN is refused. PSNR = 20 log10(peak / RMSE), peak =\n"
-        "max(1, largest value). See render/COMPARE.md.\n\n"
+        "max(1, largest value). See render/image/COMPARE.md.\n\n"
         "Examples:\n"
         "  octray compare ref.exr out.exr\n"
         "  octray compare ref.exr out.exr --fail 0.004 --failpercent 0.1 --warn 0.001\n"

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "core/version.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "scene/suggest.h"
 #include "tools/cli_describe.h"
 #include "tools/commands.h"

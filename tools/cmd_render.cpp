@@ -34,7 +34,7 @@
 
 #include "core/sha256.h"
 #include "kernels/dispatch.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "scene/animation.h"
 #include "scene/builtin.h"
 #include "scene/limits.h"

@@ -10,7 +10,7 @@
 #include <string>
 #include <system_error>
 
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "scene/load.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"

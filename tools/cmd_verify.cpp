@@ -1,5 +1,5 @@
 // `octray verify SCENE`: renders the scene with the scalar reference and with the SIMD
-// packet path and compares them with the compare library (render/image_compare.h):
+// packet path and compares them with the compare library (render/image/image_compare.h):
 // max abs error, RMSE, PSNR, the share of pixels over the fail threshold and the worst
 // pixel with both values. The two paths promise identical bits, so the default is exact
 // (every threshold 0); a tolerance can be given. --frames verifies frames of an animated
@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "kernels/dispatch.h"
-#include "render/image_compare.h"
-#include "render/image_read.h"
+#include "render/image/image_compare.h"
+#include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/animation.h"

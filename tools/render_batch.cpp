@@ -27,7 +27,7 @@
 #include "kernels/dispatch.h"
 #include "render/aov.h"
 #include "render/camera_matrices.h"
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/progressive.h"
 #include "render/reference.h"
@@ -100,7 +100,7 @@ Found existing_output(const std::string& path) {
     if (error) return {Existing::finished, {}, {}};  // not a regular file: never overwrite it
     if (size == 0) return {Existing::claim, {}, {}};
     // Not an EXR (a PNG preview target): it exists. An EXR gets the check that `compare` and
-    // `assemble` make before decoding (render/image_read.h): every chunk against its
+    // `assemble` make before decoding (render/image/image_read.h): every chunk against its
     // header. Its pixels are not decoded: resuming a long sequence only needs to know the
     // file is whole.
     if (!has_exr_signature(path)) return {Existing::finished, {}, {}};

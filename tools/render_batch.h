@@ -10,7 +10,7 @@
 
 #include "kernels/isa.h"
 #include "render/aov.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "render/types.h"
 #include "scene/accel.h"
 #include "scene/scene.h"

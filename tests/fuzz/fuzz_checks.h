@@ -24,8 +24,8 @@
 #include <system_error>
 #include <vector>
 
-#include "render/image_io.h"
-#include "render/image_read.h"
+#include "render/image/image_io.h"
+#include "render/image/image_read.h"
 #include "scene/builtin.h"
 #include "scene/compile.h"
 #include "scene/limits.h"

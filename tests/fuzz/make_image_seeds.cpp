@@ -1,7 +1,7 @@
 // Writes the seed corpus of fuzz_image_read (tests/fuzz/corpus/fuzz_image_read/): tiny
-// OpenEXR and PNG files covering the layouts render/image_read.h accepts. Written with
+// OpenEXR and PNG files covering the layouts render/image/image_read.h accepts. Written with
 // OpenEXR and libpng directly, so the seeds do not depend on the reader under test.
-// Also files that lie (tests/render/lying_exr.h): HALF data declared FLOAT for every codec,
+// Also files that lie (tests/image/lying_exr.h): HALF data declared FLOAT for every codec,
 // FLOAT declared HALF, tiled ones, and chunks cut short.
 // Usage: octray_make_image_seeds DIR
 
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "../render/lying_exr.h"
+#include "../image/lying_exr.h"
 
 namespace {
 

@@ -84,7 +84,7 @@ TEST(FuzzCorpus, EveryImageSeedReads) {
 }
 
 // The seeds that lie (a header declaring other pixel types than the data, a chunk cut
-// short: tests/render/lying_exr.h) are file errors naming the file, for every codec.
+// short: tests/image/lying_exr.h) are file errors naming the file, for every codec.
 TEST(FuzzCorpus, EveryLyingImageSeedIsAFileError) {
     int lying = 0;
     for (const fs::path& f : corpus("fuzz_image_read")) {

@@ -13,7 +13,8 @@
 #include "output_fixtures.h"
 #include "render/aov.h"
 #include "render/camera_matrices.h"
-#include "render/image_read.h"
+#include "render/image/image_read.h"
+#include "render/result_exr.h"
 
 namespace octray {
 namespace {

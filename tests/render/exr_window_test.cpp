@@ -18,8 +18,9 @@
 
 #include "output_fixtures.h"
 #include "render/camera_matrices.h"
-#include "render/image_io.h"
-#include "render/image_read.h"
+#include "render/image/image_io.h"
+#include "render/image/image_read.h"
+#include "render/result_exr.h"
 #include "scene_builders.h"
 
 namespace octray {

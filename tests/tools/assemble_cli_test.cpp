@@ -12,8 +12,9 @@
 #include "render/aov.h"
 #include "render/assemble.h"
 #include "render/camera_matrices.h"
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 #include "render/packet_renderer.h"
+#include "render/result_exr.h"
 #include "run_octray.h"
 #include "scene/load.h"
 

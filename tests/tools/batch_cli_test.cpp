@@ -33,7 +33,7 @@
 #include <vector>
 
 #include "core/sha256.h"
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 #include "run_octray.h"
 #include "tools/claim_owner.h"
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "run_octray.h"
-#include "tests/render/compare_fixtures.h"
+#include "tests/image/compare_fixtures.h"
 
 namespace octray {
 namespace {

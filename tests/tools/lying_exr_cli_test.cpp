@@ -2,7 +2,7 @@
 // (which OpenEXR 3.1 reads as garbage) is a file error, exit 4 naming the file, wherever
 // octray reads an EXR: `compare`, `assemble`, and `render --skip-existing` resuming over
 // it. The files are patched copies of what OpenEXR or octray itself wrote
-// (tests/render/lying_exr.h).
+// (tests/image/lying_exr.h).
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "run_octray.h"
-#include "tests/render/compare_fixtures.h"
-#include "tests/render/lying_exr.h"
+#include "tests/image/compare_fixtures.h"
+#include "tests/image/lying_exr.h"
 
 namespace octray {
 namespace {

@@ -1,4 +1,4 @@
-#include "render/image_compare.h"
+#include "render/image/image_compare.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "render/error_heatmap.h"
-#include "render/image_io.h"
-#include "tests/render/compare_fixtures.h"
+#include "render/image/error_heatmap.h"
+#include "render/image/image_io.h"
+#include "tests/image/compare_fixtures.h"
 
 namespace octray {
 namespace {

@@ -1,7 +1,8 @@
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -11,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "render/image_io.h"
-#include "tests/render/compare_fixtures.h"
+#include "render/image/image_io.h"
+#include "tests/image/compare_fixtures.h"
 
 namespace octray {
 namespace {
@@ -261,6 +262,52 @@ TEST_F(ImageReadTest, PngWithBrokenDataIsAnIoErrorNotACrash) {
     }
     const std::string message = read_error(path("c.png"));
     EXPECT_NE(message.find("corrupt PNG"), std::string::npos) << message;
+}
+
+// What `octray render` reads of an existing image to resume: its int and string header
+// attributes, by name and type, without decoding its pixels.
+TEST_F(ImageReadTest, ExrAttributesAreReadByNameAndType) {
+    ExrAttributes written;
+    written.ints = {{"octray.samplesSoFar", 3}};
+    written.strings = {{"octray.claimOwner", "host:1234"}};
+    written.floats = {{"octray.samples", 2.5f}};
+    Image image(4, 2);
+    image.at(3, 1) = Rgb(1.0f, 0.5f, 0.25f);
+    write_exr(path("a.exr"), image, ExrWriteOptions{}, written);
+
+    const ExrAttributes read = read_exr_attributes(path("a.exr"));
+    ASSERT_NE(read.find_int("octray.samplesSoFar"), nullptr);
+    EXPECT_EQ(*read.find_int("octray.samplesSoFar"), 3);
+    ASSERT_NE(read.find_string("octray.claimOwner"), nullptr);
+    EXPECT_EQ(*read.find_string("octray.claimOwner"), "host:1234");
+    // By type: a float attribute is not an int, an int is not a string.
+    EXPECT_EQ(read.find_int("octray.samples"), nullptr);
+    EXPECT_EQ(read.find_string("octray.samplesSoFar"), nullptr);
+    EXPECT_EQ(read.find_int("octray.missing"), nullptr);
+    // The structural attributes are the writer's, not carried.
+    EXPECT_EQ(read.find_string("compression"), nullptr);
+    // The float is there too, with OpenEXR's defaults (pixelAspectRatio, ...).
+    const auto samples =
+        std::find_if(read.floats.begin(), read.floats.end(),
+                     [](const auto& f) { return f.first == "octray.samples"; });
+    ASSERT_NE(samples, read.floats.end());
+    EXPECT_EQ(samples->second, 2.5f);
+}
+
+TEST_F(ImageReadTest, ExrAttributesOfAMissingOrNonExrFileAreAClearIoError) {
+    try {
+        read_exr_attributes(path("missing.exr"));
+        ADD_FAILURE() << "no IoError";
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find("missing.exr"), std::string::npos) << e.what();
+    }
+    write_test_png(path("p.png"), 2, 2, 3, 8, std::vector<std::uint16_t>(2 * 2 * 3, 9));
+    try {
+        read_exr_attributes(path("p.png"));
+        ADD_FAILURE() << "no IoError";
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find("p.png"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace

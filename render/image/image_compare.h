@@ -1,7 +1,7 @@
 #pragma once
 // Numeric image comparison with OpenImageIO idiff's thresholds and verdicts, as a library:
 // `octray compare` reports it, `octray verify` and the tests judge images with it.
-// render/COMPARE.md defines every figure and the NaN/Inf policy.
+// render/image/COMPARE.md defines every figure and the NaN/Inf policy.
 
 #include <cstdint>
 #include <limits>
@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 
 namespace octray {
 

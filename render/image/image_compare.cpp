@@ -1,10 +1,4 @@
-#include "render/image_compare.h"
-
-#include <ImfChannelList.h>
-#include <ImfCompression.h>
-#include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
-#include <ImfOutputFile.h>
+#include "render/image/image_compare.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 
 namespace octray {
 
@@ -324,24 +318,17 @@ ChannelImage difference_image(const ChannelImage& a, const ChannelImage& b,
 }
 
 void write_channel_exr(const std::string& path, const ChannelImage& image) {
-    const Imath::Box2i window(
-        Imath::V2i(image.origin_x, image.origin_y),
-        Imath::V2i(image.origin_x + image.width - 1, image.origin_y + image.height - 1));
-    write_file_atomically(path, [&](const std::string& tmp_path) {
-        Imf::Header header(window, window);
-        header.compression() = Imf::ZIP_COMPRESSION;
-        for (const std::string& name : image.channel_names)
-            header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-        Imf::FrameBuffer frame_buffer;
-        for (int c = 0; c < image.channel_count(); ++c)
-            frame_buffer.insert(
-                image.channel_names[static_cast<std::size_t>(c)],
-                Imf::Slice::Make(Imf::FLOAT, image.plane(c), window, sizeof(float),
-                                 sizeof(float) * static_cast<std::size_t>(image.width)));
-        Imf::OutputFile file(tmp_path.c_str(), header);
-        file.setFrameBuffer(frame_buffer);
-        file.writePixels(image.height);
-    });
+    const PixelRect window{image.origin_x, image.origin_y, image.origin_x + image.width,
+                           image.origin_y + image.height};
+    ExrImage exr;
+    exr.display_window = window;
+    exr.data_window = window;
+    exr.compression = ExrCompression::zip;
+    for (int c = 0; c < image.channel_count(); ++c)
+        exr.channels.push_back(
+            make_exr_channel(image.channel_names[static_cast<std::size_t>(c)],
+                             ExrPixelType::float32, image.plane(c), image.pixel_count()));
+    write_exr(path, exr);
 }
 
 // ---- Reports -------------------------------------------------------------------------

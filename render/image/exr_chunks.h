@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 
 namespace octray {
 

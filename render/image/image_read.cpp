@@ -1,4 +1,8 @@
-#include "render/image_read.h"
+// read_image() (OpenEXR and PNG, told apart by their magic bytes) and the one OpenEXR
+// reader, read_exr() below, that every OpenEXR file octray reads goes through: pixels,
+// header or the checks alone. PNG decoding is in png.cpp.
+
+#include "render/image/image_read.h"
 
 #include <ImfChannelList.h>
 #include <ImfCompression.h>
@@ -14,15 +18,12 @@
 #include <ImfStringAttribute.h>
 #include <ImfTileDescription.h>
 #include <ImfVersion.h>
-#include <png.h>
 
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <csetjmp>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -32,8 +33,9 @@
 #include <system_error>
 #include <utility>
 
-#include "render/exr_chunks.h"
-#include "render/image_io.h"
+#include "render/image/exr_chunks.h"
+#include "render/image/image_io.h"
+#include "render/image/png.h"
 
 namespace octray {
 
@@ -50,18 +52,18 @@ int ChannelImage::find_channel(std::string_view name) const {
     return -1;
 }
 
+void fail_reading(const std::string& path, std::string reason) {
+    // Callers print the message as one line, and OpenEXR's own messages may hold newlines.
+    std::replace(reason.begin(), reason.end(), '\n', ' ');
+    throw IoError("cannot read '" + path + "': " + reason);
+}
+
 namespace {
 
 namespace fs = std::filesystem;
 
-// A bound on what one comparison may allocate (4 GiB of floats): a corrupt header that
-// claims a gigantic image must fail as a file error, not as an out-of-memory crash.
-constexpr std::size_t max_float_values = std::size_t{1} << 30;
-
-// Callers print the message as one line, and OpenEXR's own messages may hold newlines.
 [[noreturn]] void fail(const std::string& path, std::string reason) {
-    std::replace(reason.begin(), reason.end(), '\n', ' ');
-    throw IoError("cannot read '" + path + "': " + reason);
+    fail_reading(path, std::move(reason));
 }
 
 // Called in a catch block of an OpenEXR read: the exception in flight as an IoError.
@@ -201,7 +203,7 @@ void check_pixel_data_fits(const std::string& path, const Imf::Header& header, l
 
 // The data window's width and height, after the checks both EXR readers need before they
 // allocate: a non-empty window, channels that exist and are not subsampled, a sample count
-// under max_float_values, and pixel data the file's size can hold.
+// under max_read_float_values, and pixel data the file's size can hold.
 std::pair<long long, long long> checked_data_window(const std::string& path,
                                                     const Imf::Header& header) {
     const Imath::Box2i window = header.dataWindow();
@@ -217,7 +219,7 @@ std::pair<long long, long long> checked_data_window(const std::string& path,
     }
     if (channels == 0) fail(path, "OpenEXR file has no channels");
     if (static_cast<unsigned long long>(w) * static_cast<unsigned long long>(h) * channels >
-        max_float_values)
+        max_read_float_values)
         fail(path, "image too large");
     check_pixel_data_fits(path, header, w, h);
     return {w, h};
@@ -282,7 +284,7 @@ std::string declared_channels(const Imf::Header& header) {
 }
 
 // Every chunk readPixels() will decode (level 0 of a tiled file) against the size its
-// header implies (render/exr_chunks.h): OpenEXR 3.1 reads a file whose header declares
+// header implies (render/image/exr_chunks.h): OpenEXR 3.1 reads a file whose header declares
 // FLOAT channels over ZIP-compressed HALF data as garbage, without an error.
 void check_exr_chunks(const std::string& path, Imf::InputFile& file) {
     const Imf::Header& header = file.header();
@@ -336,13 +338,45 @@ void check_exr_chunks(const std::string& path, Imf::InputFile& file) {
     }
 }
 
-ChannelImage read_exr_file(const std::string& path) {
+// ---- The one OpenEXR reader ----------------------------------------------------------
+
+// Every OpenEXR file octray reads is opened here, and any exception while it is read
+// becomes an IoError naming the file. With `check_pixel_data`, the file first gets the
+// checks made before anything is decoded: a data window it can hold (checked_data_window)
+// and chunks that hold what the header implies (check_exr_chunks). Then `use` gets the
+// open file and returns what it makes of it.
+template <class Use>
+auto read_exr(const std::string& path, bool check_pixel_data, Use&& use) {
     try {
         Imf::InputFile file(path.c_str());
+        if (check_pixel_data) {
+            checked_data_window(path, file.header());
+            check_exr_chunks(path, file);
+        }
+        return use(file);
+    } catch (...) {
+        fail_reading_exr(path);
+    }
+}
+
+// The data window's width and height (checked by checked_data_window).
+std::pair<long long, long long> window_size(const Imath::Box2i& window) {
+    return {static_cast<long long>(window.max.x) - window.min.x + 1,
+            static_cast<long long>(window.max.y) - window.min.y + 1};
+}
+
+// Decodes the whole data window into the slices of `frame_buffer`.
+void read_exr_pixels(Imf::InputFile& file, const Imf::FrameBuffer& frame_buffer) {
+    const Imath::Box2i window = file.header().dataWindow();
+    file.setFrameBuffer(frame_buffer);
+    file.readPixels(window.min.y, window.max.y);
+}
+
+ChannelImage read_exr_file(const std::string& path) {
+    return read_exr(path, true, [&](Imf::InputFile& file) {
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
-        const auto [w, h] = checked_data_window(path, header);
-        check_exr_chunks(path, file);
+        const auto [w, h] = window_size(window);
 
         std::vector<std::string> names;
         std::set<Imf::PixelType> types;
@@ -369,12 +403,9 @@ ChannelImage read_exr_file(const std::string& path) {
                 image.channel_names[static_cast<std::size_t>(c)],
                 Imf::Slice::Make(Imf::FLOAT, image.plane(c), window, sizeof(float),
                                  sizeof(float) * static_cast<std::size_t>(w)));
-        file.setFrameBuffer(frame_buffer);
-        file.readPixels(window.min.y, window.max.y);
+        read_exr_pixels(file, frame_buffer);
         return image;
-    } catch (...) {
-        fail_reading_exr(path);
-    }
+    });
 }
 
 PixelRect from_box(const Imath::Box2i& box) {
@@ -422,12 +453,10 @@ ExrAttributes read_attributes(const Imf::Header& header) {
 }
 
 ExrImage read_exr_image_file(const std::string& path) {
-    try {
-        Imf::InputFile file(path.c_str());
+    return read_exr(path, true, [&](Imf::InputFile& file) {
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
-        const auto [w, h] = checked_data_window(path, header);
-        check_exr_chunks(path, file);
+        const auto [w, h] = window_size(window);
         const Imath::Box2i display = header.displayWindow();
         if (static_cast<long long>(display.max.x) < display.min.x ||
             static_cast<long long>(display.max.y) < display.min.y)
@@ -450,158 +479,9 @@ ExrImage read_exr_image_file(const std::string& path) {
                 it.name(), Imf::Slice::Make(t, image.channels.back().samples.data(), window,
                                             element, element * static_cast<std::size_t>(w)));
         }
-        file.setFrameBuffer(frame_buffer);
-        file.readPixels(window.min.y, window.max.y);
+        read_exr_pixels(file, frame_buffer);
         return image;
-    } catch (...) {
-        fail_reading_exr(path);
-    }
-}
-
-// ---- PNG -----------------------------------------------------------------------------
-// libpng reports errors by longjmp. The functions that call setjmp create no object with
-// a destructor after it, so the jump never skips one; everything that owns memory lives
-// in read_png_file, outside them.
-
-struct PngSource {
-    const unsigned char* data = nullptr;
-    std::size_t size = 0;
-    std::size_t offset = 0;
-    bool ran_out = false;
-    char error[256] = {};
-};
-
-struct PngLayout {
-    png_uint_32 width = 0;
-    png_uint_32 height = 0;
-    int channels = 0;
-    int bit_depth = 0;  // 8 or 16 after the transforms below
-    std::size_t row_bytes = 0;
-};
-
-void on_png_error(png_structp png, png_const_charp message) {
-    auto* source = static_cast<PngSource*>(png_get_error_ptr(png));
-    std::snprintf(source->error, sizeof source->error, "%s", message);
-    png_longjmp(png, 1);
-}
-
-// libpng warns about harmless quirks (an sRGB profile it does not recognise, ...); they
-// are not the comparison's business.
-void on_png_warning(png_structp, png_const_charp) {}
-
-void on_png_read(png_structp png, png_bytep out, std::size_t length) {
-    auto* source = static_cast<PngSource*>(png_get_io_ptr(png));
-    if (length > source->size - source->offset) {
-        source->ran_out = true;
-        png_error(png, "unexpected end of file");
-    }
-    std::memcpy(out, source->data + source->offset, length);
-    source->offset += length;
-}
-
-bool read_png_header(png_structp png, png_infop info, PngLayout& layout) {
-    if (setjmp(png_jmpbuf(png))) return false;
-    png_read_info(png, info);
-    const int color_type = png_get_color_type(png, info);
-    // Palette and low-bit gray become 8-bit samples; a palette's transparency becomes an
-    // alpha channel. 16-bit samples stay 16-bit, so no precision is lost.
-    if (color_type == PNG_COLOR_TYPE_PALETTE) {
-        png_set_palette_to_rgb(png);
-        if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
-    }
-    if (color_type == PNG_COLOR_TYPE_GRAY && png_get_bit_depth(png, info) < 8)
-        png_set_expand_gray_1_2_4_to_8(png);
-    png_set_interlace_handling(png);
-    png_read_update_info(png, info);
-    layout.width = png_get_image_width(png, info);
-    layout.height = png_get_image_height(png, info);
-    layout.channels = png_get_channels(png, info);
-    layout.bit_depth = png_get_bit_depth(png, info);
-    layout.row_bytes = png_get_rowbytes(png, info);
-    return true;
-}
-
-bool read_png_rows(png_structp png, png_infop info, png_bytepp rows) {
-    if (setjmp(png_jmpbuf(png))) return false;
-    png_read_image(png, rows);
-    // Reading up to IEND is what tells a file cut off after its pixel data.
-    png_read_end(png, info);
-    return true;
-}
-
-// Owns libpng's two structures for the length of one read.
-class PngReadHandle {
-  public:
-    explicit PngReadHandle(PngSource& source) {
-        png_ = png_create_read_struct(PNG_LIBPNG_VER_STRING, &source, on_png_error,
-                                      on_png_warning);
-        if (png_) info_ = png_create_info_struct(png_);
-    }
-    ~PngReadHandle() { png_destroy_read_struct(&png_, info_ ? &info_ : nullptr, nullptr); }
-    PngReadHandle(const PngReadHandle&) = delete;
-    PngReadHandle& operator=(const PngReadHandle&) = delete;
-
-    png_structp png() const { return png_; }
-    png_infop info() const { return info_; }
-
-  private:
-    png_structp png_ = nullptr;
-    png_infop info_ = nullptr;
-};
-
-ChannelImage read_png_file(const std::string& path, const std::vector<unsigned char>& bytes) {
-    PngSource source;
-    source.data = bytes.data();
-    source.size = bytes.size();
-    PngReadHandle handle(source);
-    if (!handle.png() || !handle.info()) fail(path, "out of memory starting libpng");
-    png_set_read_fn(handle.png(), &source, on_png_read);
-
-    const auto png_failure = [&]() -> std::string {
-        if (source.ran_out) return "truncated PNG file (unexpected end of file)";
-        return std::string("corrupt PNG file (") + source.error + ")";
-    };
-
-    PngLayout layout;
-    if (!read_png_header(handle.png(), handle.info(), layout)) fail(path, png_failure());
-    if (layout.channels < 1 || layout.channels > 4 ||
-        (layout.bit_depth != 8 && layout.bit_depth != 16))
-        fail(path, "unsupported PNG sample layout");
-    const std::size_t pixels = static_cast<std::size_t>(layout.width) * layout.height;
-    if (pixels == 0) fail(path, "PNG file has no pixels");
-    if (pixels * static_cast<std::size_t>(layout.channels) > max_float_values)
-        fail(path, "image too large to compare");
-
-    std::vector<png_byte> raw(layout.row_bytes * layout.height);
-    std::vector<png_bytep> rows(layout.height);
-    for (png_uint_32 y = 0; y < layout.height; ++y) rows[y] = raw.data() + y * layout.row_bytes;
-    if (!read_png_rows(handle.png(), handle.info(), rows.data())) fail(path, png_failure());
-
-    static const std::vector<std::string> names_by_count[4] = {
-        {"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
-    ChannelImage image(static_cast<int>(layout.width), static_cast<int>(layout.height),
-                       names_by_count[layout.channels - 1]);
-    image.format = layout.bit_depth == 16 ? "PNG 16-bit" : "PNG 8-bit";
-
-    // Raw samples scaled to [0, 1]; 16-bit samples are big-endian in the file.
-    const int channels = layout.channels;
-    for (int y = 0; y < image.height; ++y) {
-        const png_byte* row = rows[static_cast<std::size_t>(y)];
-        for (int x = 0; x < image.width; ++x) {
-            for (int c = 0; c < channels; ++c) {
-                const std::size_t sample = static_cast<std::size_t>(x) * channels + c;
-                float value;
-                if (layout.bit_depth == 16) {
-                    const unsigned v = (unsigned{row[2 * sample]} << 8) | row[2 * sample + 1];
-                    value = static_cast<float>(v) / 65535.0f;
-                } else {
-                    value = static_cast<float>(row[sample]) / 255.0f;
-                }
-                image.at(c, x, y) = value;
-            }
-        }
-    }
-    return image;
+    });
 }
 
 }  // namespace
@@ -611,7 +491,7 @@ ChannelImage read_image(const std::string& path) {
     if (signature.empty()) fail(path, "empty file, not an image");
     switch (kind_of(signature)) {
         case FileKind::png:
-            return read_png_file(path, read_whole_file(path));
+            return read_png_channels(path, read_whole_file(path));
         case FileKind::exr:
             return read_exr_file(path);
         case FileKind::unknown:
@@ -621,8 +501,7 @@ ChannelImage read_image(const std::string& path) {
 }
 
 ExrLayout read_exr_layout(const std::string& path) {
-    try {
-        Imf::InputFile file(path.c_str());
+    return read_exr(path, false, [](Imf::InputFile& file) {
         const Imf::Header& header = file.header();
         ExrLayout layout;
         layout.data_window = from_box(header.dataWindow());
@@ -631,19 +510,16 @@ ExrLayout read_exr_layout(const std::string& path) {
         for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
             layout.channels.push_back({it.name(), from_imf(it.channel().type)});
         return layout;
-    } catch (...) {
-        fail_reading_exr(path);
-    }
+    });
+}
+
+ExrAttributes read_exr_attributes(const std::string& path) {
+    return read_exr(path, false,
+                    [](Imf::InputFile& file) { return read_attributes(file.header()); });
 }
 
 void check_exr_pixel_data(const std::string& path) {
-    try {
-        Imf::InputFile file(path.c_str());
-        checked_data_window(path, file.header());
-        check_exr_chunks(path, file);
-    } catch (...) {
-        fail_reading_exr(path);
-    }
+    read_exr(path, true, [](Imf::InputFile&) {});
 }
 
 ExrImage read_exr_image(const std::string& path) {

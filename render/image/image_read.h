@@ -8,8 +8,8 @@
 #include <string_view>
 #include <vector>
 
-#include "render/exr_chunks.h"
-#include "render/image_io.h"
+#include "render/image/exr_chunks.h"
+#include "render/image/image_io.h"
 
 namespace octray {
 
@@ -78,8 +78,14 @@ struct ExrLayout {
 };
 ExrLayout read_exr_layout(const std::string& path);
 
+// The header attributes of an OpenEXR file (its first part) other than the structural
+// ones, as read_exr_image() gives them, read without the pixels (`octray render` reads
+// whether an existing image is an unfinished progressive one, and whose). Throws IoError
+// naming the path and the reason.
+ExrAttributes read_exr_attributes(const std::string& path);
+
 // The check read_image() and read_exr_image() make before decoding: every chunk they
-// decode (level 0 of a tiled file) holds what its header implies (render/exr_chunks.h).
+// decode (level 0 of a tiled file) holds what its header implies (render/image/exr_chunks.h).
 // Throws IoError naming the path and the first chunk that does not.
 void check_exr_pixel_data(const std::string& path);
 

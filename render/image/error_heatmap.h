@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "render/image_compare.h"
-#include "render/image_read.h"
+#include "render/image/image_compare.h"
+#include "render/image/image_read.h"
 
 namespace octray {
 

@@ -1,6 +1,8 @@
 #pragma once
-// Writing images: OpenEXR (the product) and 8-bit PNG previews. Every writer goes through
-// write_file_atomically(), so an interrupted run never leaves a partial image behind.
+// Writing images: OpenEXR (the product) and 8-bit PNG previews, and the types an OpenEXR
+// image is made of. Every writer goes through write_file_atomically(), so an interrupted
+// run never leaves a partial image behind. Every OpenEXR file octray writes goes through
+// write_exr(path, ExrImage) (exr_write.cpp); every PNG through png.cpp.
 
 #include <array>
 #include <cstddef>
@@ -14,7 +16,7 @@
 #include <vector>
 
 #include "core/image.h"
-#include "render/types.h"
+#include "core/pixel_rect.h"
 
 namespace octray {
 
@@ -84,6 +86,10 @@ struct ExrAttributes {
     std::vector<std::pair<std::string, Matrix44>> matrices;      // M44f: worldToCamera, ...
     std::vector<std::pair<std::string, ExrRational>> rationals;  // framesPerSecond
     std::vector<ExrOpaqueAttribute> opaque;
+
+    // The value of the int / string attribute called `name`, or nullptr.
+    const int* find_int(std::string_view name) const;
+    const std::string* find_string(std::string_view name) const;
 };
 
 // ---- Images of any channel set, with windows -----------------------------------------
@@ -134,9 +140,7 @@ struct ExrImage {
 ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
                         int full_height, const ExrWriteOptions& options,
                         const ExrAttributes& attributes = {});
-// The same for a render: data window result.rect, display window the full image.
-ExrImage make_exr_image(const RenderResult& result, const ExrWriteOptions& options,
-                        const ExrAttributes& attributes = {});
+// (A render's make_exr_image(RenderResult, ...) is in render/result_exr.h.)
 
 // Writes `image` as a scanline OpenEXR file, atomically. Throws IoError naming the path
 // and the reason (an empty window, a channel whose sample count is not the data window's,
@@ -153,8 +157,13 @@ void write_png_preview(const std::string& path, const Image& image);
 
 // An 8-bit RGB PNG of ready-made sRGB bytes (row 0 on top, rgb.size() == 3 * width *
 // height), for pictures that are not renders: the compare heatmap. Throws IoError.
-// (Implemented in png_write.cpp.)
 void write_png_rgb8(const std::string& path, int width, int height,
                     const std::vector<std::uint8_t>& rgb);
+
+// The threads OpenEXR compresses and decompresses the blocks of a file on (its global
+// pool, Imf::setGlobalThreadCount): 0 means none, the calling thread does the work. The
+// file's bytes are the same for any count.
+void set_exr_thread_count(int threads);
+int exr_thread_count();
 
 }  // namespace octray

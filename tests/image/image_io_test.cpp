@@ -1,4 +1,4 @@
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
@@ -8,6 +8,7 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 #include <gtest/gtest.h>
 #include <half.h>
 #include <png.h>
@@ -21,6 +22,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -473,6 +475,29 @@ TEST_F(ImageIoTest, PngOfLargerImageIsReadable) {
     EXPECT_LT(px(0, 0, 0), px(319, 0, 0));
     EXPECT_LT(px(0, 0, 1), px(0, 199, 1));
     EXPECT_EQ(px(100, 100, 2), 255);
+}
+
+// OpenEXR's pool of compression threads, as `octray render` sets it; the bytes of a file
+// do not depend on it.
+TEST_F(ImageIoTest, ExrThreadCountIsSetAndDoesNotChangeTheBytes) {
+    const int before = exr_thread_count();
+    const Image image = gradient_image(64, 48);
+    set_exr_thread_count(0);
+    EXPECT_EQ(exr_thread_count(), 0);
+    write_exr((dir_ / "serial.exr").string(), image, ExrWriteOptions{});
+    set_exr_thread_count(3);
+    EXPECT_EQ(exr_thread_count(), 3);
+    EXPECT_EQ(Imf::globalThreadCount(), 3);
+    write_exr((dir_ / "threaded.exr").string(), image, ExrWriteOptions{});
+    set_exr_thread_count(before);
+    EXPECT_EQ(exr_thread_count(), before);
+
+    const auto bytes = [](const fs::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in),
+                           std::istreambuf_iterator<char>());
+    };
+    EXPECT_EQ(bytes(dir_ / "serial.exr"), bytes(dir_ / "threaded.exr"));
 }
 
 }  // namespace

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "render/image_read.h"
+#include "render/image/image_read.h"
 
 namespace octray::testing {
 

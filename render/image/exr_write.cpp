@@ -1,4 +1,5 @@
-#include "render/image_io.h"
+// The one OpenEXR writer, write_exr(path, ExrImage), and the types of an OpenEXR image
+// (render/image/image_io.h). Every EXR octray writes goes through write_exr_file() below.
 
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
@@ -13,99 +14,30 @@
 #include <ImfRationalAttribute.h>
 #include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 #include <ImfVersion.h>
-#include <fcntl.h>
 #include <half.h>
-#include <png.h>
-#include <sys/file.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
-#include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <memory>
-#include <random>
 #include <set>
 #include <stdexcept>
-#include <system_error>
+
+#include "render/image/image_io.h"
 
 namespace octray {
 namespace {
-
-namespace fs = std::filesystem;
 
 // Rgb is handed to OpenEXR as three interleaved float channels, so it must be exactly
 // three packed floats.
 static_assert(sizeof(Rgb) == 3 * sizeof(float));
 
-std::string errno_message(int error) { return std::generic_category().message(error); }
-
 std::string window_text(const PixelRect& r) {
     return "(" + std::to_string(r.x0) + ", " + std::to_string(r.y0) + ")-(" +
            std::to_string(r.x1) + ", " + std::to_string(r.y1) + ")";
-}
-
-// "<dir>/.<name>.<kind>.<pid>.<random>": hidden, in the target's directory so that the
-// final rename stays on one file system (and so stays atomic), and unique per process and
-// call. The kind is "new" while the file is being created and locked, "tmp" after.
-std::string temporary_path_for(const fs::path& target, const char* kind, std::uint64_t salt) {
-    fs::path dir = target.parent_path();
-    if (dir.empty()) dir = ".";
-    char suffix[80];
-    std::snprintf(suffix, sizeof suffix, ".%s.%ld.%016llx", kind, static_cast<long>(::getpid()),
-                  static_cast<unsigned long long>(salt));
-    return (dir / ("." + target.filename().string() + suffix)).string();
-}
-
-// A temporary file, held by its writer: the open descriptor carries an exclusive flock(2)
-// from before the file has its ".tmp." name until after it was renamed over the target.
-// The lock ends with the descriptor, so also when the writer is killed: a ".tmp." file
-// nobody holds the lock of is stale (remove_stale_temporaries).
-struct HeldTemporary {
-    std::string path;
-    int fd = -1;
-    HeldTemporary() = default;
-    HeldTemporary(const HeldTemporary&) = delete;
-    HeldTemporary& operator=(const HeldTemporary&) = delete;
-    ~HeldTemporary() {
-        if (fd >= 0) ::close(fd);
-    }
-};
-
-// Creates the temporary file exclusively (O_EXCL: never clobber another writer's file),
-// locks it, then gives it its ".tmp." name. The writer callback then truncates and fills
-// it. Mode 0666 lets the umask decide the final permissions, as for any file the user
-// creates.
-void create_temporary_file(const fs::path& target, HeldTemporary& held) {
-    std::random_device entropy;
-    std::mt19937_64 generator((static_cast<std::uint64_t>(entropy()) << 32) ^ entropy());
-    for (int attempt = 0; attempt < 16; ++attempt) {
-        const std::uint64_t salt = generator();
-        const std::string fresh = temporary_path_for(target, "new", salt);
-        const int fd = ::open(fresh.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0) {
-            if (errno != EEXIST) throw std::runtime_error(errno_message(errno));
-            continue;
-        }
-        held.fd = fd;
-        // Where locks do not work (some network file systems), the file is only not
-        // provably stale: other runs leave it alone.
-        (void)::flock(fd, LOCK_EX | LOCK_NB);
-        const std::string tmp = temporary_path_for(target, "tmp", salt);
-        if (std::rename(fresh.c_str(), tmp.c_str()) != 0) {
-            const int error = errno;
-            std::remove(fresh.c_str());
-            throw std::runtime_error(errno_message(error));
-        }
-        held.path = tmp;
-        return;
-    }
-    throw std::runtime_error("could not create a unique temporary file next to it");
 }
 
 Imf::Compression to_imf(ExrCompression compression) {
@@ -260,116 +192,6 @@ void write_exr_file(const std::string& path, const ExrImage& image) {
     file.writePixels(image.data_window.height());
 }
 
-// sRGB OETF (IEC 61966-2-1) of a linear value already clamped to [0, 1].
-float srgb_encode(float linear) {
-    return linear <= 0.0031308f ? 12.92f * linear
-                                : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
-}
-
-std::uint8_t to_srgb8(float linear) {
-    // NaN fails both comparisons and lands on 0, like negative values; +inf clamps to 1.
-    const float clamped = linear > 0.0f ? (linear < 1.0f ? linear : 1.0f) : 0.0f;
-    return static_cast<std::uint8_t>(std::lround(srgb_encode(clamped) * 255.0f));
-}
-
-// libpng reports errors by calling this and then longjmp-ing back to setjmp; we keep the
-// message so it can become an exception once we are back in ordinary C++ control flow.
-// libpng's own writer says only "Write Error"; ours keeps the OS reason (errno) of a
-// failed write so that the message can say it ("No space left on device").
-struct PngErrorState {
-    char message[256] = "";
-    std::FILE* file = nullptr;
-    int write_errno = 0;
-};
-
-void png_error_handler(png_structp png, png_const_charp message) {
-    auto* state = static_cast<PngErrorState*>(png_get_error_ptr(png));
-    if (state->write_errno != 0)
-        std::snprintf(state->message, sizeof state->message, "libpng: %s: %s", message,
-                      std::strerror(state->write_errno));
-    else
-        std::snprintf(state->message, sizeof state->message, "libpng: %s", message);
-    png_longjmp(png, 1);
-}
-
-void png_warning_handler(png_structp, png_const_charp) {}
-
-void png_write_data(png_structp png, png_bytep data, png_size_t length) {
-    auto* state = static_cast<PngErrorState*>(png_get_io_ptr(png));
-    errno = 0;
-    if (std::fwrite(data, 1, length, state->file) != length) {
-        state->write_errno = errno != 0 ? errno : EIO;
-        png_error(png, "Write Error");
-    }
-}
-
-void png_flush_data(png_structp png) {
-    auto* state = static_cast<PngErrorState*>(png_get_io_ptr(png));
-    errno = 0;
-    if (std::fflush(state->file) != 0) {
-        state->write_errno = errno != 0 ? errno : EIO;
-        png_error(png, "Write Error");
-    }
-}
-
-// The libpng calls, in a function with only trivially destructible locals: longjmp must
-// never skip a C++ destructor. Returns an empty string on success, else the reason.
-std::string write_png_rows(std::FILE* file, int width, int height, png_bytepp rows) {
-    PngErrorState error;
-    error.file = file;
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_error_handler,
-                                              png_warning_handler);
-    if (png == nullptr) return "libpng: cannot create the write structure";
-    png_infop info = png_create_info_struct(png);
-    if (info == nullptr) {
-        png_destroy_write_struct(&png, nullptr);
-        return "libpng: cannot create the info structure";
-    }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        return error.message;
-    }
-    png_set_write_fn(png, &error, png_write_data, png_flush_data);
-    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height),
-                 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-                 PNG_FILTER_TYPE_DEFAULT);
-    // The pixels are sRGB-encoded; the sRGB chunk tells viewers so.
-    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    png_write_info(png, info);
-    png_write_image(png, rows);
-    png_write_end(png, info);
-    png_destroy_write_struct(&png, &info);
-    return {};
-}
-
-void write_png_file(const std::string& path, const Image& image) {
-    const int width = image.width();
-    const int height = image.height();
-    const std::size_t row_bytes = static_cast<std::size_t>(width) * 3;
-    std::vector<png_byte> pixels(row_bytes * static_cast<std::size_t>(height));
-    std::vector<png_bytep> rows(static_cast<std::size_t>(height));
-    for (int y = 0; y < height; ++y) {
-        png_bytep row = pixels.data() + static_cast<std::size_t>(y) * row_bytes;
-        rows[static_cast<std::size_t>(y)] = row;
-        for (int x = 0; x < width; ++x) {
-            const Rgb c = image.at(x, y);
-            row[3 * x + 0] = to_srgb8(c.r);
-            row[3 * x + 1] = to_srgb8(c.g);
-            row[3 * x + 2] = to_srgb8(c.b);
-        }
-    }
-
-    std::FILE* file = std::fopen(path.c_str(), "wb");
-    if (file == nullptr) throw std::runtime_error(errno_message(errno));
-    std::string failure = write_png_rows(file, width, height, rows.data());
-    // A full disk may only show when buffered data is flushed, so check the close too.
-    const bool stream_failed = std::ferror(file) != 0;
-    const int close_errno = std::fclose(file) != 0 ? errno : 0;
-    if (failure.empty() && close_errno != 0) failure = errno_message(close_errno);
-    if (failure.empty() && stream_failed) failure = "write error";
-    if (!failure.empty()) throw std::runtime_error(failure);
-}
-
 void require_image(const Image& image) {
     if (image.width() <= 0 || image.height() <= 0)
         throw std::invalid_argument("the image is empty (" + std::to_string(image.width()) +
@@ -377,48 +199,6 @@ void require_image(const Image& image) {
 }
 
 }  // namespace
-
-void write_file_atomically(const std::string& path,
-                           const std::function<void(const std::string& tmp_path)>& write) {
-    HeldTemporary tmp;
-    try {
-        create_temporary_file(fs::path(path), tmp);
-        write(tmp.path);
-        if (std::rename(tmp.path.c_str(), path.c_str()) != 0)
-            throw std::runtime_error(errno_message(errno));
-    } catch (const std::exception& e) {
-        if (!tmp.path.empty()) std::remove(tmp.path.c_str());
-        throw IoError("cannot write " + path + ": " + e.what());
-    } catch (...) {
-        if (!tmp.path.empty()) std::remove(tmp.path.c_str());
-        throw IoError("cannot write " + path + ": unknown error");
-    }
-}
-
-std::vector<std::string> remove_stale_temporaries(const std::string& target) {
-    const fs::path path(target);
-    fs::path dir = path.parent_path();
-    if (dir.empty()) dir = ".";
-    const std::string prefix = "." + path.filename().string() + ".tmp.";
-    std::vector<std::string> removed;
-    std::error_code error;
-    for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
-        const std::string name = it->path().filename().string();
-        if (name.compare(0, prefix.size(), prefix) != 0) continue;
-        const std::string file = it->path().string();
-        // O_NONBLOCK: a FIFO planted under such a name must not block the open.
-        int fd = ::open(file.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-        if (fd < 0) fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-        if (fd < 0) continue;
-        // The lock is free only when no writer holds it: its writer is gone. (Names are
-        // never reused, so if the writer renamed it away meanwhile, the unlink finds
-        // nothing.)
-        if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::unlink(file.c_str()) == 0)
-            removed.push_back(file);
-        ::close(fd);
-    }
-    return removed;
-}
 
 std::optional<ExrCompression> parse_exr_compression(std::string_view name) {
     for (const auto& [text, value] : kCompressionNames)
@@ -534,6 +314,18 @@ const ExrChannel* ExrImage::find_channel(std::string_view name) const {
     return nullptr;
 }
 
+const int* ExrAttributes::find_int(std::string_view name) const {
+    for (const auto& [key, value] : ints)
+        if (key == name) return &value;
+    return nullptr;
+}
+
+const std::string* ExrAttributes::find_string(std::string_view name) const {
+    for (const auto& [key, value] : strings)
+        if (key == name) return &value;
+    return nullptr;
+}
+
 ExrRational exr_rational(double value) {
     const Imf::Rational r(value);
     return {r.n, r.d};
@@ -561,12 +353,6 @@ ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_widt
     return exr;
 }
 
-ExrImage make_exr_image(const RenderResult& result, const ExrWriteOptions& options,
-                        const ExrAttributes& attributes) {
-    return make_exr_image(result.image, result.rect, result.full_width, result.full_height,
-                          options, attributes);
-}
-
 void write_exr(const std::string& path, const ExrImage& image) {
     try {
         check_exr_image(image);
@@ -587,13 +373,8 @@ void write_exr(const std::string& path, const Image& image, const ExrWriteOption
                                    image.width(), image.height(), options, attributes));
 }
 
-void write_png_preview(const std::string& path, const Image& image) {
-    try {
-        require_image(image);
-    } catch (const std::exception& e) {
-        throw IoError("cannot write " + path + ": " + e.what());
-    }
-    write_file_atomically(path, [&](const std::string& tmp) { write_png_file(tmp, image); });
-}
+void set_exr_thread_count(int threads) { Imf::setGlobalThreadCount(threads); }
+
+int exr_thread_count() { return Imf::globalThreadCount(); }
 
 }  // namespace octray

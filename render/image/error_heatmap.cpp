@@ -1,11 +1,11 @@
-#include "render/error_heatmap.h"
+#include "render/image/error_heatmap.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string_view>
 
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 
 namespace octray {
 namespace {

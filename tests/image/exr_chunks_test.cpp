@@ -1,16 +1,16 @@
 // Files that lie: an EXR whose header declares other pixel types than its data hold, or
 // whose chunk is cut, is a file error for every codec, scan lines and tiles; honest files
-// of every codec and pixel type still read (render/exr_chunks.h).
-#include "render/exr_chunks.h"
+// of every codec and pixel type still read (render/image/exr_chunks.h).
+#include "render/image/exr_chunks.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "render/image_read.h"
-#include "tests/render/compare_fixtures.h"
-#include "tests/render/lying_exr.h"
+#include "render/image/image_read.h"
+#include "tests/image/compare_fixtures.h"
+#include "tests/image/lying_exr.h"
 
 namespace octray {
 namespace {

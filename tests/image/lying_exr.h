@@ -1,6 +1,6 @@
 #pragma once
 // OpenEXR files whose header lies about their pixel data, for the tests of the checked
-// read (render/exr_chunks.h) and the fuzzer's seeds (tests/fuzz/make_image_seeds.cpp):
+// read (render/image/exr_chunks.h) and the fuzzer's seeds (tests/fuzz/make_image_seeds.cpp):
 // written with OpenEXR in one pixel type, then the header's channel list patched to
 // declare another, or one chunk's size field cut. Depends on OpenEXR and the standard
 // library only, so that the seed generator can include it.

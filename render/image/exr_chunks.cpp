@@ -1,4 +1,4 @@
-#include "render/exr_chunks.h"
+#include "render/image/exr_chunks.h"
 
 #include <zlib.h>
 

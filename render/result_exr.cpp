@@ -1,0 +1,11 @@
+#include "render/result_exr.h"
+
+namespace octray {
+
+ExrImage make_exr_image(const RenderResult& result, const ExrWriteOptions& options,
+                        const ExrAttributes& attributes) {
+    return make_exr_image(result.image, result.rect, result.full_width, result.full_height,
+                          options, attributes);
+}
+
+}  // namespace octray
