@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "render/aov.h"
-#include "render/assemble.h"
-#include "render/camera_matrices.h"
+#include "render/batch/assemble.h"
+#include "render/batch/camera_matrices.h"
 #include "render/image_read.h"
 #include "render/packet_renderer.h"
 #include "run_octray.h"
@@ -45,7 +45,7 @@ class AssembleCliTest : public ::testing::Test {
         RenderOptions options;
         options.crop = crop;
         ExrAttributes attributes;
-        add_camera_attributes(attributes, scene_);
+        batch::add_camera_attributes(attributes, scene_);
         attributes.ints.emplace_back("octray:frame", 3);
         ExrImage exr =
             make_exr_image(render_packet(scene_, options),

@@ -33,9 +33,9 @@
 #include <vector>
 
 #include "core/sha256.h"
+#include "render/batch/claim_owner.h"
 #include "render/image_read.h"
 #include "run_octray.h"
-#include "tools/claim_owner.h"
 
 namespace octray {
 namespace {
@@ -444,7 +444,7 @@ TEST_F(BatchCliTest, AnUnfinishedPassIsAClaimWhileItsOwnerLives) {
     if (child == 0) ::_exit(0);
     ASSERT_GT(child, 0);
     ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // reaped: its PID names no process
-    const std::string live = tools::current_owner();
+    const std::string live = batch::current_owner();
     write_unfinished_pass(dir_ / "out/u.0.exr", live);
     write_unfinished_pass(dir_ / "out/u.1.exr",
                           std::string(host) + ":" + std::to_string(child) + ":12345");
