@@ -1,5 +1,5 @@
 // `octray assemble`: stitch the cropped parts of one render (render --crop) into the full
-// image, bit for bit (render/README.md, "Assembling crops").
+// image, bit for bit (render/batch/README.md, "Assembling crops").
 
 #include <CLI/CLI.hpp>
 #include <iostream>
