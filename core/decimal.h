@@ -2,7 +2,7 @@
 // The one reading of an integer that octray's users write on the command line: decimal
 // digits only, as scene files have them. The command line's integer options (through
 // tools/cli_checks.h) and the numbers inside its specs (frame lists, shards, crops:
-// tools/batch.h) all read their digits here.
+// render/batch/spec.h) all read their digits here.
 
 #include <charconv>
 #include <cstdint>

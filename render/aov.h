@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/vec3.h"
-#include "render/result_exr.h"
+#include "render/image/image_io.h"
 #include "render/types.h"
 #include "scene/scene.h"
 

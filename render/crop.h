@@ -1,7 +1,7 @@
 #pragma once
 // The checks both renderers make of RenderOptions::crop and RenderOptions::samples
-// (render/README.md, "Crops" and "Progressive passes"), in one place so that the two paths
-// accept and refuse the same options with the same messages.
+// (render/README.md, "Crops"; render/batch/README.md, "Progressive passes"), in one place so
+// that the two paths accept and refuse the same options with the same messages.
 
 #include <stdexcept>
 #include <string>

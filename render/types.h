@@ -55,7 +55,7 @@ struct RenderOptions {
     std::uint32_t frame = 0;  // the frame counter of the random hash
     int tile_width = 16;
     int tile_height = 16;
-    // Batch rendering (tools/cmd_render.cpp), both optional: the renderers poll *cancel
+    // Batch rendering (render/batch/frame_loop.h), both optional: the renderers poll *cancel
     // between tiles and, once it is true, stop and throw RenderCancelled; they add each
     // finished tile's pixel count to *pixels_done (progress).
     const std::atomic<bool>* cancel = nullptr;
@@ -64,7 +64,7 @@ struct RenderOptions {
     // image is crop-sized and each pixel equals the same pixel of the full render bit for
     // bit. Must be non-empty and inside the image (else std::invalid_argument).
     std::optional<PixelRect> crop;
-    // Progressive passes (render/progressive.h): trace only samples [begin, end) of each
+    // Progressive passes (render/batch/progressive.h): trace only samples [begin, end) of each
     // pixel, adding them in sample order onto *sample_sums (the running sums of samples
     // [0, begin), crop-sized; nullptr when begin == 0). The result then also carries the
     // new sums; its image is sums / end. Unset: every sample, as a plain render.

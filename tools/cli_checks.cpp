@@ -236,22 +236,6 @@ ImageFormat require_image_format(std::string_view option, const std::string& pat
     throw UsageError(message);
 }
 
-std::string directory_identity(const std::string& dir) {
-    const std::string path = dir.empty() ? "." : dir;
-    struct stat info {};
-    if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
-        return "device " + std::to_string(info.st_dev) + ", inode " +
-               std::to_string(info.st_ino) + ": ";
-    std::error_code error;
-    const fs::path absolute = fs::absolute(path, error);
-    return "path " + (error ? fs::path(path) : absolute).lexically_normal().string() + "/";
-}
-
-std::string output_identity(const std::string& path) {
-    const fs::path file(path);
-    return directory_identity(file.parent_path().string()) + file.filename().string();
-}
-
 std::string mistyped_argument_hint(const CLI::App& app) {
     // The command the arguments were given to: the deepest one that parsed.
     const CLI::App* command = &app;

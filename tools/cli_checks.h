@@ -27,7 +27,7 @@ namespace octray::tools {
 
 // Decimal digits only (as scene files have them): no sign, blank, "0x" prefix, fraction or
 // exponent; nullopt for anything else or above 2^64 - 1 (nothing is clamped). The same
-// reading as core/decimal.h's parse_decimal_digits, which the specs of tools/batch.h use.
+// reading as core/decimal.h's parse_decimal_digits, which the specs of render/batch/spec.h use.
 std::optional<std::uint64_t> parse_decimal_integer(std::string_view text);
 
 // Limits of integer options that more than one command shares; each option's help text
@@ -86,17 +86,6 @@ std::optional<ImageFormat> image_format_of(std::string_view path);
 // the formats and `advice`.
 ImageFormat require_image_format(std::string_view option, const std::string& path,
                                  bool png_accepted, std::string_view advice);
-
-// What a write to `path` replaces (octray writes a temporary and renames it over the
-// target): the directory entry, as the device and inode of the parent directory plus the
-// file name. Two paths with one identity are one file however they are spelled (".",
-// "..", symlinks). When the parent does not exist yet, its lexically normal absolute path
-// stands in for it.
-std::string output_identity(const std::string& path);
-
-// The directory part of output_identity: for `dir` ("" is the current directory), a key
-// such that output_identity(dir / name) == directory_identity(dir) + name.
-std::string directory_identity(const std::string& dir);
 
 // ---- Scene warnings ----------------------------------------------------------------------
 

@@ -1,5 +1,5 @@
 // `octray assemble`: stitch the cropped parts of one render (render --crop) into the full
-// image, bit for bit (render/README.md, "Assembling crops").
+// image, bit for bit (render/batch/README.md, "Assembling crops").
 
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/image.h"
-#include "render/assemble.h"
+#include "render/batch/assemble.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "tools/cli_checks.h"
@@ -23,12 +23,12 @@ struct AssembleArguments {
 };
 
 // The assembled R, G, B as the 8-bit sRGB preview `render --png` writes.
-AssembleSummary assemble_png(const std::vector<std::string>& part_paths,
-                             const std::string& output) {
+batch::AssembleSummary assemble_png(const std::vector<std::string>& part_paths,
+                                    const std::string& output) {
     std::vector<ExrImage> parts;
     parts.reserve(part_paths.size());
     for (const std::string& path : part_paths) parts.push_back(read_exr_image(path));
-    const ExrImage full = assemble_parts(parts, part_paths);
+    const ExrImage full = batch::assemble_parts(parts, part_paths);
     const ExrChannel* rgb[3] = {full.find_channel("R"), full.find_channel("G"),
                                 full.find_channel("B")};
     if (!rgb[0] || !rgb[1] || !rgb[2])
@@ -46,7 +46,7 @@ AssembleSummary assemble_png(const std::vector<std::string>& part_paths,
         }
     }
     write_png_preview(output, image);
-    AssembleSummary summary;
+    batch::AssembleSummary summary;
     summary.display_window = full.display_window;
     summary.parts = parts.size();
     for (const char* name : {"R", "G", "B"})
@@ -58,11 +58,11 @@ void run_assemble(const AssembleArguments& args) {
     const ImageFormat format =
         require_image_format("-o", args.output, /*png_accepted=*/true,
                              "a .png is the 8-bit sRGB preview of the assembled R, G, B");
-    AssembleSummary summary;
+    batch::AssembleSummary summary;
     try {
         summary = format == ImageFormat::png ? assemble_png(args.parts, args.output)
-                                             : assemble_files(args.parts, args.output);
-    } catch (const AssembleError& e) {
+                                             : batch::assemble_files(args.parts, args.output);
+    } catch (const batch::AssembleError& e) {
         // The parts named on the command line do not make one image: a usage error.
         throw UsageError(std::string("assemble: ") + e.what());
     }

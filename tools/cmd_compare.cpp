@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "render/batch/output_paths.h"
 #include "render/image/error_heatmap.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
@@ -67,7 +68,7 @@ void run_compare(const CompareArguments& args) {
                              "--diff is |A - B| in float; for a PNG picture of the error "
                              "use --heatmap FILE.png");
     if (!args.diff.empty() && !args.heatmap.empty() &&
-        output_identity(args.diff) == output_identity(args.heatmap))
+        batch::output_identity(args.diff) == batch::output_identity(args.heatmap))
         throw UsageError("--diff and --heatmap name the same file: " + args.diff + " and " +
                          args.heatmap);
 

@@ -1,52 +1,42 @@
 // `octray render`: load scenes, apply command-line overrides, then render a list of frames
 // (one still by default; animations, frame ranges, several scenes, shards of a farm job)
-// to EXR (+ PNG previews). The frame loop itself lives in render_batch.cpp.
+// to EXR (+ PNG previews). Planning and the frame loop are the library octray::batch
+// (render/batch/); this file reads the options, checks them and reports.
 
-#include <oneapi/tbb/global_control.h>
-#include <oneapi/tbb/parallel_invoke.h>
-#include <openssl/evp.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <cerrno>
-#include <charconv>
-#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
 #include <optional>
-#include <set>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
-#include <tuple>
 #include <utility>
 #include <vector>
 
-#include "core/sha256.h"
 #include "kernels/dispatch.h"
+#include "render/aov.h"
+#include "render/batch/frame_loop.h"
+#include "render/batch/output_paths.h"
+#include "render/batch/plan.h"
+#include "render/batch/spec.h"
 #include "render/image/image_io.h"
-#include "scene/animation.h"
 #include "scene/builtin.h"
 #include "scene/limits.h"
-#include "scene/load.h"
 #include "scene/max_depth.h"
 #include "scene/scene.h"
 #include "scene/scene_error.h"
-#include "tools/batch.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
+#include "tools/interrupt.h"
 #include "tools/progress.h"
-#include "tools/render_batch.h"
 
 namespace octray::tools {
 namespace {
@@ -92,64 +82,6 @@ struct RenderArguments {
 
 // ---- Pre-flight: everything that can be checked before the first frame ----------------
 
-// The scene's identity for the EXR: SHA-256 of the file's bytes (what `sha256sum` prints),
-// or for a built-in, of its spec string as given (`printf %s SPEC | sha256sum`): the
-// generators are deterministic, so the spec names the scene, and hashing it costs nothing
-// where serializing random:1048576 to JSON and hashing that took seconds. A file's bytes
-// are read once and hashed beside their parse (load_scene_and_digest), by OpenSSL's
-// libcrypto, which uses the CPU's SHA instructions: 0.13 s for a 114 MB scene against
-// 0.88 s for the portable core/sha256.h.
-class FileDigest {
-  public:
-    FileDigest() : ctx_(EVP_MD_CTX_new(), &EVP_MD_CTX_free) {
-        if (!ctx_ || EVP_DigestInit_ex(ctx_.get(), EVP_sha256(), nullptr) != 1)
-            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestInit_ex failed");
-    }
-    void update(std::string_view bytes) {
-        if (EVP_DigestUpdate(ctx_.get(), bytes.data(), bytes.size()) != 1)
-            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestUpdate failed");
-    }
-    std::string hex() {
-        unsigned char digest[EVP_MAX_MD_SIZE];
-        unsigned int size = 0;
-        if (EVP_DigestFinal_ex(ctx_.get(), digest, &size) != 1)
-            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestFinal_ex failed");
-        static constexpr char kHex[] = "0123456789abcdef";
-        std::string out;
-        for (unsigned int i = 0; i < size; ++i) {
-            out += kHex[digest[i] >> 4];
-            out += kHex[digest[i] & 15];
-        }
-        return out;
-    }
-
-  private:
-    std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> ctx_;
-};
-
-// The scene of `spec` and its digest (above). A file is read once; its hash and its parse
-// then run side by side as two TBB tasks (one after the other with --threads 1): the
-// hash takes about a third of the parse's time.
-std::pair<Scene, std::string> load_scene_and_digest(const std::string& spec, int threads) {
-    if (is_builtin_scene(spec)) return {make_builtin_scene(spec), sha256_hex(spec)};
-    const std::string text = read_scene_file(spec);
-    std::optional<tbb::global_control> thread_limit;
-    if (threads > 0) {
-        thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
-                             static_cast<std::size_t>(threads));
-    }
-    Scene scene;
-    std::string digest;
-    tbb::parallel_invoke(
-        [&] {
-            FileDigest file_digest;
-            file_digest.update(text);
-            digest = file_digest.hex();
-        },
-        [&] { scene = parse_scene_json(text, spec, text.capacity()); });
-    return {std::move(scene), std::move(digest)};
-}
-
 // Physical memory: the default --max-memory (0 if unknown: no limit).
 std::uint64_t physical_memory_bytes() {
     const long pages = ::sysconf(_SC_PHYS_PAGES);
@@ -158,172 +90,53 @@ std::uint64_t physical_memory_bytes() {
     return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
 }
 
-BatchScene load_batch_scene(const std::string& spec, const RenderArguments& args) {
-    BatchScene loaded;
-    loaded.spec = spec;
-    loaded.name = batch::scene_display_name(spec);
-    const auto load_start = std::chrono::steady_clock::now();
-    std::string digest;
-    std::tie(loaded.scene, digest) = load_scene_and_digest(spec, args.threads);
-    loaded.load_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-    Scene& scene = loaded.scene;
-    const bool overridden = args.width_option->count() || args.height_option->count() ||
-                            args.spp_option->count() || args.max_depth_option->count() ||
-                            args.seed_option->count();
-    if (args.width_option->count()) scene.image.width = args.width;
-    if (args.height_option->count()) scene.image.height = args.height;
-    if (args.spp_option->count()) scene.image.spp = args.spp;
-    if (args.max_depth_option->count()) scene.render.max_depth = args.max_depth;
-    if (args.seed_option->count()) scene.render.seed = args.seed;
-    if (overridden) {
-        // The scene itself was valid when loaded, so a failure now is the overrides' fault.
-        try {
-            validate_scene(scene);
-        } catch (const SceneError& e) {
-            throw UsageError(std::string("the options make the scene invalid: ") + e.what());
-        }
-    }
-    loaded.sha256 = std::move(digest);
-    return loaded;
-}
-
-// The frames of one scene: --frames, else the scene's own (0..frames-1, or 0 for a still).
-std::vector<int> frames_of(const Scene& scene, const std::string& spec) {
-    if (spec.empty()) return default_frames(scene);
+// The library's RequestError is a mistake on the command line: exit 2, as a parse error.
+template <class F>
+auto usage_errors(F&& f) -> decltype(f()) {
     try {
-        return batch::parse_frame_spec(spec);
-    } catch (const batch::SpecError& e) {
-        throw UsageError(std::string("--frames: ") + e.what());
+        return f();
+    } catch (const batch::RequestError& e) {
+        throw UsageError(e.what());
     }
 }
 
-std::string default_pattern(bool sequence) {
-    return sequence ? "{scene}.####.exr" : "{scene}.exr";
+// What the options ask of octray::batch, as its plain request: the overrides only where
+// the user gave the option, so the scene's own value stays otherwise.
+batch::BatchRequest batch_request(const RenderArguments& args) {
+    batch::BatchRequest request;
+    if (args.width_option->count()) request.overrides.width = args.width;
+    if (args.height_option->count()) request.overrides.height = args.height;
+    if (args.spp_option->count()) request.overrides.spp = args.spp;
+    if (args.max_depth_option->count()) request.overrides.max_depth = args.max_depth;
+    if (args.seed_option->count()) request.overrides.seed = args.seed;
+    request.threads = args.threads;
+    request.frames = args.frames;
+    request.output = args.output;
+    request.png = args.png;
+    return request;
 }
 
-// Creates the missing directories above an output (as Blender does), top down, adding each
-// one created to `created`; fails before the render when one cannot be created or the
-// directory clearly cannot be written, rather than after hours of rendering. (The writes
-// themselves still report anything this misses.)
-void prepare_output_directory(const fs::path& file, std::vector<std::string>& created) {
-    fs::path dir = file.parent_path();
-    if (dir.empty()) dir = ".";
-    struct stat info {};
-    if (::stat(dir.c_str(), &info) != 0 && errno == ENOENT) {
-        std::vector<fs::path> missing;  // deepest first
-        for (fs::path up = dir; !up.empty(); up = up.parent_path()) {
-            if (::stat(up.c_str(), &info) == 0 || errno != ENOENT) break;
-            missing.push_back(up);
-            if (up == up.parent_path()) break;
-        }
-        for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-            if (::mkdir(it->c_str(), 0777) == 0) {
-                created.push_back(it->string());
-            } else if (errno != EEXIST) {  // EEXIST: a concurrent shard made it first
-                const int error = errno;
-                if (error == ENOTDIR) break;  // a file in the way: named below
-                throw IoError("cannot write " + file.string() + ": cannot create directory " +
-                              it->string() + ": " + std::strerror(error));
-            }
-        }
-    }
-    if (::stat(dir.c_str(), &info) != 0) {
-        const int error = errno;
-        // A file in the way is the reason, not a missing directory: name it.
-        if (error == ENOTDIR) {
-            for (fs::path up = dir.parent_path(); !up.empty(); up = up.parent_path()) {
-                if (::stat(up.c_str(), &info) == 0) {
-                    if (!S_ISDIR(info.st_mode))
-                        throw IoError("cannot write " + file.string() + ": " + up.string() +
-                                      " is a file, not a directory");
-                    break;
-                }
-            }
-        }
-        throw IoError("cannot write " + file.string() + ": " + dir.string() + ": " +
-                      std::strerror(error));
-    }
-    if (!S_ISDIR(info.st_mode))
-        throw IoError("cannot write " + file.string() + ": " + dir.string() +
-                      " is a file, not a directory");
-    if (::access(dir.c_str(), W_OK | X_OK) != 0)
-        throw IoError("cannot write " + file.string() + ": directory " + dir.string() +
-                      " is not writable");
+// --aov and --accel values, as UsageErrors when bad.
+AovSet parse_aov_option(const std::string& text) {
+    std::string error;
+    const auto set = parse_aov_list(text, &error);
+    if (!set) throw UsageError("--aov: " + error);
+    return *set;
 }
 
-// The frame list of the whole run, in order: each scene's frames, scene after scene.
-std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
-                                const RenderArguments& args) {
-    std::vector<BatchJob> jobs;
-    std::size_t total = 0;
-    std::vector<std::vector<int>> frames(scenes.size());
-    for (std::size_t s = 0; s < scenes.size(); ++s) {
-        frames[s] = frames_of(scenes[s].scene, args.frames);
-        total += frames[s].size();
-    }
-    const std::string pattern =
-        args.output.empty() ? default_pattern(total > scenes.size()) : args.output;
-    try {
-        for (std::size_t s = 0; s < scenes.size(); ++s) {
-            if (frames[s].size() > 1 && !batch::pattern_has_frame_field(pattern))
-                throw UsageError("-o " + pattern +
-                                 " has no frame field (#### or {frame:04d}) but " +
-                                 std::to_string(frames[s].size()) + " frames of " +
-                                 scenes[s].spec + " are to be rendered");
-            if (!args.png.empty() && frames[s].size() > 1 &&
-                !batch::pattern_has_frame_field(args.png))
-                throw UsageError(
-                    "--png " + args.png + " has no frame field (#### or {frame:04d}) but " +
-                    std::to_string(frames[s].size()) + " frames are to be rendered");
-            for (const int frame : frames[s]) {
-                BatchJob job;
-                job.scene = s;
-                job.frame = frame;
-                job.output = batch::expand_output_pattern(pattern, frame, scenes[s].name);
-                if (!args.png.empty())
-                    job.png = batch::expand_output_pattern(args.png, frame, scenes[s].name);
-                jobs.push_back(std::move(job));
-            }
-        }
-    } catch (const batch::SpecError& e) {
-        throw UsageError(std::string("output pattern: ") + e.what());
-    }
+Accel parse_accel_option(const std::string& text) {
+    const auto accel = parse_accel(text);
+    if (!accel) throw UsageError("--accel: expected auto, bvh or none, not " + text);
+    return *accel;
+}
 
-    // Two frames must never share a file (several scenes without {scene}, say). Files are
-    // told apart by what a write replaces, the directory entry (device and inode of the
-    // directory plus the name), so no spelling ("./", "..", a symlink) hides a clash.
-    std::map<std::string, std::size_t> owner;
-    std::map<std::string, std::string> directories;  // each directory looked up once
-    const auto identity = [&directories](const std::string& file) {
-        const fs::path path(file);
-        const std::string dir = path.parent_path().string();
-        auto it = directories.find(dir);
-        if (it == directories.end())
-            it = directories.emplace(dir, directory_identity(dir)).first;
-        return it->second + path.filename().string();
-    };
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-        if (!jobs[j].png.empty() && identity(jobs[j].png) == identity(jobs[j].output))
-            throw UsageError("-o and --png name the same file: " + jobs[j].output + " and " +
-                             jobs[j].png);
-        for (const std::string* file : {&jobs[j].output, &jobs[j].png}) {
-            if (file->empty()) continue;
-            const std::string key = identity(*file);
-            const auto [it, inserted] = owner.emplace(key, j);
-            if (!inserted) {
-                const BatchJob& other = jobs[it->second];
-                throw UsageError(
-                    "two frames would write the same file " + *file + ": " +
-                    scenes[other.scene].spec + " frame " + std::to_string(other.frame) +
-                    " and " + scenes[jobs[j].scene].spec + " frame " +
-                    std::to_string(jobs[j].frame) +
-                    (scenes.size() > 1 ? " (put {scene} in the pattern)"
-                                       : " (put #### or {frame:04d} in the pattern)"));
-            }
-        }
-    }
-    return jobs;
+// The exit status of a finished run (commands.h, plus 128 + the signal when interrupted).
+int exit_status(const batch::BatchSummary& summary) {
+    if (summary.interrupted) return 128 + InterruptGuard::signal_number();
+    if (summary.scene_failure) return kExitScene;
+    if (summary.io_failure) return kExitIo;
+    if (summary.internal_failure) return kExitInternal;
+    return kExitSuccess;
 }
 
 // The format of -o, from its extension: OpenEXR, or the 8-bit sRGB PNG that --png writes.
@@ -372,7 +185,7 @@ batch::Shard resolve_shard(const RenderArguments& args) {
 
 void run_render(const RenderArguments& args) {
     // Everything about the command line first: no render time is spent on a bad one.
-    BatchSettings settings;
+    batch::BatchSettings settings;
     settings.path = *parse_render_path(args.path);  // CLI11 allowed only these two
     if (settings.path == RenderPath::simd) {
         try {
@@ -393,10 +206,8 @@ void run_render(const RenderArguments& args) {
     settings.png_output = output_format(args) == ImageFormat::png;
     settings.skip_existing = args.skip_existing;
     settings.placeholders = args.placeholders;
-    settings.stats = args.stats;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
     if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
-    settings.progress = *progress;
     if (!args.aov.empty()) settings.aovs = parse_aov_option(args.aov);
     settings.options.accel = parse_accel_option(args.accel);
     std::uint64_t memory_limit = physical_memory_bytes();
@@ -439,9 +250,10 @@ void run_render(const RenderArguments& args) {
         }
     }
 
-    std::vector<BatchScene> scenes;
+    const batch::BatchRequest request = batch_request(args);
+    std::vector<batch::BatchScene> scenes;
     for (const std::string& spec : args.scenes) {
-        scenes.push_back(load_batch_scene(spec, args));
+        scenes.push_back(usage_errors([&] { return batch::load_batch_scene(spec, request); }));
         print_scene_warnings(scenes.back().scene, args.quiet);
     }
 
@@ -459,7 +271,7 @@ void run_render(const RenderArguments& args) {
     memory.aov_normal = settings.aovs.normal;
     memory.aov_albedo = settings.aovs.albedo;
     memory.aov_id = settings.aovs.id;
-    for (BatchScene& scene : scenes) {
+    for (batch::BatchScene& scene : scenes) {
         if (!args.crop.empty()) {
             try {
                 scene.crop = batch::parse_crop(args.crop, scene.scene.image.width,
@@ -479,27 +291,22 @@ void run_render(const RenderArguments& args) {
         }
     }
 
-    std::vector<BatchJob> jobs = plan_jobs(scenes, args);
+    std::vector<batch::BatchJob> jobs =
+        usage_errors([&] { return batch::plan_jobs(scenes, request); });
     const std::size_t planned = jobs.size();
-    jobs = select_jobs(jobs, shard);
-    std::set<std::string> directories;
-    std::vector<std::string> created;
-    for (const BatchJob& job : jobs) {
-        for (const std::string* file : {&job.output, &job.png}) {
-            if (file->empty()) continue;
-            const fs::path path(*file);
-            if (directories.insert(path.parent_path().string()).second)
-                prepare_output_directory(path, created);
-        }
-    }
+    jobs = batch::select_shard(jobs, shard);
     // On stderr, so that standard output stays the progress format (--progress json).
-    for (const std::string& dir : created)
+    for (const std::string& dir : batch::prepare_output_directories(jobs))
         std::fprintf(stderr, "octray: created output directory %s/\n", dir.c_str());
-    if (shard.count > 1 && settings.progress != ProgressMode::json)
+    if (shard.count > 1 && *progress != ProgressMode::json)
         std::printf("shard    %d/%d: %zu of %zu frames\n", shard.index, shard.count,
                     jobs.size(), planned);
 
-    const int status = run_batch(scenes, jobs, settings);
+    InterruptGuard interrupt;  // Ctrl-C and SIGTERM set the flag the frame loop polls
+    ProgressReporter reporter(*progress, args.stats);
+    const batch::BatchSummary summary =
+        batch::run_batch(scenes, jobs, settings, reporter, &InterruptGuard::flag());
+    const int status = exit_status(summary);
     if (status != kExitSuccess) throw CommandExit{status};
 }
 

@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "kernels/dispatch.h"
+#include "render/batch/spec.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/animation.h"
 #include "scene/load.h"
-#include "tools/batch.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 

@@ -73,15 +73,8 @@ std::string format_duration(double seconds) {
     return text;
 }
 
-ProgressReporter::ProgressReporter(ProgressMode mode, std::size_t frame_count,
-                                   std::uint64_t total_work)
-    : mode_(mode),
-      frame_count_(frame_count),
-      total_work_(std::max<std::uint64_t>(total_work, 1)) {
-    if (mode_ == ProgressMode::bar || mode_ == ProgressMode::lines ||
-        mode_ == ProgressMode::json)
-        thread_ = std::thread([this] { ticker(); });
-}
+ProgressReporter::ProgressReporter(ProgressMode mode, bool stats)
+    : mode_(mode), stats_(stats) {}
 
 ProgressReporter::~ProgressReporter() {
     {
@@ -90,6 +83,34 @@ ProgressReporter::~ProgressReporter() {
     }
     wake_.notify_all();
     if (thread_.joinable()) thread_.join();
+}
+
+void ProgressReporter::run_started(const batch::RunStart& start) {
+    if (mode_ != ProgressMode::json && mode_ != ProgressMode::none) {
+        for (std::size_t s = 0; s < start.scenes.size(); ++s) {
+            const Scene& scene = start.scenes[s].scene;
+            std::size_t frames = 0;
+            for (const batch::BatchJob& job : start.jobs) frames += job.scene == s ? 1 : 0;
+            std::printf(
+                "scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp, max depth %d, "
+                "seed %llu, %zu frame%s\n",
+                start.scenes[s].spec.c_str(), scene.objects.size(), scene.lights.size(),
+                scene.animation ? ", animated" : "", scene.image.width, scene.image.height,
+                scene.image.spp, scene.render.max_depth,
+                static_cast<unsigned long long>(scene.render.seed), frames,
+                frames == 1 ? "" : "s");
+        }
+        std::printf("render   %s path, %zu threads, %dx%d tiles\n", start.path.c_str(),
+                    start.threads, start.tile_width, start.tile_height);
+        std::fflush(stdout);
+    }
+    std::lock_guard lock(mutex_);
+    frame_count_ = start.jobs.size();
+    total_work_ = std::max<std::uint64_t>(start.total_work, 1);
+    start_ = Clock::now();
+    if (mode_ == ProgressMode::bar || mode_ == ProgressMode::lines ||
+        mode_ == ProgressMode::json)
+        thread_ = std::thread([this] { ticker(); });
 }
 
 double ProgressReporter::fraction_locked() const {
@@ -175,6 +196,17 @@ void ProgressReporter::frame_started(std::size_t index, const std::string& scene
 
 void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t work) {
     std::lock_guard lock(mutex_);
+    if (stats_ && report.outcome == FrameOutcome::rendered)
+        // The scene is loaded once for all its frames: its load time is on each line.
+        std::fprintf(stderr,
+                     "stats: %s frame %d: load %.3f s, compile %.3f s, BVH %.3f s, "
+                     "render %.3f s, write %.3f s\n",
+                     report.scene.c_str(), report.frame, report.load_seconds,
+                     report.compile_seconds, report.bvh_seconds, report.render_seconds,
+                     report.write_seconds);
+    if (report.outcome == FrameOutcome::failed)
+        note_locked("octray: frame " + std::to_string(report.frame) + " of " +
+                    report.scene_spec + " failed: " + report.message);
     work_done_ += work;
     current_work_ = 0;
     pixels_done_.store(0, std::memory_order_relaxed);
@@ -246,15 +278,14 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
     }
 }
 
-void ProgressReporter::note(const std::string& line) {
-    std::lock_guard lock(mutex_);
+void ProgressReporter::note_locked(const std::string& line) {
     if (mode_ == ProgressMode::bar && bar_drawn_) std::fputs("\r\033[K", stderr);
     std::fprintf(stderr, "%s\n", line.c_str());
     if (mode_ == ProgressMode::bar && bar_drawn_) draw_bar_locked(false);
     std::fflush(stderr);
 }
 
-void ProgressReporter::finish(const BatchSummary& summary) {
+void ProgressReporter::run_finished(const BatchSummary& summary) {
     {
         std::lock_guard lock(mutex_);
         stopping_ = true;

@@ -1,6 +1,6 @@
 #pragma once
 // The invariants of the batch-specification fuzzers (fuzz_frame_spec, fuzz_crop_spec) on
-// tools/batch.h, one function per target. tests/tools/batch_test.cpp replays the
+// render/batch/spec.h, one function per target. tests/batch/spec_test.cpp replays the
 // checked-in corpus through the same functions, so a kept input stays a test in every
 // build. Refusing input with SpecError is success; a broken invariant throws
 // BatchInvariantBroken (std::terminate in a fuzzer, a failure in a GoogleTest).
@@ -15,7 +15,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "tools/batch.h"
+#include "render/batch/spec.h"
 
 namespace octray::fuzz {
 

@@ -1,4 +1,4 @@
-// libFuzzer target: crop rectangles and shard specs of batch renders (tools/batch.h) on
+// libFuzzer target: crop rectangles and shard specs of batch renders (render/batch/spec.h) on
 // arbitrary strings; see batch_checks.h (check_crop_spec).
 #include <cstddef>
 #include <cstdint>

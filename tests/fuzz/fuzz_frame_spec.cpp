@@ -1,4 +1,4 @@
-// libFuzzer target: frame specs and output patterns of batch renders (tools/batch.h) on
+// libFuzzer target: frame specs and output patterns of batch renders (render/batch/spec.h) on
 // arbitrary strings; see batch_checks.h (check_frame_spec).
 #include <cstddef>
 #include <cstdint>

@@ -12,8 +12,8 @@
 #include <tuple>
 
 #include "output_fixtures.h"
+#include "render/batch/result_exr.h"
 #include "render/image/image_read.h"
-#include "render/result_exr.h"
 #include "scene_builders.h"
 
 namespace octray {

@@ -17,10 +17,10 @@
 #include <cmath>
 
 #include "output_fixtures.h"
-#include "render/camera_matrices.h"
+#include "render/batch/camera_matrices.h"
+#include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
-#include "render/result_exr.h"
 #include "scene_builders.h"
 
 namespace octray {
@@ -180,8 +180,8 @@ TEST(ExrAttributes, MatricesRationalsAndOpaqueAttributesReadBack) {
 // back to ((i + 0.5) / W, (j + 0.5) / H); worldToCamera puts the eye at the origin and
 // the view down -Z.
 void expect_matrices_match_rays(const Scene& scene) {
-    const Matrix44 to_camera = world_to_camera(scene);
-    const std::optional<Matrix44> to_ndc = world_to_ndc(scene);
+    const Matrix44 to_camera = batch::world_to_camera(scene);
+    const std::optional<Matrix44> to_ndc = batch::world_to_ndc(scene);
     ASSERT_TRUE(to_ndc);
     const ReferenceTracer tracer(scene);
     const int w = scene.image.width, h = scene.image.height;
@@ -190,18 +190,18 @@ void expect_matrices_match_rays(const Scene& scene) {
         const Ray ray = *tracer.camera_ray(i, j, 0);  // spp 1: the pixel center
         for (float t : {1.0f, 3.0f, 10.0f}) {
             const Vec3 p = ray.origin + ray.direction * t;
-            const Vec3 ndc = transform_point(*to_ndc, p);
+            const Vec3 ndc = batch::transform_point(*to_ndc, p);
             EXPECT_NEAR(ndc.x * w, i + 0.5f, 2e-3f) << i << "," << j << " t " << t;
             EXPECT_NEAR(ndc.y * h, j + 0.5f, 2e-3f) << i << "," << j << " t " << t;
             // In camera space the point lies in front of the eye (negative z).
-            EXPECT_LT(transform_point(to_camera, p).z, 0.0f);
+            EXPECT_LT(batch::transform_point(to_camera, p).z, 0.0f);
         }
     }
-    const Vec3 eye = transform_point(to_camera, scene.camera.eye);
+    const Vec3 eye = batch::transform_point(to_camera, scene.camera.eye);
     EXPECT_NEAR(eye.x, 0.0f, 1e-5f);
     EXPECT_NEAR(eye.y, 0.0f, 1e-5f);
     EXPECT_NEAR(eye.z, 0.0f, 1e-5f);
-    const Vec3 target = transform_point(to_camera, scene.camera.lookat);
+    const Vec3 target = batch::transform_point(to_camera, scene.camera.lookat);
     EXPECT_NEAR(target.x, 0.0f, 1e-5f);
     EXPECT_NEAR(target.y, 0.0f, 1e-5f);
     EXPECT_NEAR(target.z, -length(scene.camera.lookat - scene.camera.eye), 1e-4f);
@@ -217,12 +217,12 @@ TEST(CameraMatrices, ProjectThePixelsOwnRays) {
     expect_matrices_match_rays(lens);
 
     const Scene fisheye = test::golden_scene("fisheye", 16, 16);
-    EXPECT_FALSE(world_to_ndc(fisheye));
+    EXPECT_FALSE(batch::world_to_ndc(fisheye));
     ExrAttributes attributes;
-    add_camera_attributes(attributes, fisheye);
+    batch::add_camera_attributes(attributes, fisheye);
     ASSERT_EQ(attributes.matrices.size(), 1u);
     EXPECT_EQ(attributes.matrices[0].first, "worldToCamera");
-    add_camera_attributes(attributes, pinhole);
+    batch::add_camera_attributes(attributes, pinhole);
     ASSERT_EQ(attributes.matrices.size(), 3u);
     EXPECT_EQ(attributes.matrices[2].first, "worldToNDC");
 }

@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "render/aov.h"
-#include "render/assemble.h"
-#include "render/camera_matrices.h"
+#include "render/batch/assemble.h"
+#include "render/batch/camera_matrices.h"
+#include "render/batch/result_exr.h"
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
-#include "render/result_exr.h"
 #include "run_octray.h"
 #include "scene/load.h"
 
@@ -46,7 +46,7 @@ class AssembleCliTest : public ::testing::Test {
         RenderOptions options;
         options.crop = crop;
         ExrAttributes attributes;
-        add_camera_attributes(attributes, scene_);
+        batch::add_camera_attributes(attributes, scene_);
         attributes.ints.emplace_back("octray:frame", 3);
         ExrImage exr =
             make_exr_image(render_packet(scene_, options),

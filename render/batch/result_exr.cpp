@@ -1,4 +1,4 @@
-#include "render/result_exr.h"
+#include "render/batch/result_exr.h"
 
 namespace octray {
 

@@ -1,53 +1,34 @@
-#include "tools/render_batch.h"
+#include "render/batch/frame_loop.h"
 
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
-#include <OpenEXR/ImfIntAttribute.h>
-#include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfThreading.h>
-#include <fcntl.h>
 #include <oneapi/tbb/global_control.h>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include <array>
-#include <cerrno>
+#include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstring>
+#include <cstdint>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <new>
+#include <optional>
 #include <system_error>
 #include <utility>
 
 #include "core/version.h"
 #include "kernels/dispatch.h"
-#include "render/aov.h"
-#include "render/camera_matrices.h"
-#include "render/image/image_read.h"
+#include "render/batch/camera_matrices.h"
+#include "render/batch/claim_owner.h"
+#include "render/batch/progressive.h"
+#include "render/batch/result_exr.h"
+#include "render/batch/resume.h"
 #include "render/packet_renderer.h"
-#include "render/progressive.h"
 #include "render/reference.h"
 #include "scene/animation.h"
 #include "scene/scene_error.h"
-#include "tools/claim_owner.h"
-#include "tools/commands.h"
-#include "tools/interrupt.h"
 
-namespace octray::tools {
+namespace octray::batch {
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-// The attribute that marks an image written by a --progressive pass before the last one:
-// --skip-existing does not count such a file as a finished frame.
-constexpr const char* kSamplesSoFarAttribute = "octray.samplesSoFar";
-// The run that writes an unfinished pass: its claim (tools/claim_owner.h).
-constexpr const char* kOwnerAttribute = "octray.owner";
 
 enum class FailureKind { none, scene, io, internal, interrupted };
 
@@ -73,103 +54,6 @@ std::pair<std::string, float> capture_date() {
     return {text, static_cast<float>(-local.tm_gmtoff)};
 }
 
-// A finished frame: a non-empty file that is not an unfinished --progressive pass.
-// An empty file is a --placeholders claim; an unfinished pass is a claim of its owner
-// (tools/claim_owner.h) while that run lives. An OpenEXR file whose chunks do not hold
-// what its header implies (cut off, or its header lying about its pixel data) is damaged:
-// resuming never takes it for a finished frame, nor renders over what it did not write.
-enum class Existing { none, claim, finished, unfinished, damaged };
-
-struct Found {
-    Existing kind = Existing::none;
-    std::string owner;  // octray.owner of an unfinished pass ("" if it has none)
-    std::string error;  // why a damaged file cannot be read
-};
-
-bool has_exr_signature(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::array<char, 4> magic{};
-    in.read(magic.data(), magic.size());
-    return in.gcount() == 4 && magic == std::array<char, 4>{0x76, 0x2f, 0x31, 0x01};
-}
-
-Found existing_output(const std::string& path) {
-    std::error_code error;
-    if (!fs::exists(path, error)) return {Existing::none, {}, {}};
-    const auto size = fs::file_size(path, error);
-    if (error) return {Existing::finished, {}, {}};  // not a regular file: never overwrite it
-    if (size == 0) return {Existing::claim, {}, {}};
-    // Not an EXR (a PNG preview target): it exists. An EXR gets the check that `compare` and
-    // `assemble` make before decoding (render/image/image_read.h): every chunk against its
-    // header. Its pixels are not decoded: resuming a long sequence only needs to know the
-    // file is whole.
-    if (!has_exr_signature(path)) return {Existing::finished, {}, {}};
-    try {
-        check_exr_pixel_data(path);
-        Imf::InputFile file(path.c_str());
-        const Imf::Header& header = file.header();
-        if (header.findTypedAttribute<Imf::IntAttribute>(kSamplesSoFarAttribute) != nullptr) {
-            const auto* owner =
-                header.findTypedAttribute<Imf::StringAttribute>(kOwnerAttribute);
-            return {
-                Existing::unfinished, owner != nullptr ? owner->value() : std::string(), {}};
-        }
-    } catch (const IoError& e) {
-        return {Existing::damaged, {}, e.what()};
-    } catch (const std::exception& e) {  // OpenEXR's own, after the check passed
-        return {Existing::damaged, {}, "cannot read '" + path + "': " + e.what()};
-    }
-    return {Existing::finished, {}, {}};
-}
-
-// Takes over a stale unfinished image at `path` for --placeholders: replaces it by an
-// empty claim of this run. Two runs may find the same stale image; the one that holds the
-// file's lock and still finds it stale under the lock wins, the other finds it changed
-// and backs off. False if another run took it (or it cannot be locked).
-bool take_over(const std::string& path) {
-    int fd = ::open(path.c_str(), O_RDWR | O_NOFOLLOW | O_CLOEXEC);
-    if (fd < 0) fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
-    if (fd < 0) return false;
-    struct Closer {
-        int fd;
-        ~Closer() { ::close(fd); }
-    } closer{fd};
-    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) return false;
-    const auto same_file = [&] {
-        struct stat held {
-        }, named{};
-        return ::fstat(fd, &held) == 0 && ::stat(path.c_str(), &named) == 0 &&
-               held.st_dev == named.st_dev && held.st_ino == named.st_ino;
-    };
-    if (!same_file()) return false;
-    const Found found = existing_output(path);
-    if (found.kind != Existing::unfinished || !owner_is_gone(found.owner) || !same_file())
-        return false;
-    write_file_atomically(path, [](const std::string& tmp) {
-        // The temporary is already there, empty: it becomes the claim.
-        (void)tmp;
-    });
-    return true;
-}
-
-// Claims `path` with an empty file; false if another run got there first.
-bool claim(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0) {
-        if (errno == EEXIST) return false;
-        throw IoError("cannot claim " + path + " with a placeholder: " + std::strerror(errno));
-    }
-    ::close(fd);
-    return true;
-}
-
-// Gives a claim back after a failed or interrupted frame, if it is still our empty file.
-void release_claim(const std::string& path) {
-    std::error_code error;
-    if (fs::exists(path, error) && fs::file_size(path, error) == 0 && !error)
-        fs::remove(path, error);
-}
-
 // A frame's work for the progress bar: the pixel samples it traces.
 std::uint64_t frame_work(const BatchScene& scene) {
     const ImageSettings& image = scene.scene.image;
@@ -180,8 +64,12 @@ std::uint64_t frame_work(const BatchScene& scene) {
 class BatchRunner {
   public:
     BatchRunner(const std::vector<BatchScene>& scenes, const BatchSettings& settings,
-                ProgressReporter& progress)
-        : scenes_(scenes), settings_(settings), progress_(progress), owner_(current_owner()) {}
+                BatchObserver& observer, const std::atomic<bool>* cancel)
+        : scenes_(scenes),
+          settings_(settings),
+          observer_(observer),
+          cancel_(cancel),
+          owner_(current_owner()) {}
 
     FrameResult run(std::size_t index, const BatchJob& job);
 
@@ -194,23 +82,21 @@ class BatchRunner {
 
     const std::vector<BatchScene>& scenes_;
     const BatchSettings& settings_;
-    ProgressReporter& progress_;
+    BatchObserver& observer_;
+    const std::atomic<bool>* cancel_;
     std::string owner_;  // octray.owner of this run's unfinished passes
 };
 
 ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
                                       const RenderResult& result, int samples_so_far) const {
     const auto [date, utc_offset] = capture_date();
-    std::string path = std::string(render_path_name(settings_.path));
-    if (settings_.path == RenderPath::simd)
-        path.append(" (").append(isa_name(settings_.isa)).append(")");
     ExrAttributes a;
     a.strings = {
         {"software", std::string("octray ") + kVersion},
         {"capDate", date},
         {"octray.scene", scene.spec},
         {"octray.sceneSha256", scene.sha256},
-        {"octray.path", path},
+        {"octray.path", render_path_label(settings_)},
         // A string keeps all 64 bits of the seed.
         {"octray.seed", std::to_string(posed.render.seed)},
     };
@@ -261,6 +147,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
     FrameResult out;
     out.report.index = index;
     out.report.scene = scene.name;
+    out.report.scene_spec = scene.spec;
     out.report.frame = job.frame;
     out.report.output = job.output;
     out.report.preview = job.png;
@@ -268,7 +155,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
 
     const auto skip = [&](FrameOutcome outcome) {
         out.report.outcome = outcome;
-        progress_.frame_finished(out.report, work);
+        observer_.frame_finished(out.report, work);
         return out;
     };
     // A directory at an output path can never be replaced by an image: the frame fails
@@ -280,9 +167,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         out.report.outcome = FrameOutcome::failed;
         out.report.message = "I/O error: cannot write " + *file +
                              ": it is a directory; expected an image file (or nothing) there";
-        progress_.note("octray: frame " + std::to_string(job.frame) + " of " + scene.spec +
-                       " failed: " + out.report.message);
-        progress_.frame_finished(out.report, work);
+        observer_.frame_finished(out.report, work);
         return out;
     }
     // Resume and claims. A frame is finished only when all its outputs are (the EXR and
@@ -305,9 +190,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
             out.report.message = "I/O error: " + damaged->error +
                                  "; not a finished frame, and left alone: remove it to "
                                  "render the frame again";
-            progress_.note("octray: frame " + std::to_string(job.frame) + " of " + scene.spec +
-                           " failed: " + out.report.message);
-            progress_.frame_finished(out.report, work);
+            observer_.frame_finished(out.report, work);
             return out;
         }
         if (existing == Existing::claim || preview == Existing::claim)
@@ -338,7 +221,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         }
         remove_stale_temporaries(job.output);
         if (!job.png.empty()) remove_stale_temporaries(job.png);
-        progress_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
+        observer_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
 
         // A still scene is its own pose: no copy of its (possibly millions of) objects.
         std::optional<Scene> animated;
@@ -346,8 +229,8 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         const Scene& posed = animated ? *animated : scene.scene;
         RenderOptions options = settings_.options;
         options.frame = static_cast<std::uint32_t>(job.frame);
-        options.cancel = &InterruptGuard::flag();
-        options.pixels_done = &progress_.pixel_counter();
+        options.cancel = cancel_;
+        options.pixels_done = observer_.pixel_counter();
         options.crop = scene.crop;
         // Writing (EXR and PNG encoding) is timed apart from tracing: the frame line and
         // the summary report each, and the rate is rays over trace time alone.
@@ -381,13 +264,6 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         out.report.bvh_seconds = result.bvh_seconds;
         out.report.render_seconds =
             result.seconds - result.compile_seconds - result.bvh_seconds;
-        if (settings_.stats)  // the scene is loaded once for all its frames: on each line
-            std::fprintf(stderr,
-                         "stats: %s frame %d: load %.3f s, compile %.3f s, BVH %.3f s, "
-                         "render %.3f s, write %.3f s\n",
-                         scene.name.c_str(), job.frame, out.report.load_seconds,
-                         out.report.compile_seconds, out.report.bvh_seconds,
-                         out.report.render_seconds, write_seconds);
         out.report.rays = result.rays.total();
         out.report.outcome = FrameOutcome::rendered;
     } catch (const RenderCancelled&) {
@@ -413,64 +289,22 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
     }
     if (out.failure != FailureKind::none && !claimed.empty()) release_claim(claimed);
     out.report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
-    if (out.failure != FailureKind::interrupted) {
-        if (out.failure != FailureKind::none)
-            progress_.note("octray: frame " + std::to_string(job.frame) + " of " + scene.spec +
-                           " failed: " + out.report.message);
-        progress_.frame_finished(out.report, work);
-    }
+    if (out.failure != FailureKind::interrupted) observer_.frame_finished(out.report, work);
     return out;
-}
-
-void print_header(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
-                  const BatchSettings& settings) {
-    for (std::size_t s = 0; s < scenes.size(); ++s) {
-        const Scene& scene = scenes[s].scene;
-        std::size_t frames = 0;
-        for (const BatchJob& job : jobs) frames += job.scene == s ? 1 : 0;
-        std::printf(
-            "scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp, max depth %d, "
-            "seed %llu, %zu frame%s\n",
-            scenes[s].spec.c_str(), scene.objects.size(), scene.lights.size(),
-            scene.animation ? ", animated" : "", scene.image.width, scene.image.height,
-            scene.image.spp, scene.render.max_depth,
-            static_cast<unsigned long long>(scene.render.seed), frames, frames == 1 ? "" : "s");
-    }
-    const std::size_t threads =
-        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-    std::string path(render_path_name(settings.path));
-    if (settings.path == RenderPath::simd)
-        path.append(" (").append(isa_name(settings.isa)).append(")");
-    std::printf("render   %s path, %zu threads, %dx%d tiles\n", path.c_str(), threads,
-                settings.options.tile_width, settings.options.tile_height);
-    std::fflush(stdout);
 }
 
 }  // namespace
 
-AovSet parse_aov_option(const std::string& text) {
-    std::string error;
-    const auto set = parse_aov_list(text, &error);
-    if (!set) throw UsageError("--aov: " + error);
-    return *set;
+std::string render_path_label(const BatchSettings& settings) {
+    std::string path(render_path_name(settings.path));
+    if (settings.path == RenderPath::simd)
+        path.append(" (").append(isa_name(settings.isa)).append(")");
+    return path;
 }
 
-Accel parse_accel_option(const std::string& text) {
-    const auto accel = parse_accel(text);
-    if (!accel) throw UsageError("--accel: expected auto, bvh or none, not " + text);
-    return *accel;
-}
-
-std::vector<BatchJob> select_jobs(const std::vector<BatchJob>& jobs, batch::Shard shard) {
-    std::vector<BatchJob> selected;
-    for (std::size_t k = 0; k < jobs.size(); ++k)
-        if (k % static_cast<std::size_t>(shard.count) == static_cast<std::size_t>(shard.index))
-            selected.push_back(jobs[k]);
-    return selected;
-}
-
-int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
-              const BatchSettings& settings) {
+BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
+                       const BatchSettings& settings, BatchObserver& observer,
+                       const std::atomic<bool>* cancel) {
     // Limit TBB for the whole run; 0 keeps its default (every core it may use).
     std::optional<tbb::global_control> thread_limit;
     if (settings.options.threads > 0)
@@ -480,24 +314,23 @@ int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>
     // threads as the render's (none for one thread: the caller compresses). The file's
     // bytes are the same for any count; a 1920x1080 ZIP frame is written about twice as
     // fast on 2 threads (tools/README.md, "Time to image").
-    const std::size_t exr_threads =
+    const std::size_t threads =
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-    Imf::setGlobalThreadCount(
-        exr_threads > 1 ? static_cast<int>(std::min<std::size_t>(exr_threads, 64)) : 0);
-    if (settings.progress != ProgressMode::json && settings.progress != ProgressMode::none)
-        print_header(scenes, jobs, settings);
+    set_exr_thread_count(threads > 1 ? static_cast<int>(std::min<std::size_t>(threads, 64))
+                                     : 0);
 
     std::uint64_t total_work = 0;
     for (const BatchJob& job : jobs) total_work += frame_work(scenes[job.scene]);
+    observer.run_started({scenes, jobs, render_path_label(settings), threads,
+                          settings.options.tile_width, settings.options.tile_height,
+                          total_work});
 
-    InterruptGuard interrupt;
-    ProgressReporter progress(settings.progress, jobs.size(), total_work);
-    BatchRunner runner(scenes, settings, progress);
+    const auto cancelled = [cancel] { return cancel != nullptr && cancel->load(); };
+    BatchRunner runner(scenes, settings, observer, cancel);
     BatchSummary summary;
-    bool scene_failure = false, io_failure = false, internal_failure = false;
     const auto started = Clock::now();
     for (std::size_t k = 0; k < jobs.size(); ++k) {
-        if (InterruptGuard::flag().load()) {
+        if (cancelled()) {
             summary.not_started = jobs.size() - k;
             break;
         }
@@ -522,19 +355,14 @@ int run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>
                 }
                 break;
         }
-        scene_failure |= result.failure == FailureKind::scene;
-        io_failure |= result.failure == FailureKind::io;
-        internal_failure |= result.failure == FailureKind::internal;
+        summary.scene_failure |= result.failure == FailureKind::scene;
+        summary.io_failure |= result.failure == FailureKind::io;
+        summary.internal_failure |= result.failure == FailureKind::internal;
     }
-    summary.interrupted = InterruptGuard::flag().load();
+    summary.interrupted = cancelled();
     summary.seconds = std::chrono::duration<double>(Clock::now() - started).count();
-    progress.finish(summary);
-
-    if (summary.interrupted) return 128 + InterruptGuard::signal_number();
-    if (scene_failure) return kExitScene;
-    if (io_failure) return kExitIo;
-    if (internal_failure) return kExitInternal;
-    return kExitSuccess;
+    observer.run_finished(summary);
+    return summary;
 }
 
-}  // namespace octray::tools
+}  // namespace octray::batch

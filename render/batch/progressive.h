@@ -1,7 +1,7 @@
 #pragma once
 // Progressive rendering: a frame in passes of 1, 2, 4, ... samples per pixel so far, with
 // the mean so far after each pass, ending on exactly the plain render's image
-// (render/README.md, "Progressive passes").
+// (render/batch/README.md, "Progressive passes").
 //
 // Each pass renders samples [begin, end) of every pixel with RenderOptions::samples and
 // adds them, one after the other, onto the previous passes' per-pixel sums
@@ -14,7 +14,7 @@
 
 #include "render/types.h"
 
-namespace octray {
+namespace octray::batch {
 
 // The samples per pixel so far after each pass: 1, 2, 4, ... (powers of two below spp),
 // then spp. spp 1: {1}; 5: {1, 2, 4, 5}; 16: {1, 2, 4, 8, 16}. Throws
@@ -35,4 +35,4 @@ using PassCallback = std::function<void(const RenderResult& so_far, int samples_
 RenderResult render_progressive(const PassRenderer& render, int spp,
                                 const RenderOptions& options, const PassCallback& on_pass);
 
-}  // namespace octray
+}  // namespace octray::batch

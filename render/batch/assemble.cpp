@@ -1,7 +1,7 @@
 // Assembling crops: checks first (display windows, channels, overlaps, gaps), then each
 // part's samples copied byte for byte into the full image, channel by channel.
 
-#include "render/assemble.h"
+#include "render/batch/assemble.h"
 
 #include <cstring>
 #include <limits>
@@ -10,7 +10,7 @@
 #include "render/crop.h"
 #include "render/image/image_read.h"
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 // A bound on the assembled image (as read_exr_image's): 2^30 samples in all channels.
@@ -172,4 +172,4 @@ AssembleSummary assemble_files(const std::vector<std::string>& part_paths,
     return summary;
 }
 
-}  // namespace octray
+}  // namespace octray::batch

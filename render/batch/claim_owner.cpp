@@ -1,4 +1,4 @@
-#include "tools/claim_owner.h"
+#include "render/batch/claim_owner.h"
 
 #include <signal.h>
 #include <unistd.h>
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string_view>
 
-namespace octray::tools {
+namespace octray::batch {
 namespace {
 
 std::string host_name() {
@@ -75,4 +75,4 @@ bool owner_is_gone(const std::string& owner) {
     return now && *now != start;
 }
 
-}  // namespace octray::tools
+}  // namespace octray::batch

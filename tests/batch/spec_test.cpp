@@ -1,7 +1,7 @@
-// Batch specifications (tools/batch.h): frame specs, output patterns, shards, crops and
+// Batch specifications (render/batch/spec.h): frame specs, output patterns, shards, crops and
 // scene names, with the message of every refusal.
 
-#include "tools/batch.h"
+#include "render/batch/spec.h"
 
 #include <gtest/gtest.h>
 

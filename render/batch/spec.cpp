@@ -1,7 +1,7 @@
 // Batch specifications: frame lists, output patterns, shards, crop rectangles
-// (tools/batch.h; grammar and limits in tools/README.md).
+// (render/batch/spec.h; grammar and limits in tools/README.md).
 
-#include "tools/batch.h"
+#include "render/batch/spec.h"
 
 #include <algorithm>
 #include <cctype>
@@ -375,17 +375,11 @@ Shard shard_from_environment(const std::function<const char*(const char*)>& gete
                     "Job), or give the shard as i/n");
 }
 
-std::vector<int> select_shard(const std::vector<int>& frames, Shard shard) {
+void check_shard(Shard shard) {
     if (shard.count < 1 || shard.index < 0 || shard.index >= shard.count) {
         throw SpecError("shard " + std::to_string(shard.index) + "/" +
                         std::to_string(shard.count) + ": expected 0 <= index < count");
     }
-    std::vector<int> out;
-    for (std::size_t k = static_cast<std::size_t>(shard.index); k < frames.size();
-         k += static_cast<std::size_t>(shard.count)) {
-        out.push_back(frames[k]);
-    }
-    return out;
 }
 
 PixelRect parse_crop(std::string_view text, int image_width, int image_height) {

@@ -1,13 +1,13 @@
 // worldToCamera and worldToNDC from the camera frame both render paths use
-// (scene/camera.h), derived in render/README.md, "Camera matrices".
+// (scene/camera.h), derived in render/batch/README.md, "Camera matrices".
 
-#include "render/camera_matrices.h"
+#include "render/batch/camera_matrices.h"
 
 #include <cmath>
 
 #include "scene/camera.h"
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 float& at(Matrix44& m, int row, int col) { return m[static_cast<std::size_t>(4 * row + col)]; }
@@ -94,4 +94,4 @@ Vec3 transform_point(const Matrix44& m, Vec3 p) {
     return {out[0] / out[3], out[1] / out[3], out[2] / out[3]};
 }
 
-}  // namespace octray
+}  // namespace octray::batch

@@ -1,9 +1,9 @@
-// Assembling crops (render/assemble.h): parts of a render, written as cropped EXRs with
+// Assembling crops (render/batch/assemble.h): parts of a render, written as cropped EXRs with
 // AOVs, assemble into exactly the file the uncropped render writes (2x2 and irregular
 // splits, half and float); overlaps, gaps and mismatches are refused with the parts and
 // pixels named.
 
-#include "render/assemble.h"
+#include "render/batch/assemble.h"
 
 #include <gtest/gtest.h>
 
@@ -12,11 +12,11 @@
 
 #include "output_fixtures.h"
 #include "render/aov.h"
-#include "render/camera_matrices.h"
+#include "render/batch/camera_matrices.h"
+#include "render/batch/result_exr.h"
 #include "render/image/image_read.h"
-#include "render/result_exr.h"
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 constexpr int kWidth = 29, kHeight = 19;
@@ -177,4 +177,4 @@ TEST(Assemble, UnreadablePartsAreIoErrorsAndNothingIsWritten) {
 }
 
 }  // namespace
-}  // namespace octray
+}  // namespace octray::batch

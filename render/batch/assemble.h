@@ -1,7 +1,7 @@
 #pragma once
 // `octray assemble`: stitching the cropped parts of one render (render --crop, each an EXR
 // whose data window is its crop inside the full display window) back into the full image,
-// sample for sample in each channel's own pixel type (render/README.md, "Assembling
+// sample for sample in each channel's own pixel type (render/batch/README.md, "Assembling
 // crops").
 
 #include <stdexcept>
@@ -10,7 +10,7 @@
 
 #include "render/image/image_io.h"
 
-namespace octray {
+namespace octray::batch {
 
 // The parts do not make one image: they overlap, leave a gap, disagree on the display
 // window or the channels, or lie outside the display window. The message names the parts
@@ -41,4 +41,4 @@ struct AssembleSummary {
 AssembleSummary assemble_files(const std::vector<std::string>& part_paths,
                                const std::string& output);
 
-}  // namespace octray
+}  // namespace octray::batch

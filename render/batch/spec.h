@@ -7,6 +7,7 @@
 // what was expected. This header is the reference for the grammar and limits; the user's
 // view is tools/README.md ("Batch rendering").
 
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -71,9 +72,21 @@ Shard parse_shard(std::string_view text);
 Shard shard_from_environment(const std::function<const char*(const char*)>& getenv_fn,
                              std::optional<int> shard_count);
 
-// The frames at positions k with k % shard.count == shard.index, in order. The shards
-// 0 ... count - 1 of one list are disjoint and together hold every frame once.
-std::vector<int> select_shard(const std::vector<int>& frames, Shard shard);
+// SpecError unless 0 <= shard.index < shard.count.
+void check_shard(Shard shard);
+
+// The items (frames, or the jobs of a run) at positions k with k % shard.count ==
+// shard.index, in order. The shards 0 ... count - 1 of one list are disjoint and together
+// hold every item once. SpecError for a bad shard (check_shard).
+template <class T>
+std::vector<T> select_shard(const std::vector<T>& items, Shard shard) {
+    check_shard(shard);
+    std::vector<T> out;
+    for (std::size_t k = static_cast<std::size_t>(shard.index); k < items.size();
+         k += static_cast<std::size_t>(shard.count))
+        out.push_back(items[k]);
+    return out;
+}
 
 // "x0,y0,x1,y1" with 0 <= x0 < x1 <= image_width and 0 <= y0 < y1 <= image_height.
 PixelRect parse_crop(std::string_view text, int image_width, int image_height);

@@ -8,7 +8,7 @@
 
 #include <string>
 
-namespace octray::tools {
+namespace octray::batch {
 
 // This process as an owner: "HOST:PID:START".
 std::string current_owner();
@@ -19,4 +19,4 @@ std::string current_owner();
 // by an octray that did not record one) is stale.
 bool owner_is_gone(const std::string& owner);
 
-}  // namespace octray::tools
+}  // namespace octray::batch

@@ -1,6 +1,6 @@
 #pragma once
 // The camera of a frame as OpenEXR's standard matrix attributes, worldToCamera and
-// worldToNDC (render/README.md, "Camera matrices"), so that compositing tools can project
+// worldToNDC (render/batch/README.md, "Camera matrices"), so that compositing tools can project
 // 3D points onto the image and relate the Z AOV to world space.
 //
 // Convention (Imath's): row vectors, p' = p * M, translation in the last row.
@@ -16,7 +16,7 @@
 #include "render/image/image_io.h"
 #include "scene/scene.h"
 
-namespace octray {
+namespace octray::batch {
 
 // World to camera space for the scene's camera. Throws std::invalid_argument if the
 // camera cannot form a frame (as make_camera_frame does).
@@ -33,4 +33,4 @@ void add_camera_attributes(ExrAttributes& attributes, const Scene& scene);
 // p * M for a point (w = 1), divided by the resulting w: Imath's multVecMatrix.
 Vec3 transform_point(const Matrix44& m, Vec3 p);
 
-}  // namespace octray
+}  // namespace octray::batch

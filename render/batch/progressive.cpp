@@ -1,10 +1,10 @@
-#include "render/progressive.h"
+#include "render/batch/progressive.h"
 
 #include <stdexcept>
 #include <string>
 #include <utility>
 
-namespace octray {
+namespace octray::batch {
 
 std::vector<int> progressive_schedule(int spp) {
     if (spp < 1)
@@ -47,4 +47,4 @@ RenderResult render_progressive(const PassRenderer& render, int spp,
     return result;
 }
 
-}  // namespace octray
+}  // namespace octray::batch

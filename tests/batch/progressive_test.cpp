@@ -1,8 +1,8 @@
-// Progressive passes (render/progressive.h): the schedule, the mean after each pass, and
+// Progressive passes (render/batch/progressive.h): the schedule, the mean after each pass, and
 // the final image equal to the plain render bit for bit on both paths (spp 1, 4, 5, 16,
 // with and without a crop).
 
-#include "render/progressive.h"
+#include "render/batch/progressive.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 
 #include "output_fixtures.h"
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 using test::golden_scene;
@@ -112,4 +112,4 @@ TEST(Progressive, BadSampleRangesAreRefused) {
 }
 
 }  // namespace
-}  // namespace octray
+}  // namespace octray::batch

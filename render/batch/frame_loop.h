@@ -1,0 +1,45 @@
+#pragma once
+// The frame loop of a batch render: claims, skips, renders and writes each frame of a
+// list of jobs (plan.h), survives failed frames, stops when its cancel flag is set, and
+// reports everything to an observer (observer.h). tools/README.md, "Batch rendering",
+// describes what it does from the user's side.
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "kernels/isa.h"
+#include "render/aov.h"
+#include "render/batch/observer.h"
+#include "render/batch/plan.h"
+#include "render/image/image_io.h"
+#include "render/types.h"
+
+namespace octray::batch {
+
+struct BatchSettings {
+    RenderPath path = RenderPath::simd;
+    Isa isa = Isa::automatic;  // resolved (simd path)
+    RenderOptions options;     // threads, tiles, accel; frame/crop/cancel set per frame
+    ExrWriteOptions exr;
+    AovSet aovs;
+    bool progressive = false;
+    // The outputs are PNG files: each job's output is the 8-bit sRGB preview, its png empty.
+    bool png_output = false;
+    bool skip_existing = false;
+    bool placeholders = false;
+};
+
+// The render path as the EXR attribute octray.path names it: "scalar", "simd (avx2)".
+std::string render_path_label(const BatchSettings& settings);
+
+// Renders every job in order on at most settings.options.threads threads (0: every core)
+// and returns the summary. A frame that fails is reported and the others go on. Once
+// *cancel is set (a signal handler may set it), the frame in progress is abandoned at its
+// next tile, leaving nothing half-written and its claim released, and no further frame
+// starts; `cancel` may be nullptr.
+BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
+                       const BatchSettings& settings, BatchObserver& observer,
+                       const std::atomic<bool>* cancel);
+
+}  // namespace octray::batch

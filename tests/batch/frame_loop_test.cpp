@@ -1,0 +1,294 @@
+// The frame loop (render/batch/frame_loop.h) in process, through a recording observer:
+// every frame reported once with its outcome, resume (a finished frame skipped and left
+// as it was), a claim held by another run (an empty placeholder, an unfinished pass of a
+// live run), a failing frame (reported, the others go on), and cancel (the frame in
+// progress abandoned, nothing half-written, its claim released, stale temporaries gone).
+
+#include "render/batch/frame_loop.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIntAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "kernels/dispatch.h"
+#include "render/batch/claim_owner.h"
+#include "render/batch/observer.h"
+#include "render/batch/plan.h"
+#include "render/image/image_read.h"
+
+namespace octray::batch {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kWidth = 24, kHeight = 16;
+
+// Everything the loop reports, in order.
+class RecordingObserver : public BatchObserver {
+  public:
+    struct Started {
+        std::size_t index;
+        std::string scene;
+        int frame;
+        std::uint64_t work;
+        int spp;
+    };
+
+    void run_started(const RunStart& start) override {
+        ++runs_started;
+        jobs_at_start = start.jobs.size();
+        total_work = start.total_work;
+        path = start.path;
+    }
+    std::atomic<std::uint64_t>* pixel_counter() override { return &pixels; }
+    void frame_started(std::size_t index, const std::string& scene, int frame,
+                       std::uint64_t work, int spp) override {
+        pixels = 0;
+        started.push_back({index, scene, frame, work, spp});
+        if (on_frame_started) on_frame_started(frame);
+    }
+    void frame_finished(const FrameReport& report, std::uint64_t work) override {
+        finished.push_back(report);
+        finished_work.push_back(work);
+        pixels_at_finish.push_back(pixels.load());
+    }
+    void run_finished(const BatchSummary& s) override {
+        ++runs_finished;
+        summary = s;
+    }
+
+    // The outcome of each finished frame, by frame number.
+    std::vector<std::pair<int, FrameOutcome>> outcomes() const {
+        std::vector<std::pair<int, FrameOutcome>> out;
+        for (const FrameReport& r : finished) out.emplace_back(r.frame, r.outcome);
+        return out;
+    }
+
+    std::function<void(int frame)> on_frame_started;
+    int runs_started = 0, runs_finished = 0;
+    std::size_t jobs_at_start = 0;
+    std::uint64_t total_work = 0;
+    std::string path;
+    std::atomic<std::uint64_t> pixels{0};
+    std::vector<Started> started;
+    std::vector<FrameReport> finished;
+    std::vector<std::uint64_t> finished_work, pixels_at_finish;
+    BatchSummary summary;
+};
+
+class FrameLoopTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = fs::path(OCTRAY_TEST_TMPDIR) / "frame_loop" /
+               ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+        request_.overrides.width = kWidth;
+        request_.overrides.height = kHeight;
+        request_.frames = "0-2";
+        request_.output = (dir_ / "w.#.exr").string();
+        scenes_.push_back(load_batch_scene("whitted", request_));
+        settings_.isa = resolve_isa(Isa::automatic);
+        settings_.options.threads = 2;
+    }
+
+    std::vector<BatchJob> jobs() const { return plan_jobs(scenes_, request_); }
+
+    BatchSummary run(RecordingObserver& observer, const std::atomic<bool>* cancel = nullptr) {
+        return run_batch(scenes_, jobs(), settings_, observer, cancel);
+    }
+
+    fs::path output(int frame) const { return dir_ / ("w." + std::to_string(frame) + ".exr"); }
+
+    std::set<std::string> files() const {
+        std::set<std::string> names;
+        for (const auto& entry : fs::directory_iterator(dir_))
+            names.insert(entry.path().filename().string());
+        return names;
+    }
+
+    fs::path dir_;
+    BatchRequest request_;
+    std::vector<BatchScene> scenes_;
+    BatchSettings settings_;
+};
+
+std::string file_bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// A 2x2 image as a --progressive pass before the last leaves it: octray.samplesSoFar and
+// the run writing it as octray.owner.
+void write_unfinished_pass(const fs::path& path, const std::string& owner) {
+    Imf::Header header(2, 2);
+    header.insert("octray.samplesSoFar", Imf::IntAttribute(1));
+    header.insert("octray.owner", Imf::StringAttribute(owner));
+    header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    std::vector<float> pixels(4, 0.5f);
+    Imf::FrameBuffer frame_buffer;
+    frame_buffer.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(pixels.data()),
+                                        sizeof(float), 2 * sizeof(float)));
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(frame_buffer);
+    file.writePixels(2);
+}
+
+TEST_F(FrameLoopTest, EveryFrameIsRenderedWrittenAndReportedOnce) {
+    RecordingObserver observer;
+    const BatchSummary summary = run(observer);
+    EXPECT_EQ(observer.runs_started, 1);
+    EXPECT_EQ(observer.runs_finished, 1);
+    EXPECT_EQ(observer.jobs_at_start, 3u);
+    const std::uint64_t frame_work = std::uint64_t{kWidth} * kHeight;  // whitted: 1 spp
+    EXPECT_EQ(observer.total_work, 3 * frame_work);
+    EXPECT_EQ(observer.path, render_path_label(settings_));
+    ASSERT_EQ(observer.started.size(), 3u);
+    for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_EQ(observer.started[k].index, k + 1);
+        EXPECT_EQ(observer.started[k].scene, "whitted");
+        EXPECT_EQ(observer.started[k].frame, static_cast<int>(k));
+        EXPECT_EQ(observer.started[k].work, frame_work);
+    }
+    ASSERT_EQ(observer.finished.size(), 3u);
+    for (std::size_t k = 0; k < 3; ++k) {
+        const FrameReport& r = observer.finished[k];
+        EXPECT_EQ(r.outcome, FrameOutcome::rendered);
+        EXPECT_EQ(r.index, k + 1);
+        EXPECT_EQ(r.scene_spec, "whitted");
+        EXPECT_EQ(r.output, output(static_cast<int>(k)).string());
+        EXPECT_GT(r.rays, 0u);
+        EXPECT_TRUE(r.message.empty()) << r.message;
+        // The renderer advanced the observer's counter over every pixel of the frame.
+        EXPECT_EQ(observer.pixels_at_finish[k], frame_work);
+        EXPECT_EQ(observer.finished_work[k], frame_work);
+        const ChannelImage image = read_image(r.output);
+        EXPECT_EQ(image.width, kWidth);
+        EXPECT_EQ(image.height, kHeight);
+    }
+    EXPECT_EQ(summary.rendered, 3u);
+    EXPECT_EQ(summary.skipped + summary.failed + summary.not_started, 0u);
+    EXPECT_FALSE(summary.interrupted);
+    EXPECT_FALSE(summary.scene_failure || summary.io_failure || summary.internal_failure);
+    EXPECT_EQ(observer.summary.rendered, 3u);
+    EXPECT_EQ(files(), (std::set<std::string>{"w.0.exr", "w.1.exr", "w.2.exr"}));
+}
+
+TEST_F(FrameLoopTest, ResumeSkipsAFinishedFrameAndLeavesItAsItWas) {
+    request_.frames = "1";
+    RecordingObserver first;
+    ASSERT_EQ(run(first).rendered, 1u);
+    const std::string before = file_bytes(output(1));
+    ASSERT_FALSE(before.empty());
+
+    request_.frames = "0-2";
+    settings_.skip_existing = true;
+    RecordingObserver resumed;
+    const BatchSummary summary = run(resumed);
+    EXPECT_EQ(resumed.outcomes(),
+              (std::vector<std::pair<int, FrameOutcome>>{{0, FrameOutcome::rendered},
+                                                         {1, FrameOutcome::skipped_existing},
+                                                         {2, FrameOutcome::rendered}}));
+    ASSERT_EQ(resumed.started.size(), 2u) << "a skipped frame does not start";
+    EXPECT_EQ(resumed.started[0].frame, 0);
+    EXPECT_EQ(resumed.started[1].frame, 2);
+    EXPECT_EQ(summary.rendered, 2u);
+    EXPECT_EQ(summary.skipped, 1u);
+    EXPECT_EQ(file_bytes(output(1)), before) << "a finished frame was written again";
+}
+
+TEST_F(FrameLoopTest, AFrameClaimedByAnotherRunIsSkipped) {
+    // Frame 0: another run's --placeholders claim; frame 1: the unfinished --progressive
+    // pass of a live run (this process: its claim cannot be stale).
+    std::ofstream(output(0)).close();
+    write_unfinished_pass(output(1), current_owner());
+    const std::string pass = file_bytes(output(1));
+    settings_.placeholders = true;
+    RecordingObserver observer;
+    const BatchSummary summary = run(observer);
+    EXPECT_EQ(observer.outcomes(),
+              (std::vector<std::pair<int, FrameOutcome>>{{0, FrameOutcome::skipped_claimed},
+                                                         {1, FrameOutcome::skipped_claimed},
+                                                         {2, FrameOutcome::rendered}}));
+    EXPECT_EQ(summary.skipped, 2u);
+    EXPECT_EQ(summary.rendered, 1u);
+    EXPECT_EQ(fs::file_size(output(0)), 0u) << "another run's claim was taken";
+    EXPECT_EQ(file_bytes(output(1)), pass) << "a live run's pass was rendered over";
+
+    // --skip-existing alone honours both claims the same way.
+    settings_.placeholders = false;
+    settings_.skip_existing = true;
+    RecordingObserver again;
+    run(again);
+    EXPECT_EQ(again.outcomes(),
+              (std::vector<std::pair<int, FrameOutcome>>{{0, FrameOutcome::skipped_claimed},
+                                                         {1, FrameOutcome::skipped_claimed},
+                                                         {2, FrameOutcome::skipped_existing}}));
+}
+
+TEST_F(FrameLoopTest, AFailingFrameIsReportedAndTheOthersGoOn) {
+    fs::create_directories(output(1) / "inside");
+    RecordingObserver observer;
+    const BatchSummary summary = run(observer);
+    EXPECT_EQ(observer.outcomes(),
+              (std::vector<std::pair<int, FrameOutcome>>{{0, FrameOutcome::rendered},
+                                                         {1, FrameOutcome::failed},
+                                                         {2, FrameOutcome::rendered}}));
+    ASSERT_EQ(observer.finished.size(), 3u);
+    EXPECT_EQ(observer.finished[1].message,
+              "I/O error: cannot write " + output(1).string() +
+                  ": it is a directory; expected an image file (or nothing) there");
+    ASSERT_EQ(observer.started.size(), 2u) << "the failing frame was rendered first";
+    EXPECT_EQ(summary.rendered, 2u);
+    EXPECT_EQ(summary.failed, 1u);
+    EXPECT_TRUE(summary.io_failure);
+    EXPECT_FALSE(summary.scene_failure || summary.internal_failure || summary.interrupted);
+    EXPECT_TRUE(fs::is_directory(output(1)));
+    EXPECT_TRUE(fs::exists(output(0)) && fs::exists(output(2)));
+}
+
+TEST_F(FrameLoopTest, CancelAbandonsTheFrameInProgressAndLeavesNothingBehind) {
+    // A temporary a killed run left next to frame 0 (no writer holds its lock): stale.
+    const fs::path stale = dir_ / ".w.0.exr.tmp.1.00000000000000bb";
+    std::ofstream(stale) << "left by a killed run";
+    settings_.placeholders = true;  // frame 0 is claimed, then released when cancelled
+    std::atomic<bool> cancel{false};
+    RecordingObserver observer;
+    observer.on_frame_started = [&](int) { cancel = true; };  // as Ctrl-C mid-frame
+    const BatchSummary summary = run(observer, &cancel);
+    ASSERT_EQ(observer.started.size(), 1u);
+    EXPECT_EQ(observer.started[0].frame, 0);
+    EXPECT_TRUE(observer.finished.empty()) << "the abandoned frame was reported finished";
+    EXPECT_EQ(observer.runs_finished, 1);
+    EXPECT_TRUE(summary.interrupted);
+    EXPECT_EQ(summary.not_started, 3u) << "the abandoned frame is not done";
+    EXPECT_EQ(summary.rendered + summary.skipped + summary.failed, 0u);
+    EXPECT_FALSE(summary.scene_failure || summary.io_failure || summary.internal_failure);
+    EXPECT_TRUE(files().empty()) << "a file, a claim or a temporary was left: "
+                                 << (files().empty() ? "" : *files().begin());
+
+    // Set before the run: no frame starts at all.
+    RecordingObserver idle;
+    const BatchSummary none = run(idle, &cancel);
+    EXPECT_TRUE(idle.started.empty());
+    EXPECT_TRUE(none.interrupted);
+    EXPECT_EQ(none.not_started, 3u);
+    EXPECT_TRUE(files().empty());
+}
+
+}  // namespace
+}  // namespace octray::batch
