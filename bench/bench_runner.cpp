@@ -28,11 +28,11 @@
 #include "bench/embree_baseline.h"
 #include "bench/embree_frames.h"
 #include "core/version.h"
+#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/image_io.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
-#include "scene/bvh.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 

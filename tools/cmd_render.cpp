@@ -37,7 +37,7 @@
 #include "render/image_io.h"
 #include "scene/animation.h"
 #include "scene/builtin.h"
-#include "scene/limits.h"
+#include "render/memory_estimate.h"
 #include "scene/load.h"
 #include "scene/max_depth.h"
 #include "scene/scene.h"

@@ -12,7 +12,7 @@
 #include "render/aov.h"
 #include "render/image_io.h"
 #include "render/types.h"
-#include "scene/accel.h"
+#include "render/accel.h"
 #include "scene/scene.h"
 #include "tools/batch.h"
 #include "tools/progress.h"
