@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "kernels/isa.h"
+#include "render/accel.h"
 #include "render/aov.h"
 #include "render/image_io.h"
 #include "render/types.h"
-#include "render/accel.h"
 #include "scene/scene.h"
 #include "tools/batch.h"
 #include "tools/progress.h"
