@@ -14,8 +14,8 @@
 #include "bench/ray_sets.h"
 #include "kernels/dispatch.h"
 #include "kernels/isa.h"
+#include "render/accel.h"
 #include "render/types.h"
-#include "scene/accel.h"
 
 namespace octray::bench {
 
@@ -96,8 +96,8 @@ struct SceneInfo {
     double compile_ms = 0.0;                        // compile_scene()
     std::optional<double> embree_build_ms;          // rtcCommitScene()
     std::optional<double> embree_bytes_per_sphere;  // Embree's device memory after the build
-    // octray's sphere BVH (scene/bvh.h): build time, bytes per sphere (nodes and its copy of
-    // the spheres), 8-wide nodes, leaves, depth. Absent without spheres.
+    // octray's sphere BVH (kernels/bvh_build.h): build time, bytes per sphere (nodes and its
+    // copy of the spheres), 8-wide nodes, leaves, depth. Absent without spheres.
     std::optional<double> bvh_build_ms, bvh_bytes_per_sphere;
     std::uint32_t bvh_nodes = 0, bvh_leaves = 0, bvh_depth = 0;
     // Time to first pixel: from the scene spec to the first finished tile of a render with

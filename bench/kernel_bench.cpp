@@ -16,10 +16,10 @@
 #include "bench/ray_sets.h"
 #include "core/aligned.h"
 #include "core/random.h"
+#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
-#include "scene/bvh.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 

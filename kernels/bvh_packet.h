@@ -5,8 +5,8 @@
 // Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
 // (packet_math.h; kernels/README.md, "the ODR rule").
 //
-// The tree is scene/bvh.h's: 8-wide nodes with their children's boxes in SoA
-// (scene/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
+// The tree is kernels/bvh_build.h's: 8-wide nodes with their children's boxes in SoA
+// (kernels/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
 // - packet traversal (Wald et al. 2001, "Interactive rendering with coherent ray
 //   tracing", widened to 8-wide nodes): the packet as a whole (a frustum, where its
 //   directions' signs agree) is tested against all 8 children at once; the 8-ray packet is
@@ -51,7 +51,7 @@
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
 // Entries of a traversal stack: a node pushes at most 8 children, and the builder keeps
-// the tree below 48 + 28 levels (scene/bvh.cpp, kMaxSahDepth).
+// the tree below 48 + 28 levels (kernels/bvh_sah.cpp, kMaxSahDepth).
 constexpr std::uint32_t kBvhStackSize = 1024;
 // 32u and 64u of the margin above.
 constexpr float kBvhFuzz = 0x1.0p-19f;

@@ -8,10 +8,10 @@
 #include <string_view>
 #include <vector>
 
+#include "kernels/bvh_build.h"
 #include "kernels/isa.h"
 #include "kernels/kernel_table.h"
 #include "kernels/kernel_types.h"
-#include "scene/bvh.h"
 #include "scene/compile.h"
 
 namespace octray {
@@ -57,8 +57,8 @@ inline constexpr std::uint32_t kBvhPacketMinLanes = 2;
 // (measured: docs/performance-log.md, "BVH: millions of spheres against Embree").
 inline constexpr std::uint32_t kBvhShadowSortMinSpheres = 32768;
 
-// The same with the spheres' BVH built from `scene` (scene/bvh.h); both must outlive the
-// view. An empty BVH (no spheres) leaves the view brute force.
+// The same with the spheres' BVH built from `scene` (kernels/bvh_build.h); both must outlive
+// the view. An empty BVH (no spheres) leaves the view brute force.
 kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& bvh,
                                    std::uint32_t packet_min_lanes = kBvhPacketMinLanes);
 

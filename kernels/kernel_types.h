@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-#include "scene/bvh_node.h"
+#include "kernels/bvh_node.h"
 
 namespace octray::kernels {
 
@@ -70,8 +70,8 @@ struct SceneView {
     float epsilon;  // ε_s
     std::int32_t max_depth;
 
-    // The sphere BVH (scene/bvh.h), or bvh_nodes == nullptr: closest_hit and any_hit test
-    // every sphere. Spheres in leaf order; node 0 is the root.
+    // The sphere BVH (kernels/bvh_build.h), or bvh_nodes == nullptr: closest_hit and any_hit
+    // test every sphere. Spheres in leaf order; node 0 is the root.
     const BvhNode8* bvh_nodes;
     const float *bvh_cx, *bvh_cy, *bvh_cz, *bvh_r2;
     const std::uint32_t* bvh_object;

@@ -20,10 +20,11 @@
 
 #include "core/aligned.h"
 #include "core/random.h"
+#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/crop.h"
 #include "render/parallel.h"
-#include "scene/bvh.h"
+#include "render/tile_layout.h"
 #include "scene/camera.h"
 
 namespace octray {
@@ -31,17 +32,24 @@ namespace {
 
 using kernels::kPacketWidth;
 
+// The stream layout render/tile_layout.h states (and render/memory_estimate.cpp counts).
+static_assert(kTileStreamPacket == kPacketWidth);
+
 // Rounds a stream length up to whole packets, with one spare packet.
 std::size_t stream_capacity(std::size_t n) {
     return (n + kPacketWidth - 1) / kPacketWidth * kPacketWidth + kPacketWidth;
 }
 
-// Grows (never shrinks) a set of SoA columns: steady state allocates nothing.
-template <class... Columns>
+// Grows (never shrinks) a set of SoA columns: steady state allocates nothing. `kColumns`
+// is the stream's column count in render/tile_layout.h, checked against the columns given.
+template <std::size_t kColumns, class... Columns>
 void grow(std::size_t n, Columns&... columns) {
+    static_assert(sizeof...(Columns) == kColumns, "render/tile_layout.h: column count");
+    static_assert(((sizeof(typename Columns::value_type) == kTileColumnBytes) && ...),
+                  "render/tile_layout.h: column element size");
     const std::size_t capacity = stream_capacity(n);
     // reserve first: resize alone may allocate up to twice the size (libstdc++ grows
-    // geometrically), and scene/limits.cpp counts exactly `capacity` elements.
+    // geometrically), and render/memory_estimate.cpp counts exactly `capacity` elements.
     ((columns.size() < capacity ? (columns.reserve(capacity), columns.resize(capacity))
                                 : void()),
      ...);
@@ -50,7 +58,7 @@ void grow(std::size_t n, Columns&... columns) {
 struct SampleStorage {
     AlignedVector<float> x, y, lens_u, lens_v;
     AlignedVector<std::uint32_t> pixel;
-    void reserve(std::size_t n) { grow(n, x, y, lens_u, lens_v, pixel); }
+    void reserve(std::size_t n) { grow<kSampleColumns>(n, x, y, lens_u, lens_v, pixel); }
     kernels::CameraSamples view() const {
         return {x.data(), y.data(), lens_u.data(), lens_v.data(), pixel.data()};
     }
@@ -59,7 +67,9 @@ struct SampleStorage {
 struct RayStorage {
     AlignedVector<float> ox, oy, oz, dx, dy, dz, wr, wg, wb;
     AlignedVector<std::uint32_t> pixel;
-    void reserve(std::size_t n) { grow(n, ox, oy, oz, dx, dy, dz, wr, wg, wb, pixel); }
+    void reserve(std::size_t n) {
+        grow<kRayColumns>(n, ox, oy, oz, dx, dy, dz, wr, wg, wb, pixel);
+    }
     kernels::RayStream view() {
         return {ox.data(), oy.data(), oz.data(), dx.data(), dy.data(),
                 dz.data(), wr.data(), wg.data(), wb.data(), pixel.data()};
@@ -69,7 +79,7 @@ struct RayStorage {
 struct HitStorage {
     AlignedVector<float> t;
     AlignedVector<std::int32_t> object;
-    void reserve(std::size_t n) { grow(n, t, object); }
+    void reserve(std::size_t n) { grow<kHitColumns>(n, t, object); }
     kernels::HitStream view() { return {t.data(), object.data()}; }
 };
 
@@ -77,7 +87,8 @@ struct ShadowStorage {
     AlignedVector<float> ox, oy, oz, dx, dy, dz, t_max, term_r, term_g, term_b;
     AlignedVector<std::uint32_t> parent, occluded;
     void reserve(std::size_t n) {
-        grow(n, ox, oy, oz, dx, dy, dz, t_max, term_r, term_g, term_b, parent, occluded);
+        grow<kShadowColumns>(n, ox, oy, oz, dx, dy, dz, t_max, term_r, term_g, term_b, parent,
+                             occluded);
     }
     kernels::ShadowStream view() {
         return {ox.data(),     oy.data(),     oz.data(),    dx.data(),
@@ -90,7 +101,8 @@ struct ColorStorage {
     AlignedVector<float> local_r, local_g, local_b, refl_r, refl_g, refl_b, refr_r, refr_g,
         refr_b;
     void reserve(std::size_t n) {
-        grow(n, local_r, local_g, local_b, refl_r, refl_g, refl_b, refr_r, refr_g, refr_b);
+        grow<kColorColumns>(n, local_r, local_g, local_b, refl_r, refl_g, refl_b, refr_r,
+                            refr_g, refr_b);
     }
     kernels::SurfaceColor view() {
         return {local_r.data(), local_g.data(), local_b.data(), refl_r.data(), refl_g.data(),
@@ -110,7 +122,7 @@ struct ColorStorage {
 struct LinkStorage {
     AlignedVector<std::uint32_t> parent;  // 2 * parent slot + (0 mirror, 1 refracted)
     AlignedVector<float> factor_r, factor_g, factor_b;
-    void reserve(std::size_t n) { grow(n, parent, factor_r, factor_g, factor_b); }
+    void reserve(std::size_t n) { grow<kLinkColumns>(n, parent, factor_r, factor_g, factor_b); }
     kernels::ChildLinks view() {
         return {parent.data(), factor_r.data(), factor_g.data(), factor_b.data()};
     }
@@ -128,6 +140,7 @@ struct Level {
 struct TilePixel {
     std::uint32_t x, y;
 };
+static_assert(sizeof(TilePixel) == kTilePixelOrderColumns * kTileColumnBytes);
 
 // Per-thread scratch, reused tile after tile (and frame after frame: scratch_for_thread).
 struct TileScratch {
@@ -137,7 +150,8 @@ struct TileScratch {
     ShadowStorage shadows;               // likewise
     std::vector<Level> levels;           // sized to max_depth + 1 before a tile, never shrinks
     std::vector<TilePixel> pixel_order;  // the tile's pixels in sample order
-    AlignedVector<float> acc_r, acc_g, acc_b;  // the tile's sums of samples
+    AlignedVector<float> acc_r, acc_g, acc_b;  // the tile's sums of samples:
+                                               // kTileAccumulatorColumns
 
     // What the scratch holds now, in bytes (its high-water mark: it never shrinks).
     std::uint64_t bytes() const {

@@ -9,16 +9,14 @@
 
 #include "kernels/isa.h"
 #include "kernels/kernel_table.h"
+#include "render/tile_layout.h"
 #include "render/types.h"
 #include "scene/compile.h"
 #include "scene/scene.h"
 
 namespace octray {
 
-// Rays a tile traces at once per generation of its ray tree when RenderOptions::ray_chunk
-// is 0: a multiple of the widest packet (16 rays). A tile's scratch then holds at most this
-// many rays per generation, whatever the depth and the samples per pixel.
-inline constexpr std::uint32_t kDefaultRayChunk = 4096;
+// kDefaultRayChunk, the rays a tile traces at once by default: render/tile_layout.h.
 
 // Renders the whole image with the kernels of `isa` (Isa::automatic: the best the CPU
 // has; a forced ISA the CPU lacks throws std::runtime_error). Tiles of

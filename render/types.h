@@ -10,7 +10,7 @@
 
 #include "core/image.h"
 #include "core/pixel_rect.h"
-#include "scene/accel.h"
+#include "render/accel.h"
 
 namespace octray {
 
@@ -70,7 +70,7 @@ struct RenderOptions {
     // new sums; its image is sums / end. Unset: every sample, as a plain render.
     std::optional<SampleRange> samples;
     const Image* sample_sums = nullptr;
-    // The SIMD path's acceleration structure for spheres (`--accel`, scene/accel.h): auto
+    // The SIMD path's acceleration structure for spheres (`--accel`, render/accel.h): auto
     // builds a BVH from kBvhAutoMinSpheres spheres on. The image is the same either way;
     // the scalar reference ignores it (brute force always).
     Accel accel = Accel::automatic;

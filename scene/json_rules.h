@@ -1,7 +1,7 @@
 #pragma once
 // The value rules of scene files that both JSON readers apply: the diagnosing reader
-// (load.cpp, nlohmann) and the fast one (load_fast.cpp, simdjson). One copy, so that the
-// two cannot drift apart; the messages for breaking them are the diagnosing reader's.
+// (read_scene.cpp, nlohmann) and the fast one (load_fast.cpp, simdjson). One copy, so that
+// the two cannot drift apart; the messages for breaking them are the diagnosing reader's.
 
 #include <cmath>
 #include <limits>

@@ -16,6 +16,7 @@
 #include "render/batch/spec.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_read.h"
+#include "render/memory_estimate.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/animation.h"
@@ -112,6 +113,10 @@ void run_verify(const VerifyArguments& args) {
     if (args.height > 0) scene.image.height = args.height;
     if (args.spp > 0) scene.image.spp = args.spp;
     validate_scene(scene);
+    // Both renders' framebuffers must fit in this machine's memory; the estimate counts one
+    // render (render/memory_estimate.h). A scene's validity does not depend on the machine.
+    if (const std::uint64_t memory = machine_memory_bytes(); memory > 0)
+        check_memory_limit(scene, memory);
 
     std::printf("scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp\n", args.scene.c_str(),
                 scene.objects.size(), scene.lights.size(), scene.animation ? ", animated" : "",

@@ -140,7 +140,7 @@ struct ExrImage {
 ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
                         int full_height, const ExrWriteOptions& options,
                         const ExrAttributes& attributes = {});
-// (A render's make_exr_image(RenderResult, ...) is in render/result_exr.h.)
+// (A render's make_exr_image(RenderResult, ...) is in render/batch/result_exr.h.)
 
 // Writes `image` as a scanline OpenEXR file, atomically. Throws IoError naming the path
 // and the reason (an empty window, a channel whose sample count is not the data window's,

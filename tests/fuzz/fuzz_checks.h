@@ -26,9 +26,9 @@
 
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
+#include "render/memory_estimate.h"
 #include "scene/builtin.h"
 #include "scene/compile.h"
-#include "scene/limits.h"
 #include "scene/load.h"
 #include "scene_diff.h"
 

@@ -16,8 +16,8 @@
 #include <limits>
 #include <string>
 
+#include "render/memory_estimate.h"
 #include "scene/builtin.h"
-#include "scene/limits.h"
 #include "scene/load.h"
 
 namespace octray {
@@ -213,22 +213,25 @@ std::int64_t physical_memory() {
     return static_cast<std::int64_t>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
 }
 
-// validate_scene's own check: a framebuffer larger than physical memory is refused with
-// its size in the message (the scene is never allocated, only described).
+// A framebuffer larger than physical memory: the scene is valid (whether it fits depends on
+// the machine), and the render command's check (check_memory_limit at its default limit,
+// the machine's memory) refuses it with the framebuffer's size in the message. Only
+// described, never allocated.
 TEST(HostileImageSize, FramebufferOverPhysicalMemoryIsRefusedUpFront) {
     const std::int64_t memory = physical_memory();
     // The largest image the pixel cap allows: 46340 x 46340 = 2147395600 pixels, 24 GiB.
     const std::int64_t bytes = std::int64_t{46340} * 46340 * 12;
     if (memory <= 0 || bytes <= memory)
         GTEST_SKIP() << "this machine has more memory than that";
+    const Scene s = make_builtin_scene("whitted,width=46340,height=46340");
     try {
-        (void)make_builtin_scene("whitted,width=46340,height=46340");
+        check_memory_limit(s, static_cast<std::uint64_t>(memory));
         FAIL() << "a 24 GiB framebuffer was accepted";
     } catch (const SceneError& e) {
         const std::string what = e.what();
-        EXPECT_NE(what.find("46340 x 46340 image needs about 24.0 GiB"), std::string::npos)
-            << what;
-        EXPECT_NE(what.find("of physical memory"), std::string::npos) << what;
+        EXPECT_NE(what.find("46340 x 46340 image at"), std::string::npos) << what;
+        EXPECT_NE(what.find("framebuffer 24.0 GiB"), std::string::npos) << what;
+        EXPECT_NE(what.find("expected at most the memory limit of"), std::string::npos) << what;
     }
 }
 

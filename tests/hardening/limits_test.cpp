@@ -1,7 +1,5 @@
-// scene/limits.h: the render memory estimate, the limit check behind --max-memory, and
-// the size parser.
-
-#include "scene/limits.h"
+// render/memory_estimate.h: the render memory estimate, the limit check behind --max-memory,
+// and the size parser.
 
 #include <gtest/gtest.h>
 
@@ -9,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "render/memory_estimate.h"
 #include "scene/builtin.h"
 #include "scene/scene_error.h"
 

@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "render/accel.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/load.h"
@@ -97,6 +98,19 @@ TEST(BvhRender, EyeInsideASphereMatchesTheReference) {
     test::add_sphere(s, s.camera.eye, 0.3f, 2);  // a glass sphere around the eye
     s.render.max_depth = 8;
     expect_same_images(s, "eye inside glass");
+}
+
+// The --accel names, and where `auto` switches to the BVH (render/accel.h).
+TEST(Accel, NamesRoundTrip) {
+    for (Accel a : {Accel::automatic, Accel::bvh, Accel::none})
+        EXPECT_EQ(parse_accel(accel_name(a)), a);
+    EXPECT_FALSE(parse_accel("BVH").has_value());
+    EXPECT_FALSE(parse_accel("").has_value());
+    EXPECT_FALSE(accel_uses_bvh(Accel::none, 1000000));
+    EXPECT_TRUE(accel_uses_bvh(Accel::bvh, 1));
+    EXPECT_FALSE(accel_uses_bvh(Accel::bvh, 0));
+    EXPECT_FALSE(accel_uses_bvh(Accel::automatic, kBvhAutoMinSpheres - 1));
+    EXPECT_TRUE(accel_uses_bvh(Accel::automatic, kBvhAutoMinSpheres));
 }
 
 TEST(BvhRender, AutoMatchesOnBothSidesOfTheCrossover) {

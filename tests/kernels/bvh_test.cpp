@@ -1,4 +1,4 @@
-// The sphere BVH (scene/bvh.h) and its traversal (kernels/hit_kernels.h and the bvh_*.h
+// The sphere BVH (kernels/bvh_build.h) and its traversal (kernels/hit_kernels.h and the bvh_*.h
 // headers it includes).
 // Builder: every sphere in exactly one leaf, leaves of 1-8 spheres, every child box holds
 // its spheres (the exact spheres, in double precision) and its children's boxes, empty
@@ -9,8 +9,6 @@
 // hit for hit on random rays over random and degenerate scenes (one sphere, all spheres at
 // one point, radii from 1e-6 to 1e3, spheres far apart along one axis, duplicates that tie,
 // planes); any-hit equals the reference's occlusion and agrees with closest hit.
-
-#include "scene/bvh.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -23,6 +21,7 @@
 #include <vector>
 
 #include "core/aligned.h"
+#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/reference.h"
 #include "scene/compile.h"
@@ -269,7 +268,7 @@ void check_invariants(const NamedScene& ns) {
     EXPECT_GT(bvh.memory_bytes(), 0u);
 }
 
-// Large enough that the builder's tasks collapse subtrees of their own (scene/bvh.cpp:
+// Large enough that the builder's tasks collapse subtrees of their own (kernels/bvh_build.cpp:
 // 1024 spheres or more), whose nodes are appended and relocated.
 NamedScene large_scene() {
     std::mt19937 rng(2026);
@@ -344,18 +343,6 @@ TEST(SphereBvh, DeterministicAcrossThreadCounts) {
         EXPECT_EQ(one.depth, other.depth);
         EXPECT_EQ(one.leaf_count, other.leaf_count);
     }
-}
-
-TEST(Accel, NamesRoundTrip) {
-    for (Accel a : {Accel::automatic, Accel::bvh, Accel::none})
-        EXPECT_EQ(parse_accel(accel_name(a)), a);
-    EXPECT_FALSE(parse_accel("BVH").has_value());
-    EXPECT_FALSE(parse_accel("").has_value());
-    EXPECT_FALSE(accel_uses_bvh(Accel::none, 1000000));
-    EXPECT_TRUE(accel_uses_bvh(Accel::bvh, 1));
-    EXPECT_FALSE(accel_uses_bvh(Accel::bvh, 0));
-    EXPECT_FALSE(accel_uses_bvh(Accel::automatic, kBvhAutoMinSpheres - 1));
-    EXPECT_TRUE(accel_uses_bvh(Accel::automatic, kBvhAutoMinSpheres));
 }
 
 // ---------------------------------------------------------------------------------------

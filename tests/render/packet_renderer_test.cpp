@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "kernels/dispatch.h"
+#include "render/memory_estimate.h"
 #include "render/reference.h"
-#include "scene/limits.h"
 #include "scene/load.h"
 #include "scene_builders.h"
 
@@ -267,8 +267,8 @@ TEST(PacketRenderer, RayChunksChangeNoPixel) {
 // The worst case for a breadth-first tile: every bounce spawns a mirror and a refracted
 // ray that the weight cut-off never stops (reflect = transmit = 1), depth 8, the eye
 // inside nested glass shells. A generation then has up to 2^8 times the tile's samples;
-// in chunks, a thread's scratch stays within scene/limits' per-thread estimate (which
-// assumes one chunk per generation), and the image is still the reference's.
+// in chunks, a thread's scratch stays within render/memory_estimate.h's per-thread estimate
+// (which assumes one chunk per generation), and the image is still the reference's.
 TEST(PacketRenderer, MirrorAndGlassEverywhereStaysWithinBoundedMemory) {
     Scene s = empty_scene(16, 16);
     s.image.spp = 8;

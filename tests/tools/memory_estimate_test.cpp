@@ -123,6 +123,34 @@ TEST_F(MemoryEstimateTest, ASceneFileWhoseParseDominates) {
                                  "--accel", "none", "-o", "b.exr"});
 }
 
+// An image whose framebuffer alone exceeds this machine's memory (the largest the pixel
+// cap allows, 24 GiB): a valid scene, refused by the render command at its default limit,
+// the machine's memory (exit 2), with the framebuffer's size and where the limit comes
+// from in the message, before anything is allocated. (Scene validation once refused it;
+// whether an image fits depends on the machine, so the render command decides.)
+TEST_F(MemoryEstimateTest, AFramebufferLargerThanThisMachinesMemoryIsRefused) {
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    ASSERT_GT(pages, 0);
+    ASSERT_GT(page, 0);
+    const double memory = static_cast<double>(pages) * static_cast<double>(page);
+    // On machines with more memory than that, the estimate may fit and the image render.
+    if (memory >= 2147483647.0 * 12.0)
+        GTEST_SKIP() << "more memory than any allowed image needs";
+    const int side = 46340;  // 46340^2 < 2^31 - 1
+    ASSERT_GT(static_cast<double>(side) * side * 12.0, memory);
+    const auto r = run_octray({"render", "whitted", "--width", std::to_string(side), "--height",
+                               std::to_string(side), "-o", "big.exr"},
+                              dir_);
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("whitted: image: a 46340 x 46340 image at"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("framebuffer 24.0 GiB"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("(the limit is this machine's memory; --max-memory sets another)"),
+              std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "big.exr"));
+}
+
 // A 5 M-sphere JSON with --max-memory 1K was refused only after 30 s and 3.2 GB of parsing.
 // The file's size alone tells: this one is not even valid JSON, and is refused for its
 // size (exit 2), not parsed (a parse would end in a scene error, exit 3).

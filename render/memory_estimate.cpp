@@ -1,7 +1,9 @@
-// The memory estimate of scene/limits.h. Every size below names the layout it comes from;
-// when those layouts change, change the constants with them.
+// The memory estimate of render/memory_estimate.h. Every size below names the layout it comes
+// from; when those layouts change, change the constants with them.
 
-#include "scene/limits.h"
+#include "render/memory_estimate.h"
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -11,6 +13,8 @@
 #include <system_error>
 #include <thread>
 
+#include "kernels/bvh_node.h"
+#include "render/tile_layout.h"
 #include "scene/scene_error.h"
 
 namespace octray {
@@ -27,10 +31,10 @@ std::uint64_t u64(int v) { return v > 0 ? static_cast<std::uint64_t>(v) : 0; }
 
 // core/image.h: one Rgb (three floats) per pixel.
 constexpr std::uint64_t kFramebufferBytesPerPixel = 12;
-// render/progressive.cpp: while a pass renders, the last pass's image and sample sums are
+// render/batch/progressive.cpp: while a pass renders, the last pass's image and sample sums are
 // kept, and the pass makes its own: four images.
 constexpr std::uint64_t kProgressiveImages = 4;
-// render/image_io.cpp make_exr_image and render/aov.cpp append_aov_channels: every
+// render/batch/result_exr.cpp make_exr_image and render/aov.cpp append_aov_channels: every
 // channel is copied into the EXR image, as half (2 bytes) or float (4); the id AOV is
 // UINT (4).
 constexpr std::uint64_t kColorChannels = 3;
@@ -38,7 +42,7 @@ constexpr std::uint64_t kDepthChannels = 1, kNormalChannels = 3, kAlbedoChannels
 // OpenEXR's scan-line writer holds one block of lines of every channel, uncompressed and
 // compressed (at worst as large again, plus the codec's own state): three copies.
 constexpr std::uint64_t kExrLineBufferCopies = 3;
-// render/image_io.cpp write_png_file: 8-bit RGB rows and a row pointer per row.
+// render/image/png.cpp write_png_file: 8-bit RGB rows and a row pointer per row.
 constexpr std::uint64_t kPngBytesPerPixel = 3, kPngBytesPerRow = 8;
 // render/aov.h AovImages: depth a float, normal a Vec3, albedo an Rgb, id a uint32.
 constexpr std::uint64_t kAovDepthBytes = 4, kAovNormalBytes = 12, kAovAlbedoBytes = 12,
@@ -52,36 +56,44 @@ constexpr std::uint64_t kCompiledMaterialBytes = 16 * 4;  // CompiledMaterials' 
 constexpr std::uint64_t kCompiledLightBytes = 11 * 4;     // CompiledLights' 11 columns
 constexpr std::uint64_t kPadding = 8;
 
-// scene/bvh.cpp build_sphere_bvh, per sphere: two PrimRef arrays (32 bytes each) and
-// 2n - 1 BinaryNodes (28 bytes) while building, the 8-wide nodes (224 bytes each; one per
-// 26 spheres measured on random:1000000, counted as one per 4) and the BVH's copy of the
-// spheres (5 columns). Its arrays sit on 2 MiB huge pages: a page of rounding for each
-// of its 8 arrays.
+// kernels/bvh_build.cpp build_sphere_bvh, per sphere: two PrimRef arrays (32 bytes each)
+// and 2n - 1 BinaryNodes (28 bytes) while building (kernels/bvh_sah.h), the 8-wide nodes
+// (224 bytes each; one per 26 spheres measured on random:1000000, counted as one per 4)
+// and the BVH's copy of the spheres (5 columns). Its arrays sit on 2 MiB huge pages: a
+// page of rounding for each of its 8 arrays.
 constexpr std::uint64_t kBvhBuildBytesPerSphere = 2 * 32 + 2 * 28;
-constexpr std::uint64_t kBvhNodeBytesPerSphere = 224 / 4;
+constexpr std::uint64_t kBvhNodeBytesPerSphere = sizeof(BvhNode8) / 4;
 constexpr std::uint64_t kBvhSphereBytes = 5 * 4;
 constexpr std::uint64_t kBvhPageRounding = 8 * (std::uint64_t{2} << 20);
 
-// tools/render_batch.cpp: each frame renders a posed copy of the scene (scene_at_frame)
+// render/batch/frame_loop.cpp: each frame renders a posed copy of the scene (scene_at_frame)
 // while the batch keeps the loaded one.
 constexpr std::uint64_t kAuthoredCopies = 2;
 
-// render/packet_renderer.cpp TileScratch. A tile traces each generation of its ray tree
-// in chunks of at most kTileRayChunk rays (its kDefaultRayChunk), depth first; a stream of
-// n rays has n rounded up to a packet plus a spare packet in each column (at most n + 16).
-// Per ray of the camera-sample chunk: samples 5 columns, primary rays 10.
-constexpr std::uint64_t kTileRayChunk = 4096;
-constexpr std::uint64_t kTileStreamSlack = 16;
-constexpr std::uint64_t kTileBytesPerSample = 5 * 4 + 10 * 4;
-// Per ray of the largest chunk of any generation: hits 2 columns; shadow rays 12 columns
-// per (ray, light).
-constexpr std::uint64_t kTileBytesPerChunkRay = 2 * 4;
-constexpr std::uint64_t kTileBytesPerShadowRay = 12 * 4;
-// Per ray of a generation's chunk (max_depth + 1 generations): 9 color columns, and its
-// children: 10 ray columns and 4 link columns at twice the count.
-constexpr std::uint64_t kTileBytesPerGenerationRay = 9 * 4 + 2 * (10 * 4 + 4 * 4);
-// The tile's three accumulators and its pixel order (x and y), per pixel.
-constexpr std::uint64_t kTileBytesPerPixel = 3 * 4 + 2 * 4;
+// render/packet_renderer.cpp TileScratch, in its layout (render/tile_layout.h). A tile
+// traces each generation of its ray tree in chunks of at most kTileRayChunk rays (its
+// kDefaultRayChunk), depth first; a stream of n rays has n rounded up to a packet plus a
+// spare packet in each column (at most n + kTileStreamSlack).
+// Per ray of the camera-sample chunk: samples and primary rays.
+constexpr std::uint64_t kTileRayChunk = kDefaultRayChunk;
+constexpr std::uint64_t kTileStreamSlack = 2 * kTileStreamPacket;
+constexpr std::uint64_t kTileBytesPerSample = (kSampleColumns + kRayColumns) * kTileColumnBytes;
+// Per ray of the largest chunk of any generation: hits; shadow rays per (ray, light).
+constexpr std::uint64_t kTileBytesPerChunkRay = kHitColumns * kTileColumnBytes;
+constexpr std::uint64_t kTileBytesPerShadowRay = kShadowColumns * kTileColumnBytes;
+// Per ray of a generation's chunk (max_depth + 1 generations): its colors, and its
+// children: ray and link columns at twice the count.
+constexpr std::uint64_t kTileBytesPerGenerationRay =
+    (kColorColumns + 2 * (kRayColumns + kLinkColumns)) * kTileColumnBytes;
+// The tile's accumulators and its pixel order, per pixel.
+constexpr std::uint64_t kTileBytesPerPixel =
+    (kTileAccumulatorColumns + kTilePixelOrderColumns) * kTileColumnBytes;
+// The same numbers as before the layout had a header of its own.
+static_assert(kTileBytesPerSample == 5 * 4 + 10 * 4 && kTileBytesPerChunkRay == 2 * 4 &&
+              kTileBytesPerShadowRay == 12 * 4 &&
+              kTileBytesPerGenerationRay == 9 * 4 + 2 * (10 * 4 + 4 * 4) &&
+              kTileBytesPerPixel == 3 * 4 + 2 * 4 && kTileRayChunk == 4096 &&
+              kTileStreamSlack == 16);
 
 // Measured (peak resident set size of `octray render`, Debian 12, glibc malloc): the
 // process rendering a 1x1 image of a small scene, code, libraries and TBB's threads
@@ -250,6 +262,15 @@ void check_load_memory_limit(const std::string& path, std::uint64_t file_bytes,
                          gib(e.load) + ", the process " + gib(e.fixed) +
                          "), before rendering; expected at most the memory limit of " +
                          gib(limit_bytes) + " (" + std::to_string(limit_bytes) + " bytes)");
+}
+
+std::uint64_t machine_memory_bytes() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long page_size = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page_size <= 0) return 0;
+    const auto p = static_cast<std::uint64_t>(pages),
+               size = static_cast<std::uint64_t>(page_size);
+    return sat_mul(p, size);
 }
 
 std::optional<std::uint64_t> parse_memory_size(std::string_view text) {

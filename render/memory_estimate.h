@@ -4,8 +4,9 @@
 // --max-memory`), and the parser for sizes such as "512M" or "4G".
 //
 // The estimate counts what the process really allocates, from the layouts in
-// core/image.h, scene/compile.h, scene/bvh.cpp, render/packet_renderer.cpp,
-// render/progressive.cpp, render/aov.h, render/image_io.cpp and tools/render_batch.cpp,
+// core/image.h, scene/compile.h, kernels/bvh_build.cpp, render/packet_renderer.cpp (its
+// tile scratch: render/tile_layout.h), render/batch/progressive.cpp, render/aov.h,
+// render/batch/result_exr.cpp, render/image/png.cpp and render/batch/frame_loop.cpp,
 // plus the process's own fixed footprint and the parse of a scene file; it is meant to be
 // an upper bound of the peak resident set size (tests/tools/memory_estimate_test.cpp
 // measures it). It errs on the high side: the packet path's per-thread ray streams are
@@ -18,7 +19,7 @@
 #include <string>
 #include <string_view>
 
-#include "scene/accel.h"
+#include "render/accel.h"
 #include "scene/scene.h"
 
 namespace octray {
@@ -77,6 +78,11 @@ RenderMemoryEstimate estimate_load_memory(std::uint64_t file_bytes);
 // exceed `limit_bytes`: a huge file is refused before it is read.
 void check_load_memory_limit(const std::string& path, std::uint64_t file_bytes,
                              std::uint64_t limit_bytes);
+
+// This machine's physical memory in bytes (sysconf), 0 if unknown: the limit for commands
+// that render a whole scene without a --max-memory of their own (`octray verify`). Whether
+// an image fits is the render's question, never the scene's (validate_scene).
+std::uint64_t machine_memory_bytes();
 
 // "1048576", "512K", "512M", "4G", "1T" (binary units, optional "iB"/"B" suffix, case
 // insensitive); nullopt for anything else, zero, or a size over UINT64_MAX bytes.

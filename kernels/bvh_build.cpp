@@ -1,0 +1,301 @@
+// The sphere BVH builder (kernels/bvh_build.h): the binary tree by binned SAH
+// (kernels/bvh_sah.cpp), then collapsed into 8-wide nodes (Wald et al. 2008, "Getting rid
+// of packets"; embree's BVH8 collapse: open the child with the largest surface area until
+// 8 children) and laid out.
+//
+// Determinism: the binary tree is the same for any thread count (kernels/bvh_sah.cpp); the
+// 8-wide collapse hands large subtrees to tasks, and one pass then writes every node to its
+// place in child order, whichever task finished first.
+
+#include "kernels/bvh_build.h"
+
+#include <emmintrin.h>
+#include <math.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "kernels/bvh_sah.h"
+
+namespace octray {
+
+std::size_t SphereBvh::memory_bytes() const {
+    return nodes.size() * sizeof(BvhNode8) +
+           cx.size() * (sizeof(float) * 4 + sizeof(std::uint32_t));
+}
+
+double SphereBvh::bytes_per_sphere() const {
+    return sphere_count > 0 ? static_cast<double>(memory_bytes()) / sphere_count : 0.0;
+}
+
+namespace {
+
+using namespace bvh_sah;
+
+// The 8-wide collapse hands subtrees of this many spheres or more to tasks of their own.
+constexpr std::uint32_t kParallelCollapse = 1024;
+
+// The 8-wide nodes of a subtree, its root first, inner child references relative to its
+// own first node; the subtrees collapsed by tasks of their own (`parts`) are not in
+// `nodes`, and the child slots that will point at them (`links`) hold kBvhEmpty.
+struct Collapsed {
+    struct Link {
+        std::uint32_t node, child;
+    };
+    UninitializedVector<BvhNode8, Pages::huge> nodes;  // emit() writes every field
+    std::vector<Collapsed> parts;
+    std::vector<Link> links;  // where parts[i]'s root goes
+    std::size_t total = 0;    // nodes with all the parts'
+    std::uint32_t leaf_count = 0;
+    std::uint32_t depth = 0;
+
+    // Writes the subtree's nodes to dst[offset, offset + total): its own nodes, then each
+    // part's after them, in order (so the same bytes for any number of threads), with
+    // their references made absolute. Each node is copied once.
+    void flatten(BvhNode8* dst, std::uint32_t offset) const {
+        std::vector<std::uint32_t> part_offset(parts.size());
+        auto next = static_cast<std::uint32_t>(offset + nodes.size());
+        for (std::size_t i = 0; i < parts.size(); ++i) {
+            part_offset[i] = next;
+            next += static_cast<std::uint32_t>(parts[i].total);
+        }
+        tbb::parallel_invoke(
+            [&] {
+                for (std::size_t k = 0; k < nodes.size(); ++k) {
+                    BvhNode8 node = nodes[k];
+                    for (std::uint32_t& child : node.child)
+                        if ((child & kBvhLeafBit) == 0) child += offset;  // kBvhEmpty: leaf bit
+                    dst[offset + k] = node;
+                }
+                for (std::size_t i = 0; i < parts.size(); ++i)
+                    dst[offset + links[i].node].child[links[i].child] = part_offset[i];
+            },
+            [&] {
+                tbb::parallel_for(std::size_t{0}, parts.size(), [&](std::size_t i) {
+                    parts[i].flatten(dst, part_offset[i]);
+                });
+            });
+    }
+};
+
+class Collapser {
+  public:
+    explicit Collapser(const BinaryNode* binary) : binary_(binary) {}
+
+    // Collapses the binary subtree at `slot` (spheres [b, e), at 8-wide level `depth`) into
+    // `out`, its root at out.nodes[0]. Subtrees of kParallelCollapse spheres or more are
+    // collapsed by tasks of their own into out.parts.
+    void collapse(std::uint32_t slot, std::uint32_t b, std::uint32_t e, std::uint32_t depth,
+                  Collapsed& out) const {
+        std::vector<Deferred> deferred;
+        emit(slot, b, e, depth, out, deferred);
+        out.total = out.nodes.size();
+        if (deferred.empty()) return;
+        out.parts.resize(deferred.size());
+        tbb::parallel_for(std::size_t{0}, deferred.size(), [&](std::size_t i) {
+            const Deferred& d = deferred[i];
+            collapse(d.slot, d.b, d.e, d.depth, out.parts[i]);
+        });
+        for (const Collapsed& part : out.parts) {
+            out.total += part.total;
+            out.leaf_count += part.leaf_count;
+            out.depth = std::max(out.depth, part.depth);
+        }
+    }
+
+  private:
+    // A subtree left for a task of its own (its child slot: the matching Collapsed::links).
+    struct Deferred {
+        std::uint32_t slot, b, e, depth;
+    };
+
+    std::uint32_t emit(std::uint32_t slot, std::uint32_t b, std::uint32_t e,
+                       std::uint32_t depth, Collapsed& out,
+                       std::vector<Deferred>& deferred) const {
+        out.depth = std::max(out.depth, depth);
+        // A binary node to become a child: its spheres, its split (0: a leaf), its area.
+        struct Child {
+            std::uint32_t slot, b, e, mid;
+            float area;
+            std::uint32_t right_slot() const { return slot + 2 * (mid - b); }
+        };
+        const auto child = [&](std::uint32_t s, std::uint32_t cb, std::uint32_t ce) {
+            const Child c{s, cb, ce, binary_[s].mid, half_area(s)};
+            // An inner node's right child lies past its left subtree, far away in memory
+            // for a large one: fetched now, it is there when the node is opened.
+            if (c.mid != 0)
+                _mm_prefetch(reinterpret_cast<const char*>(&binary_[c.right_slot()]),
+                             _MM_HINT_T0);
+            return c;
+        };
+        Child children[kBvhWidth];
+        std::uint32_t count = 0;
+        const auto open = [&](const Child& c, Child& first, Child& second) {
+            first = child(c.slot + 1, c.b, c.mid);
+            second = child(c.right_slot(), c.mid, c.e);
+        };
+        children[count++] = child(slot, b, e);
+        // Open the inner child with the largest surface area (the root first) until there
+        // are 8.
+        while (count < kBvhWidth) {
+            int pick = -1;
+            float pick_area = -1.0f;
+            for (std::uint32_t i = 0; i < count; ++i)
+                if (children[i].mid != 0 && children[i].area > pick_area)
+                    pick = static_cast<int>(i), pick_area = children[i].area;
+            if (pick < 0) break;
+            Child first, second;
+            open(children[pick], first, second);
+            for (std::uint32_t i = count; i > static_cast<std::uint32_t>(pick) + 1; --i)
+                children[i] = children[i - 1];
+            children[pick] = first;
+            children[pick + 1] = second;
+            ++count;
+        }
+
+        // Largest box first: the any-hit traversals take children in node order, and a ray
+        // that meets a node meets its larger children more often (the SAH's odds), so an
+        // occluder tends to be found sooner. Closest-hit orders children by distance.
+        // (A stable insertion sort: at most 8 children.)
+        for (std::uint32_t i = 1; i < count; ++i) {
+            const Child c = children[i];
+            std::uint32_t j = i;
+            for (; j > 0 && children[j - 1].area < c.area; --j) children[j] = children[j - 1];
+            children[j] = c;
+        }
+        const auto index = static_cast<std::uint32_t>(out.nodes.size());
+        out.nodes.emplace_back();
+        std::uint32_t refs[kBvhWidth];
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const Child& c = children[i];
+            if (c.mid == 0) {
+                ++out.leaf_count;
+                refs[i] = kBvhLeafBit | (c.b << kBvhLeafCountBits) | (c.e - c.b - 1);
+            } else if (c.e - c.b >= kParallelCollapse) {
+                deferred.push_back({c.slot, c.b, c.e, depth + 1});
+                out.links.push_back({index, i});
+                refs[i] = kBvhEmpty;  // set by Collapsed::flatten()
+            } else {
+                refs[i] = emit(c.slot, c.b, c.e, depth + 1, out, deferred);
+            }
+        }
+        BvhNode8& node = out.nodes[index];  // after the recursion: emplace_back moves nodes
+        for (std::uint32_t i = 0; i < kBvhWidth; ++i) {
+            const bool used = i < count;
+            const BinaryNode* bn = used ? &binary_[children[i].slot] : nullptr;
+            node.min_x[i] = used ? bn->lo[0] : kInf, node.max_x[i] = used ? bn->hi[0] : -kInf;
+            node.min_y[i] = used ? bn->lo[1] : kInf, node.max_y[i] = used ? bn->hi[1] : -kInf;
+            node.min_z[i] = used ? bn->lo[2] : kInf, node.max_z[i] = used ? bn->hi[2] : -kInf;
+            node.child[i] = used ? refs[i] : kBvhEmpty;
+        }
+        return index;
+    }
+
+    float half_area(std::uint32_t slot) const {
+        const BinaryNode& b = binary_[slot];
+        const float dx = b.hi[0] - b.lo[0], dy = b.hi[1] - b.lo[1], dz = b.hi[2] - b.lo[2];
+        return dx * dy + dy * dz + dz * dx;
+    }
+
+    const BinaryNode* binary_;
+};
+
+}  // namespace
+
+SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::uint32_t n = spheres.count;
+    // Sphere indices travel as exact floats through the build (as hit ids do in the
+    // kernels): at most 2^24, the most objects a compiled scene has.
+    if (n > (1u << 24)) throw std::invalid_argument("a sphere BVH holds at most 2^24 spheres");
+    SphereBvh bvh;
+    bvh.sphere_count = n;
+    if (n == 0) {
+        bvh.build_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return bvh;
+    }
+
+    // The builder's buffers (references twice, binary nodes) on huge pages: core/aligned.h.
+    using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef, Pages::huge>>;
+    PrimRefs refs(n);
+    // Each sphere's box c ± sqrt(r2), rounded outwards: it holds every point of the sphere
+    // the kernels intersect (which knows only r2).
+    tbb::parallel_for(
+        tbb::blocked_range<std::uint32_t>(0, n, 4096),
+        [&](const tbb::blocked_range<std::uint32_t>& r) {
+            // c -+ r rounded outwards in float: sqrtf is exact to half an
+            // ulp, the factor and the relative and absolute steps cover
+            // every rounding after it.
+            const __m128 grow_r = _mm_set1_ps(1.0f + 0x1.0p-21f);
+            const __m128 rel = _mm_set1_ps(0x1.0p-21f);
+            const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+            const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
+            for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                const auto index = static_cast<float>(i);
+                const __m128 c = _mm_setr_ps(spheres.cx[i], spheres.cy[i], spheres.cz[i], 0.0f);
+                const __m128 radius = _mm_mul_ps(_mm_set1_ps(sqrtf(spheres.r2[i])), grow_r);
+                __m128 lo = _mm_sub_ps(c, radius), hi = _mm_add_ps(c, radius);
+                const auto step = [&](__m128 v) {
+                    return _mm_add_ps(_mm_mul_ps(_mm_and_ps(v, abs_mask), rel), tiny);
+                };
+                lo = _mm_sub_ps(lo, step(lo));
+                hi = _mm_add_ps(hi, step(hi));
+                alignas(16) float l[4], h[4];
+                _mm_store_ps(l, lo);
+                _mm_store_ps(h, hi);
+                refs[i].box.lo = _mm_setr_ps(l[0], l[1], l[2], index);
+                refs[i].box.hi = _mm_setr_ps(h[0], h[1], h[2], index);
+            }
+        });
+
+    // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
+    std::vector<BinaryNode, UninitializedAllocator<BinaryNode, Pages::huge>> binary(
+        2 * static_cast<std::size_t>(n) - 1);
+    {
+        PrimRefs scratch(n);
+        build_binary_tree(refs.data(), scratch.data(), binary.data(),
+                          range_bounds(refs.data(), 0, n), n);
+    }
+    const Box root{_mm_setr_ps(binary[0].lo[0], binary[0].lo[1], binary[0].lo[2], 0.0f),
+                   _mm_setr_ps(binary[0].hi[0], binary[0].hi[1], binary[0].hi[2], 0.0f)};
+
+    // 8-wide nodes: preorder, but for the subtrees collapsed by tasks of their own.
+    Collapsed collapsed;
+    Collapser(binary.data()).collapse(0, 0, n, 1, collapsed);
+    bvh.nodes.resize(collapsed.total);
+    collapsed.flatten(bvh.nodes.data(), 0);
+    bvh.leaf_count = collapsed.leaf_count;
+    bvh.depth = collapsed.depth;
+    binary = {};
+
+    // The spheres in leaf order, padded with a packet of never-hit entries.
+    const std::uint32_t padded = n + kBvhWidth;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    bvh.cx.resize(padded), bvh.cy.resize(padded), bvh.cz.resize(padded);
+    bvh.r2.resize(padded), bvh.object.resize(padded);
+    for (std::uint32_t i = n; i < padded; ++i)
+        bvh.cx[i] = bvh.cy[i] = bvh.cz[i] = bvh.r2[i] = nan, bvh.object[i] = 0u;
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) {
+                          for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                              const std::uint32_t s = refs[i].sphere();
+                              bvh.cx[i] = spheres.cx[s], bvh.cy[i] = spheres.cy[s];
+                              bvh.cz[i] = spheres.cz[s], bvh.r2[i] = spheres.r2[s];
+                              bvh.object[i] = spheres.object[s];
+                          }
+                      });
+
+    for (int a = 0; a < 3; ++a) bvh.lo[a] = root.lo_at(a), bvh.hi[a] = root.hi_at(a);
+    bvh.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return bvh;
+}
+
+}  // namespace octray

@@ -1,0 +1,357 @@
+// Binned SAH (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies")
+// on a binary tree built in parallel over subtrees: the first half of the sphere BVH
+// builder (kernels/bvh_sah.h; the 8-wide collapse is kernels/bvh_build.cpp).
+//
+// Determinism: every decision depends only on the spheres of a subtree and its place in
+// the tree. Binning reduces boxes with min/max and counts with integer sums (both exact,
+// so any TBB split gives the same bins); a partition is one serial pass over its range; each
+// binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
+// preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
+// depends on which thread got there first.
+
+#include "kernels/bvh_sah.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace octray::bvh_sah {
+namespace {
+
+// The bins of a range: 8 + n/20 per axis up to kBins (n spheres). Most nodes are small,
+// and a node's bins are cleared, filled and swept whatever its size. Maps a center to its
+// bin along each axis; the partition uses the same function, so it agrees with the bins'
+// counts exactly.
+struct BinMapping {
+    __m128 lo;
+    __m128 scale;        // 0 on an axis without extent (and in w)
+    int count;           // bins per axis, 8 ... kBins
+    __m128 extent_mask;  // all ones in the lanes of axes with extent
+
+    BinMapping(const Box& centers, std::uint32_t n) {
+        count = static_cast<int>(std::min<std::uint32_t>(8 + n / 20, kBins));
+        alignas(16) float s[4] = {0, 0, 0, 0};
+        for (int a = 0; a < 3; ++a) {
+            const float extent = centers.hi_at(a) - centers.lo_at(a);
+            // Slightly fewer than `count` bins per extent, so the top center maps to the
+            // last bin rather than past it (clamped anyway).
+            s[a] = extent > 0.0f ? (static_cast<float>(count) * 0.99999f) / extent : 0.0f;
+            if (!(s[a] < kInf)) s[a] = 0.0f;  // denormal extent
+        }
+        lo = centers.lo;
+        scale = _mm_load_ps(s);
+        extent_mask = _mm_cmpgt_ps(scale, _mm_setzero_ps());
+    }
+    __m128i bins(__m128 center) const {
+        __m128 k = _mm_mul_ps(_mm_sub_ps(center, lo), scale);
+        k = _mm_min_ps(_mm_max_ps(k, _mm_setzero_ps()),
+                       _mm_set1_ps(static_cast<float>(count - 1)));
+        return _mm_cvttps_epi32(k);
+    }
+};
+
+// Lanes of `a` where `mask` is set, else lanes of `b`.
+__m128 select(__m128 mask, __m128 a, __m128 b) {
+    return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+__m128i select(__m128 mask, __m128i a, __m128i b) {
+    const __m128i m = _mm_castps_si128(mask);
+    return _mm_or_si128(_mm_and_si128(m, a), _mm_andnot_si128(m, b));
+}
+
+// Per axis and bin: the spheres' boxes and their count (the children's center bounds come
+// out of the partition, which visits every sphere anyway). Counts are kept per bin with
+// the three axes in lanes, as the sweep reads them.
+struct Bins {
+    Box box[3][kBins];
+    alignas(16) std::int32_t count[kBins][4];
+
+    explicit Bins(int bins) {
+        for (int k = 0; k < bins; ++k) {
+            for (int a = 0; a < 3; ++a) box[a][k] = Box{};
+            _mm_store_si128(counts_at(k), _mm_setzero_si128());
+        }
+    }
+    __m128i* counts_at(int k) { return reinterpret_cast<__m128i*>(count[k]); }
+    __m128i counts(int k) const {
+        return _mm_load_si128(reinterpret_cast<const __m128i*>(count[k]));
+    }
+    void add(const PrimRef& p, const BinMapping& m) {
+        // The three bins out of their lanes by shuffles (a store and three loads would
+        // make each update wait on store forwarding).
+        const __m128i k = m.bins(p.center());
+        const int kx = _mm_cvtsi128_si32(k);
+        const int ky = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0x55));
+        const int kz = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0xaa));
+        box[0][kx].grow(p.box), ++count[kx][0];
+        box[1][ky].grow(p.box), ++count[ky][1];
+        box[2][kz].grow(p.box), ++count[kz][2];
+    }
+    void merge(const Bins& o, int bins) {
+        for (int k = 0; k < bins; ++k) {
+            for (int a = 0; a < 3; ++a) box[a][k].grow(o.box[a][k]);
+            _mm_store_si128(counts_at(k), _mm_add_epi32(counts(k), o.counts(k)));
+        }
+    }
+};
+
+// Ranges from this many spheres on are binned into two sets of bins, even and odd
+// spheres apart, merged at the end.
+constexpr std::uint32_t kTwoWayBinning = 32;
+
+// Bins spheres [b, e) one after the other. Neighbouring spheres tend to fall into the same
+// bins (sphereflakes are generated child by child), and then each update waits for the
+// previous one's store; two sets of bins, merged at the end (exactly: min, max and integer
+// sums), make two independent chains.
+void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+                Bins& bins) {
+    std::uint32_t i = b;
+    if (e - b >= kTwoWayBinning) {
+        Bins odd(m.count);
+        for (; i + 1 < e; i += 2) {
+            bins.add(refs[i], m);
+            odd.add(refs[i + 1], m);
+        }
+        bins.merge(odd, m.count);
+    }
+    for (; i < e; ++i) bins.add(refs[i], m);
+}
+
+void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+               Bins& bins) {
+    if (e - b < kParallelBinning) {
+        bin_serial(refs, b, e, m, bins);
+        return;
+    }
+    bins = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(b, e, kParallelBinning / 4), Bins(m.count),
+        [&](const tbb::blocked_range<std::uint32_t>& r, Bins part) {
+            bin_serial(refs, r.begin(), r.end(), m, part);
+            return part;
+        },
+        [&](Bins x, const Bins& y) {
+            x.merge(y, m.count);
+            return x;
+        });
+}
+
+// Half the surface areas of three boxes, one per lane (w: 0). Empty boxes come out
+// infinite (never used: a split with an empty side is skipped).
+__m128 half_areas(const Box (&boxes)[3]) {
+    __m128 x = _mm_sub_ps(boxes[0].hi, boxes[0].lo), y = _mm_sub_ps(boxes[1].hi, boxes[1].lo);
+    __m128 z = _mm_sub_ps(boxes[2].hi, boxes[2].lo), w = _mm_setzero_ps();
+    _MM_TRANSPOSE4_PS(x, y, z, w);  // now x holds the three boxes' x extents, and so on
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+}
+
+struct Split {
+    int axis = -1;
+    int bin = 0;  // the left side holds bins [0, bin]
+    float cost = kInf;
+    Box left, right;
+};
+
+// The cheapest SAH split over every axis and bin boundary (ties: the lower axis, then
+// the lower bin). The three axes are swept at once, one per lane.
+Split best_split(const Bins& bins, const BinMapping& m) {
+    const int nb = m.count;
+    // Bins [k, nb): their boxes' areas and their counts.
+    alignas(16) float right_area[kBins][4];
+    alignas(16) std::int32_t right_count[kBins][4];
+    Box acc[3];
+    __m128i n = _mm_setzero_si128();
+    for (int k = nb - 1; k > 0; --k) {
+        for (int a = 0; a < 3; ++a) acc[a].grow(bins.box[a][k]);
+        n = _mm_add_epi32(n, bins.counts(k));
+        _mm_store_ps(right_area[k], half_areas(acc));
+        _mm_store_si128(reinterpret_cast<__m128i*>(right_count[k]), n);
+    }
+    // Bins [0, k] against bins [k + 1, nb): the cheapest k per axis.
+    Box left[3];
+    __m128i nl = _mm_setzero_si128();
+    __m128 best_cost = _mm_set1_ps(kInf);
+    __m128i best_bin = _mm_setzero_si128();
+    const __m128i zero = _mm_setzero_si128();
+    for (int k = 0; k < nb - 1; ++k) {
+        for (int a = 0; a < 3; ++a) left[a].grow(bins.box[a][k]);
+        nl = _mm_add_epi32(nl, bins.counts(k));
+        const __m128i nr = _mm_load_si128(reinterpret_cast<const __m128i*>(right_count[k + 1]));
+        const __m128 cost =
+            _mm_add_ps(_mm_mul_ps(half_areas(left), _mm_cvtepi32_ps(nl)),
+                       _mm_mul_ps(_mm_load_ps(right_area[k + 1]), _mm_cvtepi32_ps(nr)));
+        const __m128 empty_side = _mm_castsi128_ps(
+            _mm_or_si128(_mm_cmpeq_epi32(nl, zero), _mm_cmpeq_epi32(nr, zero)));
+        const __m128 better =
+            _mm_andnot_ps(empty_side, _mm_and_ps(m.extent_mask, _mm_cmplt_ps(cost, best_cost)));
+        best_cost = select(better, cost, best_cost);
+        best_bin = select(better, _mm_set1_epi32(k), best_bin);
+    }
+    alignas(16) float costs[4];
+    alignas(16) std::int32_t bins_at[4];
+    _mm_store_ps(costs, best_cost);
+    _mm_store_si128(reinterpret_cast<__m128i*>(bins_at), best_bin);
+    Split best;
+    for (int a = 0; a < 3; ++a)
+        if (costs[a] < best.cost) best.axis = a, best.bin = bins_at[a], best.cost = costs[a];
+    if (best.axis >= 0)
+        for (int k = 0; k < nb; ++k)
+            (k <= best.bin ? best.left : best.right).grow(bins.box[best.axis][k]);
+    return best;
+}
+
+// Copies the spheres of [b, e) from `src` to `dst`, those whose center lies in bins
+// [0, bin] of `Axis` first, and returns where the rest begin; the two sides' center
+// bounds come out on the way. Branch-free (which side a sphere goes to is a coin toss
+// the CPU cannot predict): each sphere goes to the next free slot at the front or at the
+// back of [b, e) (the right side comes out reversed). The axis is a template argument so
+// that its lane is picked by a shuffle, not by a round trip through memory.
+template <int Axis>
+std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
+                           const BinMapping& m, int bin, Box& left_centers,
+                           Box& right_centers) {
+    constexpr int kBroadcast = Axis * 0x55;  // _MM_SHUFFLE(Axis, Axis, Axis, Axis)
+    const __m128i last_left = _mm_set1_epi32(bin);
+    const __m128 all_ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    Box lc, rc;
+    PrimRef* front = dst + b;
+    PrimRef* back = dst + e;
+    for (std::uint32_t i = b; i < e; ++i) {
+        const PrimRef p = src[i];
+        const __m128 c = p.center();
+        // All ones in every lane where the bin on `Axis` lies right of `bin`.
+        const __m128i right_mask =
+            _mm_shuffle_epi32(_mm_cmpgt_epi32(m.bins(c), last_left), kBroadcast);
+        const std::int32_t right = _mm_cvtsi128_si32(right_mask);  // 0 or -1
+        *(right ? back - 1 : front) = p;
+        front += 1 + right;
+        back += right;
+        // The side's bounds grow by the center, the other side's by NaN, which min and
+        // max pass over: minps and maxps return their second operand where either is
+        // NaN, and all ones (the mask) is a NaN.
+        const __m128 to_right = _mm_castsi128_ps(right_mask);
+        const __m128 left_c = _mm_or_ps(c, to_right);
+        const __m128 right_c = _mm_or_ps(c, _mm_xor_ps(to_right, all_ones));
+        lc.lo = _mm_min_ps(left_c, lc.lo), lc.hi = _mm_max_ps(left_c, lc.hi);
+        rc.lo = _mm_min_ps(right_c, rc.lo), rc.hi = _mm_max_ps(right_c, rc.hi);
+    }
+    left_centers = lc;
+    right_centers = rc;
+    return static_cast<std::uint32_t>(front - dst);
+}
+
+std::uint32_t partition(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
+                        const BinMapping& m, int axis, int bin, Box& left_centers,
+                        Box& right_centers) {
+    switch (axis) {
+        case 0:
+            return partition_on<0>(src, dst, b, e, m, bin, left_centers, right_centers);
+        case 1:
+            return partition_on<1>(src, dst, b, e, m, bin, left_centers, right_centers);
+        default:
+            return partition_on<2>(src, dst, b, e, m, bin, left_centers, right_centers);
+    }
+}
+
+class Builder {
+  public:
+    // The spheres start in `refs` and end there in leaf order; the partitions move them
+    // back and forth between `refs` and `scratch` (as many spheres), level by level.
+    Builder(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes)
+        : refs_(refs), scratch_(scratch), nodes_(nodes) {}
+
+    void build(const RangeBounds& rb, std::uint32_t n) { build(0, 0, n, rb, 0, refs_); }
+
+  private:
+    // Builds the subtree of spheres [b, e), which lie in `src` (refs_ or scratch_), into
+    // slots [slot, slot + 2(e - b) - 1).
+    void build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
+               std::uint32_t depth, PrimRef* src) {
+        BinaryNode& node = nodes_[slot];
+        for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
+        node.mid = 0;
+        const std::uint32_t n = e - b;
+        const auto leaf = [&] {
+            if (src != refs_) std::copy(src + b, src + e, refs_ + b);
+        };
+        // A split costs at least one traversal step, more than testing this many spheres:
+        // the SAH would choose the leaf, so the binning is skipped.
+        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return leaf();
+
+        PrimRef* const other = src == refs_ ? scratch_ : refs_;
+        PrimRef* children_src = src;
+        std::uint32_t mid = 0;
+        RangeBounds left, right;
+        if (depth < kMaxSahDepth) {
+            const BinMapping m(rb.centers, n);
+            Bins bins(m.count);
+            bin_range(src, b, e, m, bins);
+            const Split split = best_split(bins, m);
+            const float area = rb.box.half_area();
+            const float leaf_cost = kIntersectionCost * static_cast<float>(n);
+            const float split_cost =
+                split.axis < 0 ? kInf
+                : area > 0.0f  ? kTraversalCost + kIntersectionCost * split.cost / area
+                               : kTraversalCost + kIntersectionCost * static_cast<float>(n);
+            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return leaf();
+            if (split.axis >= 0) {
+                mid = partition(src, other, b, e, m, split.axis, split.bin, left.centers,
+                                right.centers);
+                children_src = other;
+                left.box = split.left;
+                right.box = split.right;
+            }
+        } else if (n <= kMaxLeafSize) {
+            return leaf();
+        }
+        // Every center in one bin (coincident spheres) or too deep: the middle index.
+        if (mid <= b || mid >= e) {
+            mid = b + n / 2;
+            left = range_bounds(src, b, mid);
+            right = range_bounds(src, mid, e);
+        }
+        node.mid = mid;
+        const std::uint32_t left_slot = slot + 1, right_slot = slot + 2 * (mid - b);
+        if (n >= kParallelSubtree) {
+            tbb::parallel_invoke(
+                [&] { build(left_slot, b, mid, left, depth + 1, children_src); },
+                [&] { build(right_slot, mid, e, right, depth + 1, children_src); });
+        } else {
+            build(left_slot, b, mid, left, depth + 1, children_src);
+            build(right_slot, mid, e, right, depth + 1, children_src);
+        }
+    }
+
+    PrimRef* refs_;
+    PrimRef* scratch_;
+    BinaryNode* nodes_;
+};
+
+}  // namespace
+
+RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e) {
+    const auto serial = [refs](std::uint32_t first, std::uint32_t last, RangeBounds r) {
+        for (std::uint32_t i = first; i < last; ++i) r.grow(refs[i]);
+        return r;
+    };
+    if (e - b < kParallelBinning) return serial(b, e, RangeBounds{});
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(b, e, kParallelBinning / 4), RangeBounds{},
+        [&](const tbb::blocked_range<std::uint32_t>& r, RangeBounds init) {
+            return serial(r.begin(), r.end(), init);
+        },
+        [](RangeBounds x, const RangeBounds& y) {
+            x.grow(y);
+            return x;
+        });
+}
+
+void build_binary_tree(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes,
+                       const RangeBounds& rb, std::uint32_t n) {
+    Builder(refs, scratch, nodes).build(rb, n);
+}
+
+}  // namespace octray::bvh_sah
