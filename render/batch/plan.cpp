@@ -2,7 +2,6 @@
 
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_invoke.h>
-#include <openssl/evp.h>
 
 #include <chrono>
 #include <filesystem>
@@ -11,7 +10,7 @@
 #include <string_view>
 #include <tuple>
 
-#include "core/sha256.h"
+#include "render/batch/digest.h"
 #include "render/batch/output_paths.h"
 #include "render/batch/spec.h"
 #include "scene/animation.h"
@@ -23,38 +22,6 @@ namespace octray::batch {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The scene's identity for the EXR (plan.h, load_scene_and_digest): hashing a built-in's
-// spec costs nothing where serializing random:1048576 to JSON and hashing that took
-// seconds. A file's bytes are hashed by OpenSSL's libcrypto, which uses the CPU's SHA
-// instructions: 0.13 s for a 114 MB scene against 0.88 s for the portable core/sha256.h.
-class FileDigest {
-  public:
-    FileDigest() : ctx_(EVP_MD_CTX_new(), &EVP_MD_CTX_free) {
-        if (!ctx_ || EVP_DigestInit_ex(ctx_.get(), EVP_sha256(), nullptr) != 1)
-            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestInit_ex failed");
-    }
-    void update(std::string_view bytes) {
-        if (EVP_DigestUpdate(ctx_.get(), bytes.data(), bytes.size()) != 1)
-            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestUpdate failed");
-    }
-    std::string hex() {
-        unsigned char digest[EVP_MAX_MD_SIZE];
-        unsigned int size = 0;
-        if (EVP_DigestFinal_ex(ctx_.get(), digest, &size) != 1)
-            throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestFinal_ex failed");
-        static constexpr char kHex[] = "0123456789abcdef";
-        std::string out;
-        for (unsigned int i = 0; i < size; ++i) {
-            out += kHex[digest[i] >> 4];
-            out += kHex[digest[i] & 15];
-        }
-        return out;
-    }
-
-  private:
-    std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> ctx_;
-};
 
 // The frames of one scene: `spec`, else the scene's own (0..frames-1, or 0 for a still).
 std::vector<int> frames_of(const Scene& scene, const std::string& spec) {
@@ -72,7 +39,9 @@ std::string default_pattern(bool sequence) {
 
 }  // namespace
 
-// The hash takes about a third of the parse's time, so the two run as two TBB tasks (one
+// The scene's identity for the EXR: hashing a built-in's spec costs nothing where
+// serializing random:1048576 to JSON and hashing that took seconds. The hash takes about a
+// third of the parse's time, so the two run as two TBB tasks (one
 // after the other with one thread).
 std::pair<Scene, std::string> load_scene_and_digest(const std::string& spec, int threads) {
     if (is_builtin_scene(spec)) return {make_builtin_scene(spec), sha256_hex(spec)};
@@ -86,9 +55,9 @@ std::pair<Scene, std::string> load_scene_and_digest(const std::string& spec, int
     std::string digest;
     tbb::parallel_invoke(
         [&] {
-            FileDigest file_digest;
+            Sha256 file_digest;
             file_digest.update(text);
-            digest = file_digest.hex();
+            digest = file_digest.hex_digest();
         },
         [&] { scene = parse_scene_json(text, spec, text.capacity()); });
     return {std::move(scene), std::move(digest)};

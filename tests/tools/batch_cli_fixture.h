@@ -32,8 +32,8 @@
 #include <thread>
 #include <vector>
 
-#include "core/sha256.h"
 #include "render/batch/claim_owner.h"
+#include "render/batch/digest.h"
 #include "render/image/image_read.h"
 #include "run_octray.h"
 

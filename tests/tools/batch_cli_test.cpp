@@ -244,7 +244,7 @@ TEST_F(BatchCliTest, EveryFrameCarriesItsAttributes) {
     const std::string bytes((std::istreambuf_iterator<char>(scene_file)), {});
     ASSERT_NE(h.findTypedAttribute<Imf::StringAttribute>("octray.sceneSha256"), nullptr);
     EXPECT_EQ(h.typedAttribute<Imf::StringAttribute>("octray.sceneSha256").value(),
-              sha256_hex(bytes));
+              batch::sha256_hex(bytes));
 }
 
 // A built-in is identified by its spec string as given: hashing it is free, where the JSON
@@ -256,7 +256,7 @@ TEST_F(BatchCliTest, ABuiltInsDigestIsItsSpecString) {
     const auto* digest =
         file.header().findTypedAttribute<Imf::StringAttribute>("octray.sceneSha256");
     ASSERT_NE(digest, nullptr);
-    EXPECT_EQ(digest->value(), sha256_hex(spec));
+    EXPECT_EQ(digest->value(), batch::sha256_hex(spec));
 }
 
 // --stats: one line per frame with the seconds of each phase (issue 19).

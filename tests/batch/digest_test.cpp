@@ -1,12 +1,12 @@
-// SHA-256 against the FIPS 180-4 examples and sha256sum.
+// SHA-256 (render/batch/digest.h) against the FIPS 180-4 examples and sha256sum.
 
-#include "core/sha256.h"
+#include "render/batch/digest.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 TEST(Sha256, EmptyInput) {
@@ -34,4 +34,4 @@ TEST(Sha256, MillionAsInPiecesEqualsOneUpdate) {
 }
 
 }  // namespace
-}  // namespace octray
+}  // namespace octray::batch
