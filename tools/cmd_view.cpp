@@ -91,9 +91,11 @@ void run_view(const ViewArguments& args) {
 
     view::ViewSettings settings;
     settings.path = *parse_render_path(args.path);
-    const auto isa = parse_isa(args.isa);
-    if (!isa) throw UsageError("--isa: unknown instruction set \"" + args.isa + "\"");
-    settings.isa = *isa;
+    try {
+        settings.isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
+    } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--isa: ") + e.what());
+    }
     settings.threads = args.threads;
     settings.preview_divisor = args.preview_divisor;
 

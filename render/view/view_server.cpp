@@ -3,7 +3,9 @@
 #include <httplib.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <mutex>
@@ -130,6 +132,7 @@ struct ViewServer::Impl {
     httplib::Server server;
     std::thread listener;
     std::atomic<bool> stopping{false};
+    std::atomic<bool> listener_done{false};
     std::mutex stop_mutex;
 
     Impl(ViewSession& s, ServerOptions o) : session(s), options(std::move(o)) {
@@ -193,20 +196,28 @@ void ViewServer::Impl::routes() {
                     {"full_width", session.scene().image.width},
                     {"full_height", session.scene().image.height}};
         if (const auto frame = session.latest()) status["frame"] = frame_json(*frame);
+        if (const std::string error = session.error(); !error.empty()) status["error"] = error;
         res.set_content(status.dump(), "application/json");
     });
 
     server.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
         res.set_chunked_content_provider(
-            "text/event-stream",
-            [this, last = std::uint64_t{0}](std::size_t, httplib::DataSink& sink) mutable {
+            "text/event-stream", [this, last = std::uint64_t{0}, last_error = std::string()](
+                                     std::size_t, httplib::DataSink& sink) mutable {
                 const auto frame = session.wait_newer(last, kHeartbeat);
                 if (stopping || session.stopped()) {
                     sink.done();
                     return true;
                 }
                 std::string message = ": heartbeat\n\n";
-                if (frame && frame->generation > last) {
+                if (std::string error = session.error(); error != last_error) {
+                    last_error = error;
+                    if (!error.empty()) {
+                        message =
+                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
+                            "\n\n";
+                    }
+                } else if (frame && frame->generation > last) {
                     last = frame->generation;
                     message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
                 }
@@ -265,15 +276,18 @@ ViewServer::ViewServer(ViewSession& session, ServerOptions options)
     : impl_(std::make_unique<Impl>(session, std::move(options))) {
     impl_->routes();
     const std::string& host = impl_->options.bind;
+    const auto failure = [&](int port) {
+        const int error = errno;
+        return std::runtime_error("cannot listen on " + host + ":" + std::to_string(port) +
+                                  (error != 0 ? std::string(": ") + std::strerror(error) : ""));
+    };
+    errno = 0;
     if (impl_->options.port == 0) {
         impl_->port = impl_->server.bind_to_any_port(host);
-        if (impl_->port <= 0)
-            throw std::runtime_error("cannot listen on " + host + ": " + std::strerror(errno));
+        if (impl_->port <= 0) throw failure(0);
     } else {
         if (!impl_->server.bind_to_port(host, impl_->options.port))
-            throw std::runtime_error("cannot listen on " + host + ":" +
-                                     std::to_string(impl_->options.port) + ": " +
-                                     std::strerror(errno));
+            throw failure(impl_->options.port);
         impl_->port = impl_->options.port;
     }
     impl_->cookie_name = "octray_token_" + std::to_string(impl_->port);
@@ -287,9 +301,12 @@ ViewServer::~ViewServer() {
 void ViewServer::start() {
     if (impl_->stopping) return;
     std::signal(SIGPIPE, SIG_IGN);
-    impl_->listener = std::thread([this] { impl_->server.listen_after_bind(); });
+    impl_->listener = std::thread([this] {
+        impl_->server.listen_after_bind();
+        impl_->listener_done = true;
+    });
     // stop() before listen_after_bind() runs would be lost: wait until it does.
-    while (!impl_->server.is_running() && !impl_->stopping)
+    while (!impl_->server.is_running() && !impl_->stopping && !impl_->listener_done)
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 

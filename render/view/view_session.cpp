@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <utility>
 
 #include "render/packet_renderer.h"
@@ -62,6 +63,11 @@ std::shared_ptr<const ViewFrame> ViewSession::wait_newer(
     return latest_;
 }
 
+std::string ViewSession::error() const {
+    std::lock_guard lock(mutex_);
+    return error_;
+}
+
 Camera ViewSession::camera() const {
     std::lock_guard lock(mutex_);
     return camera_;
@@ -116,6 +122,7 @@ void ViewSession::run() {
         const bool preview = moving_ && !(version == done_version && !refined);
         moving_ = false;
         cancel_ = false;
+        error_.clear();
         lock.unlock();
         try {
             if (preview) {
@@ -128,6 +135,15 @@ void ViewSession::run() {
             done_version = version;
         } catch (const RenderCancelled&) {
             // A new camera or stop(): the loop picks up whichever it was.
+        } catch (const std::exception& e) {
+            // The thread must not end the process; the page shows why, and the next
+            // camera tries again.
+            lock.lock();
+            error_ = e.what();
+            done_version = version;
+            refined = true;
+            changed_.notify_all();
+            continue;
         }
         lock.lock();
     }

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 
 #include "core/image.h"
@@ -68,6 +69,10 @@ class ViewSession {
     std::uint64_t set_camera(const Camera& camera, bool moving);
     Camera camera() const;
 
+    // Why the latest camera could not be rendered (a render that threw, such as out of
+    // memory), empty if it could; cleared by the next camera.
+    std::string error() const;
+
     // Ends the render thread (the pass in flight is abandoned) and wakes every waiter.
     void stop();
     bool stopped() const;
@@ -89,6 +94,7 @@ class ViewSession {
     bool stop_ = false;
     std::uint64_t generation_ = 0;
     std::shared_ptr<const ViewFrame> latest_;
+    std::string error_;
     std::atomic<bool> cancel_{false};  // what the renderers poll between tiles
 
     std::thread thread_;

@@ -6,7 +6,7 @@
 Starts `octray view` on a free port, opens the URL it prints, and checks that the page
 shows the refined picture (the canvas has non-black pixels and says spp 4), that a drag
 across the canvas orbits the camera (the server reports a new camera at the same distance
-from the same look-at point, and the canvas changes), that the server refuses the page
+from the same look-at point, and the canvas changes), that the wheel dollies, that the server refuses the page
 without the token, and that SIGINT stops the command with status 0. Screenshots go to
 ARTIFACTS_DIR. Exits 77 (ctest's SKIP_RETURN_CODE) when Chromium, chromedriver or
 python3-selenium is missing.
@@ -75,6 +75,7 @@ def run(octray, artifacts):
         from selenium import webdriver
         from selenium.webdriver.chrome.service import Service
         from selenium.webdriver.common.action_chains import ActionChains
+        from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
         from selenium.webdriver.support.ui import WebDriverWait
     except ImportError:
         return skip("python3-selenium is not installed")
@@ -105,7 +106,8 @@ def run(octray, artifacts):
                 options.add_argument(argument)
             browser = webdriver.Chrome(service=Service(driver), options=options)
             try:
-                status = check_page(browser, url, artifacts, ActionChains, WebDriverWait)
+                status = check_page(browser, url, artifacts, ActionChains, ScrollOrigin,
+                                    WebDriverWait)
             finally:
                 browser.quit()
     finally:
@@ -122,7 +124,7 @@ def run(octray, artifacts):
     return status
 
 
-def check_page(browser, url, artifacts, ActionChains, WebDriverWait):
+def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWait):
     browser.set_page_load_timeout(WAIT)
     browser.get(url)
     # The refined first picture: the last pass's event, and its PNG drawn on the canvas.
@@ -170,8 +172,25 @@ def check_page(browser, url, artifacts, ActionChains, WebDriverWait):
     _, after = canvas_digest(browser)
     if after == before:
         return fail("the canvas did not change after the drag")
+
+    # The wheel dollies: scrolling down moves the eye away along the view.
+    ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(canvas), 0,
+                                             200).perform()
+
+    def refined_after_wheel(b):
+        frame = fetch_status(url)["frame"]
+        if (frame["camera_version"] <= moved["camera_version"] or frame["preview"]
+                or frame["spp"] != 4):
+            return False
+        return frame
+
+    dollied = WebDriverWait(browser, WAIT).until(refined_after_wheel)
+    r2 = math.dist(dollied["camera"]["eye"], lookat)
+    if not r2 > 1.01 * r1:
+        return fail(f"the wheel did not dolly out: distance {r1} -> {r2}")
     print(f"PASS: first picture {lit} lit pixels; drag moved the eye {eye0} -> {eye1} "
-          f"(camera version {moved['camera_version']}); screenshots in {artifacts}")
+          f"(camera version {moved['camera_version']}); the wheel dollied from {r1:.3f} "
+          f"to {r2:.3f}; screenshots in {artifacts}")
     return 0
 
 
