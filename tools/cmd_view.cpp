@@ -9,11 +9,13 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
 #include "kernels/dispatch.h"
+#include "render/view/view_bench.h"
 #include "render/view/view_server.h"
 #include "render/view/view_session.h"
 #include "scene/animation.h"
@@ -32,6 +34,7 @@ struct ViewArguments {
     int width = 0, height = 0, spp = 0, max_depth = 0;
     int threads = 0;
     int preview_divisor = 4;
+    int bench = 0;  // orbit updates to measure; 0: serve
     std::string path{"simd"};
     std::string isa{"auto"};
 };
@@ -75,8 +78,23 @@ class StopOnSignal {
     std::thread waiter_;
 };
 
+void print_bench(const Scene& scene, const view::ViewSettings& settings,
+                 const view::ViewBenchResult& r) {
+    std::printf("octray view --bench: %s, %s path, %d threads (0 = all)\n",
+                scene.source.c_str(), render_path_name(settings.path), settings.threads);
+    std::printf("first picture: %dx%d at 1 spp after %.3f s\n", r.first_width, r.first_height,
+                r.first_picture_seconds);
+    std::printf(
+        "orbit: %d updates of %dx%d (1 spp, preview) in %.3f s: %.1f updates/s, %.1f Mrays/s, "
+        "PNG %.0f bytes\n",
+        r.updates, r.update_width, r.update_height, r.seconds, r.updates_per_second,
+        r.mrays_per_second, r.png_bytes);
+    std::fflush(stdout);
+}
+
 void run_view(const ViewArguments& args) {
-    StopOnSignal stop_on_signal;  // before any thread is made (TBB's too)
+    std::optional<StopOnSignal> stop_on_signal;
+    if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
     Scene scene = load_scene(args.scene);
     // An animation shows its first frame; the viewer has no time line yet.
     if (scene.animation) {
@@ -99,6 +117,11 @@ void run_view(const ViewArguments& args) {
     settings.threads = args.threads;
     settings.preview_divisor = args.preview_divisor;
 
+    if (args.bench > 0) {
+        print_bench(scene, settings, view::bench_orbit(scene, settings, args.bench));
+        return;
+    }
+
     view::ServerOptions options;
     options.bind = args.bind;
     options.port = args.port;
@@ -111,7 +134,7 @@ void run_view(const ViewArguments& args) {
         throw UsageError(std::string("--bind/--port: ") + e.what());
     }
     server->start();
-    stop_on_signal.watch(*server);
+    stop_on_signal->watch(*server);
     std::cout << "octray view: " << scene.source << " (" << scene.image.width << "x"
               << scene.image.height << ", " << scene.image.spp << " spp) at\n"
               << "  " << server->url() << "\n"
@@ -174,6 +197,14 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->type_name("D")
         ->transform(decimal_integer(1, 64))
         ->capture_default_str();
+    cmd->add_option(
+           "--bench", args->bench,
+           "Serve nothing: measure the time to the first picture and the pictures\n"
+           "a second while the camera orbits, over N updates, " +
+               integer_range_text(1, 1000000) +
+               " (each rendered as a moving\ncamera is and PNG-encoded as for the page)")
+        ->type_name("N")
+        ->transform(decimal_integer(1, 1000000));
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer)")
         ->type_name("PATH")
@@ -196,7 +227,8 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray view                                  # the built-in whitted scene\n"
         "  octray view scene.json --port 0              # any free port\n"
-        "  octray view random:1024 --width 640 --height 360 --spp 16\n\n" +
+        "  octray view random:1024 --width 640 --height 360 --spp 16\n"
+        "  octray view whitted --width 640 --height 360 --threads 2 --bench 200\n\n" +
         exit_code_help());
     cmd->callback([args, &run] { run.action = [args] { run_view(*args); }; });
 }

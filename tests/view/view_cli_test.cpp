@@ -65,4 +65,18 @@ TEST(ViewCli, AForcedIsaIsChecked) {
     EXPECT_EQ(r.status, 2) << r.output;
 }
 
+// --bench serves nothing: it renders the first picture and N orbit updates and reports
+// their rates (the figures themselves are not checked: no timing in tests).
+TEST(ViewCli, BenchReportsTheFirstPictureAndTheOrbitUpdates) {
+    const RunResult r = run_octray({"view", "whitted", "--width", "64", "--height", "36",
+                                    "--threads", "1", "--bench", "12"},
+                                   kCwd);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "first picture: 64x36 at 1 spp after ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "orbit: 12 updates of 16x9 (1 spp, preview) in "))
+        << r.output;
+    EXPECT_TRUE(contains(r.output, "updates/s")) << r.output;
+    EXPECT_TRUE(contains(r.output, "Mrays/s")) << r.output;
+}
+
 }  // namespace
