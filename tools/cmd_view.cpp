@@ -37,6 +37,7 @@ struct ViewArguments {
     int bench = 0;  // orbit updates to measure; 0: serve
     std::string path{"simd"};
     std::string isa{"auto"};
+    std::string order{"tiled"};
 };
 
 CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
@@ -116,6 +117,8 @@ void run_view(const ViewArguments& args) {
     }
     settings.threads = args.threads;
     settings.preview_divisor = args.preview_divisor;
+    settings.order =
+        args.order == "frameless" ? view::PixelOrder::frameless : view::PixelOrder::tiled;
 
     if (args.bench > 0) {
         print_bench(scene, settings, view::bench_orbit(scene, settings, args.bench));
@@ -205,6 +208,13 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
                " (each rendered as a moving\ncamera is and PNG-encoded as for the page)")
         ->type_name("N")
         ->transform(decimal_integer(1, 1000000));
+    cmd->add_option("--order", args->order,
+                    "Pixel order: tiled (whole pictures, progressive passes, previews while\n"
+                    "moving) or frameless (8x8 blocks re-rendered in a fixed random order and\n"
+                    "shown as they land, no frame boundaries; Bishop et al. 1994)")
+        ->type_name("ORDER")
+        ->check(quiet(CLI::IsMember({"tiled", "frameless"})))
+        ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer)")
         ->type_name("PATH")

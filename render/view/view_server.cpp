@@ -43,6 +43,7 @@ json frame_json(const ViewFrame& frame) {
         {"pass_seconds", frame.pass_seconds},
         {"frame_seconds", frame.frame_seconds},
         {"mrays_per_second", frame.mrays_per_second},
+        {"coverage", frame.coverage},
         {"camera",
          {{"eye", vec3_json(camera.eye)},
           {"lookat", vec3_json(camera.lookat)},

@@ -1,13 +1,20 @@
 #include "render/view/view_session.h"
 
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
+#include <optional>
 #include <utility>
+#include <vector>
 
 #include "render/packet_renderer.h"
 #include "render/progressive.h"
 #include "render/reference.h"
+#include "render/view/frameless.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 #include "scene/scene_error.h"
@@ -103,6 +110,7 @@ void ViewSession::publish(ViewFrame frame) {
 }
 
 void ViewSession::run() {
+    if (settings_.order == PixelOrder::frameless) return run_frameless();
     std::uint64_t done_version = 0;  // the camera version of the last picture rendered
     bool refined = true;             // whether that picture was the full progressive one
     Clock::time_point last_preview;
@@ -142,6 +150,93 @@ void ViewSession::run() {
             error_ = e.what();
             done_version = version;
             refined = true;
+            changed_.notify_all();
+            continue;
+        }
+        lock.lock();
+    }
+}
+
+// Frameless: one framebuffer, re-rendered a batch of blocks at a time in the permutation
+// of frameless_blocks, continuing where the last camera left off (the oldest pixels are
+// renewed first); each batch is published at once. A camera that stays still is rendered
+// once over (a full sweep), which is then exactly the tiled order's picture.
+void ViewSession::run_frameless() {
+    const int width = scene_.image.width, height = scene_.image.height;
+    const std::vector<PixelRect> blocks =
+        frameless_blocks(width, height, std::max(1, settings_.frameless_block));
+    // About 16 pictures a sweep, of at least 16 blocks each (enough work for the threads).
+    const std::size_t batch_size = std::max<std::size_t>(16, blocks.size() / 16);
+    Image framebuffer(width, height);
+    std::size_t cursor = 0;             // next block of the permutation
+    std::size_t fresh = blocks.size();  // blocks rendered with the current camera
+    std::uint64_t version = 0;
+    Scene scene = scene_;
+    std::optional<CompiledScene> compiled;
+    Clock::time_point camera_start;
+    std::optional<tbb::task_arena> arena;
+    if (settings_.threads > 0) arena.emplace(settings_.threads);
+
+    std::unique_lock lock(mutex_);
+    while (!stop_) {
+        if (camera_version_ == version && fresh >= blocks.size()) {
+            changed_.wait(lock);
+            continue;
+        }
+        const bool new_camera = camera_version_ != version;
+        version = camera_version_;
+        const Camera camera = camera_;
+        if (new_camera) error_.clear();
+        lock.unlock();
+        try {
+            if (new_camera) {
+                scene.camera = camera;
+                if (settings_.path == RenderPath::simd) compiled.emplace(compile_scene(scene));
+                fresh = 0;
+                camera_start = Clock::now();
+            }
+            const std::size_t count = std::min(batch_size, blocks.size() - fresh);
+            std::atomic<std::uint64_t> rays{0};
+            const auto start = Clock::now();
+            const auto render_batch = [&] {
+                tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
+                    const PixelRect& rect = blocks[(cursor + i) % blocks.size()];
+                    RenderOptions options;
+                    options.crop = rect;
+                    const RenderResult result =
+                        compiled ? render_packet(*compiled, options, settings_.isa)
+                                 : render_reference(scene, options);
+                    for (int y = 0; y < rect.height(); ++y)
+                        for (int x = 0; x < rect.width(); ++x)
+                            framebuffer.at(rect.x0 + x, rect.y0 + y) = result.image.at(x, y);
+                    rays += result.rays.total();
+                });
+            };
+            if (arena) {
+                arena->execute(render_batch);
+            } else {
+                render_batch();
+            }
+            cursor = (cursor + count) % blocks.size();
+            fresh += count;
+            ViewFrame frame;
+            frame.image = framebuffer;
+            frame.camera_version = version;
+            frame.camera = camera;
+            frame.spp = scene_.image.spp;
+            frame.target_spp = scene_.image.spp;
+            frame.pass_seconds = seconds_since(start);
+            frame.frame_seconds = seconds_since(camera_start);
+            frame.mrays_per_second =
+                frame.pass_seconds > 0.0
+                    ? static_cast<double>(rays.load()) / frame.pass_seconds / 1e6
+                    : 0.0;
+            frame.coverage = static_cast<double>(fresh) / static_cast<double>(blocks.size());
+            publish(std::move(frame));
+        } catch (const std::exception& e) {
+            lock.lock();
+            error_ = e.what();
+            fresh = blocks.size();
             changed_.notify_all();
             continue;
         }

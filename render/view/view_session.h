@@ -20,7 +20,15 @@
 
 namespace octray::view {
 
+// The order in which a picture's pixels are rendered and shown.
+enum class PixelOrder {
+    tiled,      // whole pictures: progressive passes (and previews while moving)
+    frameless,  // blocks in a fixed random permutation, shown as they land (frameless.h)
+};
+
 struct ViewSettings {
+    PixelOrder order = PixelOrder::tiled;
+    int frameless_block = 8;  // frameless: block side in pixels
     RenderPath path = RenderPath::simd;
     Isa isa = Isa::automatic;
     int threads = 0;          // 0: every core TBB sees
@@ -42,6 +50,9 @@ struct ViewFrame {
     double pass_seconds = 0.0;      // this pass
     double frame_seconds = 0.0;     // every pass so far of this camera
     double mrays_per_second = 0.0;  // this pass: rays traced / pass_seconds
+    // Frameless: the part of the picture rendered with this camera so far (1: all of it,
+    // at the scene's spp; the rest still shows earlier cameras). Tiled: always 1.
+    double coverage = 1.0;
 };
 
 class ViewSession {
@@ -79,6 +90,7 @@ class ViewSession {
 
   private:
     void run();
+    void run_frameless();
     void render_preview(const Camera& camera, std::uint64_t version);
     bool render_passes(const Camera& camera, std::uint64_t version);
     void publish(ViewFrame frame);

@@ -6,7 +6,8 @@
 Starts `octray view` on a free port, opens the URL it prints, and checks that the page
 shows the refined picture (the canvas has non-black pixels and says spp 4), that a drag
 across the canvas orbits the camera (the server reports a new camera at the same distance
-from the same look-at point, and the canvas changes), that the wheel dollies, that the server refuses the page
+from the same look-at point, and the canvas changes), that the wheel dollies, that
+the frameless order converges to the same picture as the tiled one, that the server refuses the page
 without the token, and that SIGINT stops the command with status 0. Screenshots go to
 ARTIFACTS_DIR. Exits 77 (ctest's SKIP_RETURN_CODE) when Chromium, chromedriver or
 python3-selenium is missing.
@@ -38,10 +39,10 @@ def fail(why):
     return 1
 
 
-def start_view(octray):
+def start_view(octray, *extra):
     process = subprocess.Popen(
         [octray, "view", "whitted", "--port", "0", "--width", "160", "--height", "90",
-         "--spp", "4", "--threads", "2"],
+         "--spp", "4", "--threads", "2", *extra],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     for line in process.stdout:
         line = line.strip()
@@ -108,6 +109,8 @@ def run(octray, artifacts):
             try:
                 status = check_page(browser, url, artifacts, ActionChains, ScrollOrigin,
                                     WebDriverWait)
+                if status == 0:
+                    status = check_frameless(browser, octray, artifacts, WebDriverWait)
             finally:
                 browser.quit()
     finally:
@@ -156,7 +159,8 @@ def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWai
         shown = b.execute_script(
             "const c = document.getElementById('view');"
             "return [Number(c.dataset.generation), c.dataset.spp];")
-        return frame if shown[0] >= frame["generation"] and shown[1] == "4" else False
+        ok = shown[0] is not None and shown[0] >= frame["generation"] and shown[1] == "4"
+        return frame if ok else False
 
     moved = WebDriverWait(browser, WAIT).until(refined_after_drag)
     browser.save_screenshot(os.path.join(artifacts, "view_orbited.png"))
@@ -191,6 +195,39 @@ def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWai
     print(f"PASS: first picture {lit} lit pixels; drag moved the eye {eye0} -> {eye1} "
           f"(camera version {moved['camera_version']}); the wheel dollied from {r1:.3f} "
           f"to {r2:.3f}; screenshots in {artifacts}")
+    return 0
+
+
+def check_frameless(browser, octray, artifacts, WebDriverWait):
+    """The frameless order converges to the tiled order's picture: the same canvas pixels
+    as a tiled viewer's refined first picture (the first URL's, before any drag)."""
+    tiled, tiled_url = start_view(octray)
+    frameless, frameless_url = start_view(octray, "--order", "frameless")
+    try:
+        digests = []
+        for url, name, done in (
+                (tiled_url, "view_tiled.png", lambda f: f["spp"] == 4 and not f["preview"]),
+                (frameless_url, "view_frameless.png", lambda f: f["coverage"] == 1)):
+            browser.get(url)
+
+            def converged(b):
+                frame = fetch_status(url)["frame"]
+                if not done(frame):
+                    return False
+                generation = b.execute_script(
+                    "return Number(document.getElementById('view').dataset.generation);")
+                return generation is not None and generation >= frame["generation"]
+
+            WebDriverWait(browser, WAIT).until(converged)
+            digests.append(canvas_digest(browser))
+            browser.save_screenshot(os.path.join(artifacts, name))
+    finally:
+        for process in (tiled, frameless):
+            process.send_signal(signal.SIGINT)
+            process.communicate(timeout=60)
+    if digests[0] != digests[1]:
+        return fail(f"frameless converged to another picture than tiled: {digests}")
+    print(f"PASS: the frameless order converged to the tiled picture {digests[0]}")
     return 0
 
 

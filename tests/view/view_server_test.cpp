@@ -11,6 +11,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <functional>
@@ -20,6 +21,7 @@
 #include <thread>
 
 #include "render/packet_renderer.h"
+#include "render/view/frameless.h"
 #include "render/view/view_session.h"
 #include "scene/builtin.h"
 
@@ -49,8 +51,11 @@ std::string rendered_bytes(const Scene& scene) {
 
 class ViewServerTest : public ::testing::Test {
   protected:
+    virtual octray::view::PixelOrder order() const { return octray::view::PixelOrder::tiled; }
+
     void SetUp() override {
         ViewSettings settings;
+        settings.order = order();
         settings.threads = 2;
         // Long enough that a test polling the status sees a preview before it is refined,
         // however loaded the machine.
@@ -364,6 +369,59 @@ TEST_F(ViewServerTest, StopEndsAnOpenEventStream) {
     stopper.join();
     server_->wait();
     SUCCEED();
+}
+
+TEST(FramelessBlocks, CoverThePictureOnceInAFixedShuffledOrder) {
+    const auto blocks = octray::view::frameless_blocks(21, 10, 8);
+    ASSERT_EQ(blocks.size(), 6u);  // 3 x 2, the last column 5 wide and the last row 2 high
+    std::vector<int> hits(21 * 10, 0);
+    for (const octray::PixelRect& r : blocks)
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) ++hits[static_cast<std::size_t>(y * 21 + x)];
+    EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), 210);
+    EXPECT_EQ(octray::view::frameless_blocks(21, 10, 8), blocks) << "the order is fixed";
+    const auto many = octray::view::frameless_blocks(64, 64, 8);
+    auto row_major = many;
+    std::sort(row_major.begin(), row_major.end(), [](const auto& a, const auto& b) {
+        return a.y0 != b.y0 ? a.y0 < b.y0 : a.x0 < b.x0;
+    });
+    EXPECT_NE(many, row_major) << "the order is shuffled";
+    EXPECT_THROW(octray::view::frameless_blocks(0, 10, 8), std::invalid_argument);
+}
+
+class FramelessViewTest : public ViewServerTest {
+  protected:
+    octray::view::PixelOrder order() const override {
+        return octray::view::PixelOrder::frameless;
+    }
+};
+
+// Blocks land a batch at a time; once every block of a still camera has been rendered,
+// the picture is the tiled order's (render_packet's) bit for bit, for the first camera and
+// for a camera set later, whose sweep starts over a picture of the old one.
+TEST_F(FramelessViewTest, ConvergesToTheTiledPictureBitForBit) {
+    // 40 blocks of 8x8 in batches of 16: pictures of coverage 0.4, 0.8, then 1.
+    const json first = wait_for_frame(
+        [](const json& f) { return f["camera_version"] == 1 && f["coverage"] == 1.0; });
+    ASSERT_FALSE(first.is_null());
+    const auto image = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(image);
+    EXPECT_TRUE(image->body == rendered_bytes(scene_));
+
+    const auto result = client_->Post(with_token("/api/camera"), R"({"eye": [1.5, 2.5, 6.0]})",
+                                      "application/json");
+    ASSERT_TRUE(result);
+    ASSERT_EQ(result->status, 200);
+    const int version = json::parse(result->body)["camera_version"];
+    const json moved = wait_for_frame(
+        [&](const json& f) { return f["camera_version"] == version && f["coverage"] == 1.0; });
+    ASSERT_FALSE(moved.is_null());
+    const auto after = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(after);
+    ASSERT_EQ(after->get_header_value("X-Octray-Camera-Version"), std::to_string(version));
+    Scene scene = scene_;
+    scene.camera.eye = octray::Vec3{1.5f, 2.5f, 6.0f};
+    EXPECT_TRUE(after->body == rendered_bytes(scene));
 }
 
 }  // namespace
