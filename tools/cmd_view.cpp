@@ -86,7 +86,7 @@ void print_bench(const Scene& scene, const view::ViewSettings& settings,
     std::printf("first picture: %dx%d at 1 spp after %.3f s\n", r.first_width, r.first_height,
                 r.first_picture_seconds);
     std::printf(
-        "orbit: %d updates of %dx%d (1 spp, preview) in %.3f s: %.1f updates/s, %.1f Mrays/s, "
+        "orbit: %d updates of %dx%d in %.3f s: %.1f updates/s, %.1f Mrays/s, "
         "PNG %.0f bytes\n",
         r.updates, r.update_width, r.update_height, r.seconds, r.updates_per_second,
         r.mrays_per_second, r.png_bytes);
