@@ -83,8 +83,8 @@ void print_bench(const Scene& scene, const view::ViewSettings& settings,
                  const view::ViewBenchResult& r) {
     std::printf("octray view --bench: %s, %s path, %d threads (0 = all)\n",
                 scene.source.c_str(), render_path_name(settings.path), settings.threads);
-    std::printf("first picture: %dx%d at 1 spp after %.3f s\n", r.first_width, r.first_height,
-                r.first_picture_seconds);
+    std::printf("first picture: %dx%d at %d spp after %.3f s\n", r.first_width, r.first_height,
+                r.first_spp, r.first_picture_seconds);
     std::printf(
         "orbit: %d updates of %dx%d in %.3f s: %.1f updates/s, %.1f Mrays/s, "
         "PNG %.0f bytes\n",

@@ -49,6 +49,7 @@ ViewBenchResult bench_orbit(const Scene& scene, const ViewSettings& settings, in
     result.first_picture_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     result.first_width = first->image.width();
     result.first_height = first->image.height();
+    result.first_spp = first->spp;
 
     const Camera initial = scene.camera;
     double rays = 0.0, render_seconds = 0.0, png_bytes = 0.0;

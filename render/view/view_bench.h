@@ -10,7 +10,7 @@ namespace octray::view {
 
 struct ViewBenchResult {
     double first_picture_seconds = 0.0;  // session start to its first published picture
-    int first_width = 0, first_height = 0;
+    int first_width = 0, first_height = 0, first_spp = 0;
     int updates = 0;  // orbit steps rendered
     int update_width = 0, update_height = 0;
     double seconds = 0.0;  // wall-clock time of all updates
