@@ -83,6 +83,7 @@ std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run) {
     add_verify_command(*app, run);
     add_info_command(*app, run);
     add_assemble_command(*app, run);
+    add_view_command(*app, run);
     add_man_command(*app, run);
     add_completion_command(*app, run);
 

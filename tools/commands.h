@@ -70,6 +70,7 @@ void add_bench_command(CLI::App& app, CommandRunner& run);
 void add_verify_command(CLI::App& app, CommandRunner& run);
 void add_info_command(CLI::App& app, CommandRunner& run);
 void add_assemble_command(CLI::App& app, CommandRunner& run);
+void add_view_command(CLI::App& app, CommandRunner& run);
 // man and completion describe every command (tools/cli_describe.h) when they run, after
 // all are registered; they come last so that --help lists them after the commands they
 // document.

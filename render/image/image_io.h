@@ -155,6 +155,16 @@ void write_exr(const std::string& path, const Image& image, const ExrWriteOption
 // An 8-bit sRGB preview: linear values clamped to [0, 1], sRGB-encoded. Throws IoError.
 void write_png_preview(const std::string& path, const Image& image);
 
+// A linear value clamped to [0, 1] (NaN and negatives to 0) through the sRGB OETF
+// (IEC 61966-2-1), rounded to 8 bits: what the PNG preview stores.
+std::uint8_t srgb8(float linear);
+
+// An 8-bit RGB PNG of `rgb` (3 * width * height bytes, row 0 on top) with an sRGB chunk,
+// in memory (`octray view` sends it to the browser): zlib's fastest level, since it is
+// wanted soon rather than small. Throws IoError for a size that does not match or a
+// failure of libpng.
+std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_t>& rgb);
+
 // An 8-bit RGB PNG of ready-made sRGB bytes (row 0 on top, rgb.size() == 3 * width *
 // height), for pictures that are not renders: the compare heatmap. Throws IoError.
 void write_png_rgb8(const std::string& path, int width, int height,

@@ -1,5 +1,6 @@
 // Every PNG octray writes or reads: the sRGB preview of a render (write_png_preview), ready
-// sRGB bytes (write_png_rgb8: the compare heatmap), and the reader behind read_image().
+// sRGB bytes (write_png_rgb8: the compare heatmap; encode_png_rgb8: `octray view`'s
+// pictures, in memory), and the reader behind read_image().
 // One libpng error handler serves them all.
 
 #include "render/image/png.h"
@@ -33,6 +34,7 @@ std::string errno_message(int error) { return std::generic_category().message(er
 // One libpng run: where the bytes go (writing) or come from (reading), and the error.
 struct PngIo {
     std::FILE* file = nullptr;            // writing: the open temporary
+    std::string* memory = nullptr;        // or writing into memory
     const unsigned char* data = nullptr;  // reading: the whole file
     std::size_t size = 0;
     std::size_t offset = 0;
@@ -67,6 +69,11 @@ void on_png_write(png_structp png, png_bytep data, png_size_t length) {
     }
 }
 
+void on_png_append(png_structp png, png_bytep data, png_size_t length) {
+    static_cast<PngIo*>(png_get_io_ptr(png))
+        ->memory->append(reinterpret_cast<char*>(data), length);
+}
+
 void on_png_flush(png_structp png) {
     auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
     errno = 0;
@@ -83,7 +90,13 @@ enum class SrgbChunks { srgb, srgb_gama_chrm };
 bool write_rgb8_rows(png_structp png, png_infop info, PngIo* io, png_uint_32 width,
                      png_uint_32 height, png_bytepp rows, SrgbChunks chunks) {
     if (setjmp(png_jmpbuf(png))) return false;
-    png_set_write_fn(png, io, on_png_write, on_png_flush);
+    if (io->memory != nullptr) {
+        png_set_write_fn(png, io, on_png_append, nullptr);
+        png_set_compression_level(png, 1);
+        png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+    } else {
+        png_set_write_fn(png, io, on_png_write, on_png_flush);
+    }
     png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     if (chunks == SrgbChunks::srgb_gama_chrm)
@@ -96,18 +109,13 @@ bool write_rgb8_rows(png_structp png, png_infop info, PngIo* io, png_uint_32 wid
     return true;
 }
 
-// Writes an 8-bit RGB PNG of `rows` (row 0 on top) to a new file at `path`. Throws
-// std::runtime_error with the reason.
-void write_png_file(const std::string& path, int width, int height, png_bytepp rows,
-                    SrgbChunks chunks) {
-    std::FILE* file = std::fopen(path.c_str(), "wb");
-    if (file == nullptr) throw std::runtime_error(errno_message(errno));
-    PngIo io;
-    io.file = file;
-    std::string failure;
+// Writes an 8-bit RGB PNG of `rows` (row 0 on top) through `io` (its file or its memory).
+// Returns the reason it failed, or "".
+std::string write_png(PngIo& io, int width, int height, png_bytepp rows, SrgbChunks chunks) {
     png_structp png =
         png_create_write_struct(PNG_LIBPNG_VER_STRING, &io, on_png_error, on_png_warning);
     png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+    std::string failure;
     if (png == nullptr)
         failure = "libpng: cannot create the write structure";
     else if (info == nullptr)
@@ -116,6 +124,18 @@ void write_png_file(const std::string& path, int width, int height, png_bytepp r
                               static_cast<png_uint_32>(height), rows, chunks))
         failure = std::string("libpng: ") + io.message;
     if (png != nullptr) png_destroy_write_struct(&png, info != nullptr ? &info : nullptr);
+    return failure;
+}
+
+// Writes an 8-bit RGB PNG of `rows` (row 0 on top) to a new file at `path`. Throws
+// std::runtime_error with the reason.
+void write_png_file(const std::string& path, int width, int height, png_bytepp rows,
+                    SrgbChunks chunks) {
+    std::FILE* file = std::fopen(path.c_str(), "wb");
+    if (file == nullptr) throw std::runtime_error(errno_message(errno));
+    PngIo io;
+    io.file = file;
+    std::string failure = write_png(io, width, height, rows, chunks);
     // A full disk may only show when buffered data is flushed, so check the close too.
     const bool stream_failed = std::ferror(file) != 0;
     const int close_errno = std::fclose(file) != 0 ? errno : 0;
@@ -124,17 +144,34 @@ void write_png_file(const std::string& path, int width, int height, png_bytepp r
     if (!failure.empty()) throw std::runtime_error(failure);
 }
 
+// The row pointers of packed RGB bytes; libpng wants mutable ones but only reads.
+std::vector<png_bytep> rgb8_rows(int width, int height, const std::vector<std::uint8_t>& rgb) {
+    std::vector<png_bytep> rows(static_cast<std::size_t>(height));
+    for (std::size_t y = 0; y < rows.size(); ++y)
+        rows[y] = const_cast<png_bytep>(rgb.data() + y * 3 * static_cast<std::size_t>(width));
+    return rows;
+}
+
+bool rgb8_size_matches(int width, int height, const std::vector<std::uint8_t>& rgb) {
+    return width > 0 && height > 0 &&
+           rgb.size() == 3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+}
+
 // sRGB OETF (IEC 61966-2-1) of a linear value already clamped to [0, 1].
 float srgb_encode(float linear) {
     return linear <= 0.0031308f ? 12.92f * linear
                                 : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
-std::uint8_t to_srgb8(float linear) {
+}  // namespace
+
+std::uint8_t srgb8(float linear) {
     // NaN fails both comparisons and lands on 0, like negative values; +inf clamps to 1.
     const float clamped = linear > 0.0f ? (linear < 1.0f ? linear : 1.0f) : 0.0f;
     return static_cast<std::uint8_t>(std::lround(srgb_encode(clamped) * 255.0f));
 }
+
+namespace {
 
 // ---- Reading -----------------------------------------------------------------------------
 
@@ -226,9 +263,9 @@ void write_png_preview(const std::string& path, const Image& image) {
         rows[static_cast<std::size_t>(y)] = row;
         for (int x = 0; x < width; ++x) {
             const Rgb c = image.at(x, y);
-            row[3 * x + 0] = to_srgb8(c.r);
-            row[3 * x + 1] = to_srgb8(c.g);
-            row[3 * x + 2] = to_srgb8(c.b);
+            row[3 * x + 0] = srgb8(c.r);
+            row[3 * x + 1] = srgb8(c.g);
+            row[3 * x + 2] = srgb8(c.b);
         }
     }
     write_file_atomically(path, [&](const std::string& tmp) {
@@ -238,19 +275,28 @@ void write_png_preview(const std::string& path, const Image& image) {
 
 void write_png_rgb8(const std::string& path, int width, int height,
                     const std::vector<std::uint8_t>& rgb) {
-    if (width <= 0 || height <= 0 ||
-        rgb.size() != 3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
+    if (!rgb8_size_matches(width, height, rgb))
         throw IoError("cannot write '" + path + "': " + std::to_string(rgb.size()) +
                       " bytes do not make a " + std::to_string(width) + "x" +
                       std::to_string(height) + " RGB image");
-
-    // libpng wants mutable row pointers but only reads through them.
-    std::vector<png_bytep> rows(static_cast<std::size_t>(height));
-    for (std::size_t y = 0; y < rows.size(); ++y)
-        rows[y] = const_cast<png_bytep>(rgb.data() + y * 3 * static_cast<std::size_t>(width));
+    std::vector<png_bytep> rows = rgb8_rows(width, height, rgb);
     write_file_atomically(path, [&](const std::string& tmp) {
         write_png_file(tmp, width, height, rows.data(), SrgbChunks::srgb);
     });
+}
+
+std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_t>& rgb) {
+    if (!rgb8_size_matches(width, height, rgb))
+        throw IoError("cannot encode a PNG: " + std::to_string(rgb.size()) +
+                      " bytes do not make a " + std::to_string(width) + "x" +
+                      std::to_string(height) + " RGB image");
+    std::vector<png_bytep> rows = rgb8_rows(width, height, rgb);
+    std::string out;
+    PngIo io;
+    io.memory = &out;
+    const std::string failure = write_png(io, width, height, rows.data(), SrgbChunks::srgb);
+    if (!failure.empty()) throw IoError("cannot encode a PNG: " + failure);
+    return out;
 }
 
 ChannelImage read_png_channels(const std::string& path,

@@ -1,0 +1,28 @@
+#pragma once
+// `octray view --bench`: what the viewer sustains, measured without a browser — the time to
+// the first picture, and how many pictures a second it delivers while the camera orbits
+// (each rendered as a moving camera is, then tone-mapped and PNG-encoded as the server
+// does for the page).
+
+#include "render/view/view_session.h"
+
+namespace octray::view {
+
+struct ViewBenchResult {
+    double first_picture_seconds = 0.0;  // session start to its first published picture
+    int first_width = 0, first_height = 0, first_spp = 0;
+    int updates = 0;  // orbit steps rendered
+    int update_width = 0, update_height = 0;
+    double seconds = 0.0;  // wall-clock time of all updates
+    double updates_per_second = 0.0;
+    double mrays_per_second = 0.0;  // rays of all updates / their render time
+    double png_bytes = 0.0;         // mean size of an update's PNG
+};
+
+// Starts a session of `scene` with `settings`, waits for its first picture, then moves the
+// camera `updates` times around its look-at point (one full turn about the up axis, as a
+// drag does), each as a moving camera, waiting for each picture and encoding it as PNG.
+// `updates` >= 1. Throws what the session throws.
+ViewBenchResult bench_orbit(const Scene& scene, const ViewSettings& settings, int updates);
+
+}  // namespace octray::view

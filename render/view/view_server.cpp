@@ -1,0 +1,335 @@
+#include "render/view/view_server.h"
+
+#include <httplib.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstring>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "render/image/image_io.h"
+#include "render/view/page.h"
+#include "render/view/token.h"
+#include "render/view/tone_map.h"
+#include "scene/scene_error.h"
+
+namespace octray::view {
+namespace {
+
+using nlohmann::json;
+
+// How often an idle event stream writes a comment line: the write that fails tells the
+// server a tab has closed, so the stream's worker thread is back within about this long.
+constexpr std::chrono::milliseconds kHeartbeat{250};
+
+json vec3_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+json frame_json(const ViewFrame& frame) {
+    const Camera& camera = frame.camera;
+    return json{
+        {"generation", frame.generation},
+        {"camera_version", frame.camera_version},
+        {"preview", frame.preview},
+        {"spp", frame.spp},
+        {"target_spp", frame.target_spp},
+        {"width", frame.image.width()},
+        {"height", frame.image.height()},
+        {"pass_seconds", frame.pass_seconds},
+        {"frame_seconds", frame.frame_seconds},
+        {"mrays_per_second", frame.mrays_per_second},
+        {"coverage", frame.coverage},
+        {"camera",
+         {{"eye", vec3_json(camera.eye)},
+          {"lookat", vec3_json(camera.lookat)},
+          {"up", vec3_json(camera.up)},
+          {"fov", camera.fov}}},
+    };
+}
+
+// A request the client got wrong: answered with `status` and the message as plain text.
+struct BadRequest : std::runtime_error {
+    int status;
+    BadRequest(int s, const std::string& message) : std::runtime_error(message), status(s) {}
+};
+
+float finite_number(const json& value, const std::string& what) {
+    if (!value.is_number()) throw BadRequest(400, what + ": expected a number");
+    const double v = value.get<double>();
+    if (!std::isfinite(v) || std::fabs(v) > 1e30)
+        throw BadRequest(400, what + ": expected a finite number of at most 1e30");
+    return static_cast<float>(v);
+}
+
+Vec3 vec3_from(const json& value, const std::string& what) {
+    if (!value.is_array() || value.size() != 3)
+        throw BadRequest(400, what + ": expected an array of 3 numbers");
+    return Vec3{finite_number(value[0], what + "[0]"), finite_number(value[1], what + "[1]"),
+                finite_number(value[2], what + "[2]")};
+}
+
+// The body of POST /api/camera: {"eye": [x, y, z], "lookat": [...], "up": [...],
+// "fov": degrees, "moving": bool}, every key optional (the current camera's value).
+std::pair<Camera, bool> parse_camera_request(const std::string& body, Camera camera) {
+    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    if (request.is_discarded() || !request.is_object())
+        throw BadRequest(400, "camera: expected a JSON object such as {\"eye\": [0, 1, 5]}");
+    bool moving = false;
+    for (const auto& [key, value] : request.items()) {
+        if (key == "eye") {
+            camera.eye = vec3_from(value, "camera.eye");
+        } else if (key == "lookat") {
+            camera.lookat = vec3_from(value, "camera.lookat");
+        } else if (key == "up") {
+            camera.up = vec3_from(value, "camera.up");
+        } else if (key == "fov") {
+            camera.fov = finite_number(value, "camera.fov");
+        } else if (key == "moving") {
+            if (!value.is_boolean())
+                throw BadRequest(400, "camera.moving: expected true or false");
+            moving = value.get<bool>();
+        } else {
+            throw BadRequest(400, "camera: unknown key \"" + key +
+                                      "\" (expected eye, lookat, up, fov, moving)");
+        }
+    }
+    return {camera, moving};
+}
+
+// The value of cookie `name` in a Cookie header ("a=1; b=2"), empty if absent.
+std::string cookie_value(const std::string& header, const std::string& name) {
+    std::size_t pos = 0;
+    while (pos < header.size()) {
+        while (pos < header.size() && (header[pos] == ' ' || header[pos] == ';')) ++pos;
+        const std::size_t end = std::min(header.find(';', pos), header.size());
+        const std::string pair = header.substr(pos, end - pos);
+        const std::size_t eq = pair.find('=');
+        if (eq != std::string::npos && pair.compare(0, eq, name) == 0)
+            return pair.substr(eq + 1);
+        pos = end;
+    }
+    return {};
+}
+
+void set_common_headers(httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    res.set_header("Referrer-Policy", "no-referrer");
+}
+
+}  // namespace
+
+struct ViewServer::Impl {
+    ViewSession& session;
+    ServerOptions options;
+    std::string token;
+    std::string cookie_name;
+    int port = 0;
+    httplib::Server server;
+    std::thread listener;
+    std::atomic<bool> stopping{false};
+    std::atomic<bool> listener_done{false};
+    std::mutex stop_mutex;
+
+    Impl(ViewSession& s, ServerOptions o) : session(s), options(std::move(o)) {
+        token = options.token.empty() ? random_token() : options.token;
+    }
+
+    bool authorized(const httplib::Request& req) const {
+        if (req.has_param("token") && tokens_equal(req.get_param_value("token"), token))
+            return true;
+        return tokens_equal(cookie_value(req.get_header_value("Cookie"), cookie_name), token);
+    }
+
+    void routes();
+};
+
+void ViewServer::Impl::routes() {
+    server.set_payload_max_length(options.max_body);
+    server.set_tcp_nodelay(true);
+    server.set_keep_alive_timeout(2);
+    server.set_read_timeout(5, 0);
+    server.set_write_timeout(5, 0);
+    const auto threads = static_cast<std::size_t>(std::max(2, options.http_threads));
+    server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+
+    // The token first: nothing, not even a 404, answers a request without it.
+    server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+        set_common_headers(res);
+        if (authorized(req)) return httplib::Server::HandlerResponse::Unhandled;
+        res.status = 403;
+        res.set_content(
+            "403 Forbidden: open the URL that `octray view` printed (it carries the token)\n",
+            "text/plain");
+        return httplib::Server::HandlerResponse::Handled;
+    });
+    server.set_exception_handler([](const httplib::Request&, httplib::Response& res,
+                                    std::exception_ptr error) {
+        try {
+            std::rethrow_exception(error);
+        } catch (const BadRequest& e) {
+            res.status = e.status;
+            res.set_content(std::string(e.what()) + "\n", "text/plain");
+        } catch (const SceneError& e) {
+            res.status = 400;
+            res.set_content(std::string(e.what()) + "\n", "text/plain");
+        } catch (const std::exception& e) {
+            res.status = 500;
+            res.set_content(std::string("internal error: ") + e.what() + "\n", "text/plain");
+        }
+    });
+
+    server.Get("/", [this](const httplib::Request&, httplib::Response& res) {
+        // The cookie lets the page's requests carry the token without repeating it; its
+        // name has the port in it because cookies do not tell ports apart.
+        res.set_header("Set-Cookie",
+                       cookie_name + "=" + token + "; Path=/; HttpOnly; SameSite=Strict");
+        res.set_content(kViewPage, "text/html; charset=utf-8");
+    });
+
+    server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
+        json status{{"scene", session.scene().source},
+                    {"full_width", session.scene().image.width},
+                    {"full_height", session.scene().image.height}};
+        if (const auto frame = session.latest()) status["frame"] = frame_json(*frame);
+        if (const std::string error = session.error(); !error.empty()) status["error"] = error;
+        res.set_content(status.dump(), "application/json");
+    });
+
+    server.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
+        res.set_chunked_content_provider(
+            "text/event-stream", [this, last = std::uint64_t{0}, last_error = std::string()](
+                                     std::size_t, httplib::DataSink& sink) mutable {
+                const auto frame = session.wait_newer(last, kHeartbeat);
+                if (stopping || session.stopped()) {
+                    sink.done();
+                    return true;
+                }
+                std::string message = ": heartbeat\n\n";
+                if (std::string error = session.error(); error != last_error) {
+                    last_error = error;
+                    if (!error.empty()) {
+                        message =
+                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
+                            "\n\n";
+                    }
+                } else if (frame && frame->generation > last) {
+                    last = frame->generation;
+                    message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                }
+                return sink.write(message.data(), message.size());
+            });
+    });
+
+    const auto image_headers = [](httplib::Response& res, const ViewFrame& frame) {
+        res.set_header("X-Octray-Generation", std::to_string(frame.generation));
+        res.set_header("X-Octray-Spp", std::to_string(frame.spp));
+        res.set_header("X-Octray-Width", std::to_string(frame.image.width()));
+        res.set_header("X-Octray-Height", std::to_string(frame.image.height()));
+        res.set_header("X-Octray-Camera-Version", std::to_string(frame.camera_version));
+    };
+
+    server.Get("/api/image.png", [this, image_headers](const httplib::Request& req,
+                                                       httplib::Response& res) {
+        const auto frame = session.latest();
+        if (!frame) throw BadRequest(503, "no picture yet");
+        float exposure = 0.0f;
+        if (req.has_param("exposure")) {
+            const std::string text = req.get_param_value("exposure");
+            char* end = nullptr;
+            const float value = std::strtof(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !std::isfinite(value) || std::fabs(value) > 64)
+                throw BadRequest(400, "exposure: expected a number of stops in [-64, 64]");
+            exposure = value;
+        }
+        image_headers(res, *frame);
+        res.set_content(encode_png_rgb8(frame->image.width(), frame->image.height(),
+                                        tone_map_srgb8(frame->image, exposure)),
+                        "image/png");
+    });
+
+    // The picture as it is: little-endian float32 R, G, B per pixel, row 0 on top, for
+    // tests and tools that compare exactly.
+    server.Get("/api/image.f32", [this, image_headers](const httplib::Request&,
+                                                       httplib::Response& res) {
+        const auto frame = session.latest();
+        if (!frame) throw BadRequest(503, "no picture yet");
+        image_headers(res, *frame);
+        static_assert(sizeof(Rgb) == 3 * sizeof(float));
+        res.set_content(std::string(reinterpret_cast<const char*>(frame->image.data()),
+                                    frame->image.pixel_count() * sizeof(Rgb)),
+                        "application/octet-stream");
+    });
+
+    server.Post("/api/camera", [this](const httplib::Request& req, httplib::Response& res) {
+        const auto [camera, moving] = parse_camera_request(req.body, session.camera());
+        const std::uint64_t version = session.set_camera(camera, moving);
+        res.set_content(json{{"camera_version", version}}.dump(), "application/json");
+    });
+}
+
+ViewServer::ViewServer(ViewSession& session, ServerOptions options)
+    : impl_(std::make_unique<Impl>(session, std::move(options))) {
+    impl_->routes();
+    const std::string& host = impl_->options.bind;
+    const auto failure = [&](int port) {
+        const int error = errno;
+        return std::runtime_error("cannot listen on " + host + ":" + std::to_string(port) +
+                                  (error != 0 ? std::string(": ") + std::strerror(error) : ""));
+    };
+    errno = 0;
+    if (impl_->options.port == 0) {
+        impl_->port = impl_->server.bind_to_any_port(host);
+        if (impl_->port <= 0) throw failure(0);
+    } else {
+        if (!impl_->server.bind_to_port(host, impl_->options.port))
+            throw failure(impl_->options.port);
+        impl_->port = impl_->options.port;
+    }
+    impl_->cookie_name = "octray_token_" + std::to_string(impl_->port);
+}
+
+ViewServer::~ViewServer() {
+    stop();
+    wait();
+}
+
+void ViewServer::start() {
+    if (impl_->stopping) return;
+    std::signal(SIGPIPE, SIG_IGN);
+    impl_->listener = std::thread([this] {
+        impl_->server.listen_after_bind();
+        impl_->listener_done = true;
+    });
+    // stop() before listen_after_bind() runs would be lost: wait until it does.
+    while (!impl_->server.is_running() && !impl_->stopping && !impl_->listener_done)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+}
+
+void ViewServer::stop() {
+    std::lock_guard lock(impl_->stop_mutex);
+    impl_->stopping = true;
+    impl_->server.stop();
+}
+
+void ViewServer::wait() {
+    if (impl_->listener.joinable()) impl_->listener.join();
+}
+
+int ViewServer::port() const { return impl_->port; }
+
+const std::string& ViewServer::token() const { return impl_->token; }
+
+std::string ViewServer::url() const {
+    std::string host = impl_->options.bind;
+    if (host.find(':') != std::string::npos) host = "[" + host + "]";
+    return "http://" + host + ":" + std::to_string(impl_->port) + "/?token=" + impl_->token;
+}
+
+}  // namespace octray::view

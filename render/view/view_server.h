@@ -1,0 +1,50 @@
+#pragma once
+// The HTTP side of `octray view`: the page, the pictures of a ViewSession and the camera
+// endpoint, behind an access token (render/view/README.md lists the protocol).
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+#include "render/view/view_session.h"
+
+namespace octray::view {
+
+struct ServerOptions {
+    std::string bind = "127.0.0.1";  // loopback only unless the user says otherwise
+    int port = 0;                    // 0: a free port, chosen by the kernel
+    std::string token;               // empty: random_token()
+    std::size_t max_body = 4096;     // bytes; a longer request body gets 413
+    int http_threads = 16;           // requests served at once (an event stream holds one)
+};
+
+class ViewServer {
+  public:
+    // Binds the socket (nothing is served before start()). Throws std::runtime_error
+    // naming the address if it cannot be bound. `session` must outlive the server.
+    ViewServer(ViewSession& session, ServerOptions options);
+    ~ViewServer();  // stop()
+    ViewServer(const ViewServer&) = delete;
+    ViewServer& operator=(const ViewServer&) = delete;
+
+    // Serves on a thread of its own until stop(); returns once requests are accepted.
+    // Ignores SIGPIPE for the whole process: a client that goes away mid-answer must give
+    // a failed write, not kill the viewer.
+    void start();
+    // Stops accepting, ends the event streams and waits for the requests in flight.
+    // Safe to call from any thread, more than once.
+    void stop();
+    // Blocks until the server has stopped (after stop(), from another thread or a signal).
+    void wait();
+
+    int port() const;
+    const std::string& token() const;
+    // http://HOST:PORT/?token=TOKEN — what the user opens.
+    std::string url() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace octray::view

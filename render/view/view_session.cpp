@@ -1,0 +1,304 @@
+#include "render/view/view_session.h"
+
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "render/batch/progressive.h"
+#include "render/packet_renderer.h"
+#include "render/reference.h"
+#include "render/view/frameless.h"
+#include "scene/compile.h"
+#include "scene/load.h"
+#include "scene/scene_error.h"
+
+namespace octray::view {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double mrays_per_second(const RenderResult& result) {
+    return result.seconds > 0.0
+               ? static_cast<double>(result.rays.total()) / result.seconds / 1e6
+               : 0.0;
+}
+
+}  // namespace
+
+ViewSession::ViewSession(Scene scene, ViewSettings settings)
+    : scene_(std::move(scene)), settings_(settings), camera_(scene_.camera) {
+    thread_ = std::thread([this] { run(); });
+}
+
+ViewSession::~ViewSession() { stop(); }
+
+void ViewSession::stop() {
+    {
+        std::lock_guard lock(mutex_);
+        stop_ = true;
+        cancel_ = true;
+    }
+    changed_.notify_all();
+    if (thread_.joinable() && thread_.get_id() != std::this_thread::get_id()) thread_.join();
+}
+
+bool ViewSession::stopped() const {
+    std::lock_guard lock(mutex_);
+    return stop_;
+}
+
+std::shared_ptr<const ViewFrame> ViewSession::latest() const {
+    std::lock_guard lock(mutex_);
+    return latest_;
+}
+
+std::shared_ptr<const ViewFrame> ViewSession::wait_newer(
+    std::uint64_t generation, std::chrono::milliseconds timeout) const {
+    std::unique_lock lock(mutex_);
+    changed_.wait_for(lock, timeout, [&] { return stop_ || generation_ > generation; });
+    return latest_;
+}
+
+std::string ViewSession::error() const {
+    std::lock_guard lock(mutex_);
+    return error_;
+}
+
+Camera ViewSession::camera() const {
+    std::lock_guard lock(mutex_);
+    return camera_;
+}
+
+std::uint64_t ViewSession::set_camera(const Camera& camera, bool moving) {
+    // The whole scene would be validated again for every move of the mouse; the camera's
+    // rules need only the camera and the image size, so a scene of nothing else checks them.
+    Scene probe;
+    probe.source = scene_.source;
+    probe.image = scene_.image;
+    probe.camera = camera;
+    validate_scene(probe);
+    std::uint64_t version = 0;
+    {
+        std::lock_guard lock(mutex_);
+        camera_ = camera;
+        moving_ = moving;
+        version = ++camera_version_;
+        cancel_ = true;
+    }
+    changed_.notify_all();
+    return version;
+}
+
+void ViewSession::publish(ViewFrame frame) {
+    {
+        std::lock_guard lock(mutex_);
+        frame.generation = ++generation_;
+        latest_ = std::make_shared<const ViewFrame>(std::move(frame));
+    }
+    changed_.notify_all();
+}
+
+void ViewSession::run() {
+    if (settings_.order == PixelOrder::frameless) return run_frameless();
+    std::uint64_t done_version = 0;  // the camera version of the last picture rendered
+    bool refined = true;             // whether that picture was the full progressive one
+    Clock::time_point last_preview;
+    std::unique_lock lock(mutex_);
+    while (!stop_) {
+        if (camera_version_ == done_version && refined) {
+            changed_.wait(lock);
+            continue;
+        }
+        if (camera_version_ == done_version && !refined &&
+            changed_.wait_until(lock, last_preview + settings_.settle,
+                                [&] { return stop_ || camera_version_ != done_version; })) {
+            continue;  // moved again (or stopping) before it settled
+        }
+        const std::uint64_t version = camera_version_;
+        const Camera camera = camera_;
+        const bool preview = moving_ && !(version == done_version && !refined);
+        moving_ = false;
+        cancel_ = false;
+        error_.clear();
+        lock.unlock();
+        try {
+            if (preview) {
+                render_preview(camera, version);
+                last_preview = Clock::now();
+                refined = false;
+            } else {
+                refined = render_passes(camera, version);
+            }
+            done_version = version;
+        } catch (const RenderCancelled&) {
+            // A new camera or stop(): the loop picks up whichever it was.
+        } catch (const std::exception& e) {
+            // The thread must not end the process; the page shows why, and the next
+            // camera tries again.
+            lock.lock();
+            error_ = e.what();
+            done_version = version;
+            refined = true;
+            changed_.notify_all();
+            continue;
+        }
+        lock.lock();
+    }
+}
+
+// Frameless: one framebuffer, re-rendered a batch of blocks at a time in the permutation
+// of frameless_blocks, continuing where the last camera left off (the oldest pixels are
+// renewed first); each batch is published at once. A camera that stays still is rendered
+// once over (a full sweep), which is then exactly the tiled order's picture.
+void ViewSession::run_frameless() {
+    const int width = scene_.image.width, height = scene_.image.height;
+    const std::vector<PixelRect> blocks =
+        frameless_blocks(width, height, std::max(1, settings_.frameless_block));
+    // About 16 pictures a sweep, of at least 16 blocks each (enough work for the threads).
+    const std::size_t batch_size = std::max<std::size_t>(16, blocks.size() / 16);
+    Image framebuffer(width, height);
+    std::size_t cursor = 0;             // next block of the permutation
+    std::size_t fresh = blocks.size();  // blocks rendered with the current camera
+    std::uint64_t version = 0;
+    Scene scene = scene_;
+    std::optional<CompiledScene> compiled;
+    Clock::time_point camera_start;
+    std::optional<tbb::task_arena> arena;
+    if (settings_.threads > 0) arena.emplace(settings_.threads);
+
+    std::unique_lock lock(mutex_);
+    while (!stop_) {
+        if (camera_version_ == version && fresh >= blocks.size()) {
+            changed_.wait(lock);
+            continue;
+        }
+        const bool new_camera = camera_version_ != version;
+        version = camera_version_;
+        const Camera camera = camera_;
+        if (new_camera) error_.clear();
+        lock.unlock();
+        try {
+            if (new_camera) {
+                scene.camera = camera;
+                if (settings_.path == RenderPath::simd) compiled.emplace(compile_scene(scene));
+                fresh = 0;
+                camera_start = Clock::now();
+            }
+            const std::size_t count = std::min(batch_size, blocks.size() - fresh);
+            std::atomic<std::uint64_t> rays{0};
+            const auto start = Clock::now();
+            const auto render_batch = [&] {
+                tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
+                    const PixelRect& rect = blocks[(cursor + i) % blocks.size()];
+                    RenderOptions options;
+                    options.crop = rect;
+                    const RenderResult result =
+                        compiled ? render_packet(*compiled, options, settings_.isa)
+                                 : render_reference(scene, options);
+                    for (int y = 0; y < rect.height(); ++y)
+                        for (int x = 0; x < rect.width(); ++x)
+                            framebuffer.at(rect.x0 + x, rect.y0 + y) = result.image.at(x, y);
+                    rays += result.rays.total();
+                });
+            };
+            if (arena) {
+                arena->execute(render_batch);
+            } else {
+                render_batch();
+            }
+            cursor = (cursor + count) % blocks.size();
+            fresh += count;
+            ViewFrame frame;
+            frame.image = framebuffer;
+            frame.camera_version = version;
+            frame.camera = camera;
+            frame.spp = scene_.image.spp;
+            frame.target_spp = scene_.image.spp;
+            frame.pass_seconds = seconds_since(start);
+            frame.frame_seconds = seconds_since(camera_start);
+            frame.mrays_per_second =
+                frame.pass_seconds > 0.0
+                    ? static_cast<double>(rays.load()) / frame.pass_seconds / 1e6
+                    : 0.0;
+            frame.coverage = static_cast<double>(fresh) / static_cast<double>(blocks.size());
+            publish(std::move(frame));
+        } catch (const std::exception& e) {
+            lock.lock();
+            error_ = e.what();
+            fresh = blocks.size();
+            changed_.notify_all();
+            continue;
+        }
+        lock.lock();
+    }
+}
+
+void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
+    Scene scene = scene_;
+    scene.camera = camera;
+    const int d = std::max(1, settings_.preview_divisor);
+    scene.image.width = std::max(1, (scene_.image.width + d - 1) / d);
+    scene.image.height = std::max(1, (scene_.image.height + d - 1) / d);
+    scene.image.spp = 1;
+    RenderOptions options;
+    options.threads = settings_.threads;
+    options.cancel = &cancel_;
+    const auto start = Clock::now();
+    RenderResult result = settings_.path == RenderPath::simd
+                              ? render_packet(scene, options, settings_.isa)
+                              : render_reference(scene, options);
+    ViewFrame frame;
+    frame.image = std::move(result.image);
+    frame.camera_version = version;
+    frame.camera = camera;
+    frame.preview = true;
+    frame.spp = 1;
+    frame.target_spp = scene_.image.spp;
+    frame.pass_seconds = result.seconds;
+    frame.frame_seconds = seconds_since(start);
+    frame.mrays_per_second = mrays_per_second(result);
+    publish(std::move(frame));
+}
+
+bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
+    Scene scene = scene_;
+    scene.camera = camera;
+    RenderOptions options;
+    options.threads = settings_.threads;
+    options.cancel = &cancel_;
+    const auto start = Clock::now();
+    // The SIMD path compiles the scene once for all passes of this camera.
+    std::optional<CompiledScene> compiled;
+    if (settings_.path == RenderPath::simd) compiled.emplace(compile_scene(scene));
+    const batch::PassRenderer render_pass = [&](const RenderOptions& pass_options) {
+        return compiled ? render_packet(*compiled, pass_options, settings_.isa)
+                        : render_reference(scene, pass_options);
+    };
+    const batch::PassCallback on_pass = [&](const RenderResult& so_far, int samples_so_far) {
+        ViewFrame frame;
+        frame.image = so_far.image;
+        frame.camera_version = version;
+        frame.camera = camera;
+        frame.spp = samples_so_far;
+        frame.target_spp = scene.image.spp;
+        frame.pass_seconds = so_far.seconds;
+        frame.frame_seconds = seconds_since(start);
+        frame.mrays_per_second = mrays_per_second(so_far);
+        publish(std::move(frame));
+    };
+    batch::render_progressive(render_pass, scene.image.spp, options, on_pass);
+    return true;
+}
+
+}  // namespace octray::view

@@ -1,0 +1,115 @@
+#pragma once
+// The renderer behind `octray view`: one scene, a camera the page moves, and a thread that
+// renders it — a reduced-resolution preview while the camera moves, then progressive
+// passes of 1, 2, 4, ... samples per pixel up to the scene's spp once it stops — and
+// publishes each finished picture for the HTTP server (render/view/view_server.h).
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "core/image.h"
+#include "kernels/isa.h"
+#include "render/types.h"
+#include "scene/scene.h"
+
+namespace octray::view {
+
+// The order in which a picture's pixels are rendered and shown.
+enum class PixelOrder {
+    tiled,      // whole pictures: progressive passes (and previews while moving)
+    frameless,  // blocks in a fixed random permutation, shown as they land (frameless.h)
+};
+
+struct ViewSettings {
+    PixelOrder order = PixelOrder::tiled;
+    int frameless_block = 8;  // frameless: block side in pixels
+    RenderPath path = RenderPath::simd;
+    Isa isa = Isa::automatic;
+    int threads = 0;          // 0: every core TBB sees
+    int preview_divisor = 4;  // a moving camera renders (width / d) x (height / d) at 1 spp
+    // After a preview, the passes at full resolution start once the camera has not moved
+    // for this long (a page that sends no final "stopped" still gets a sharp picture).
+    std::chrono::milliseconds settle{300};
+};
+
+// One published picture and how it was made.
+struct ViewFrame {
+    Image image;                       // linear RGB, row 0 on top
+    std::uint64_t generation = 0;      // 1, 2, 3, ... in publishing order
+    std::uint64_t camera_version = 0;  // which set_camera() call it shows (1: the scene's)
+    Camera camera;
+    bool preview = false;           // reduced resolution while the camera moves
+    int spp = 0;                    // samples per pixel so far
+    int target_spp = 0;             // the scene's spp: the last pass
+    double pass_seconds = 0.0;      // this pass
+    double frame_seconds = 0.0;     // every pass so far of this camera
+    double mrays_per_second = 0.0;  // this pass: rays traced / pass_seconds
+    // Frameless: the part of the picture rendered with this camera so far (1: all of it,
+    // at the scene's spp; the rest still shows earlier cameras). Tiled: always 1.
+    double coverage = 1.0;
+};
+
+class ViewSession {
+  public:
+    // `scene` must be a still scene that passed validate_scene(). Starts rendering at once.
+    ViewSession(Scene scene, ViewSettings settings);
+    ~ViewSession();  // stop()
+    ViewSession(const ViewSession&) = delete;
+    ViewSession& operator=(const ViewSession&) = delete;
+
+    // The scene as loaded (its camera is the initial one).
+    const Scene& scene() const { return scene_; }
+
+    // The latest picture, nullptr before the first one.
+    std::shared_ptr<const ViewFrame> latest() const;
+    // Waits up to `timeout` for a picture newer than `generation` (or stop()); returns the
+    // latest (possibly still the old one, or nullptr).
+    std::shared_ptr<const ViewFrame> wait_newer(std::uint64_t generation,
+                                                std::chrono::milliseconds timeout) const;
+
+    // Moves the camera: the picture being rendered is abandoned at its next tile. `moving`:
+    // more moves follow soon, so render a preview first. Throws SceneError (with what is
+    // wrong) for a camera the scene cannot have: non-finite numbers, eye on the look-at
+    // point, up along the view, a fov out of range. Returns the new camera version.
+    std::uint64_t set_camera(const Camera& camera, bool moving);
+    Camera camera() const;
+
+    // Why the latest camera could not be rendered (a render that threw, such as out of
+    // memory), empty if it could; cleared by the next camera.
+    std::string error() const;
+
+    // Ends the render thread (the pass in flight is abandoned) and wakes every waiter.
+    void stop();
+    bool stopped() const;
+
+  private:
+    void run();
+    void run_frameless();
+    void render_preview(const Camera& camera, std::uint64_t version);
+    bool render_passes(const Camera& camera, std::uint64_t version);
+    void publish(ViewFrame frame);
+
+    const Scene scene_;
+    const ViewSettings settings_;
+
+    mutable std::mutex mutex_;
+    mutable std::condition_variable changed_;  // camera set, picture published, or stop
+    Camera camera_;
+    std::uint64_t camera_version_ = 1;
+    bool moving_ = false;
+    bool stop_ = false;
+    std::uint64_t generation_ = 0;
+    std::shared_ptr<const ViewFrame> latest_;
+    std::string error_;
+    std::atomic<bool> cancel_{false};  // what the renderers poll between tiles
+
+    std::thread thread_;
+};
+
+}  // namespace octray::view

@@ -1,0 +1,237 @@
+#!/usr/bin/env python3
+"""The page of `octray view` in a real browser (headless Chromium through chromedriver).
+
+    browser_test.py OCTRAY ARTIFACTS_DIR
+
+Starts `octray view` on a free port, opens the URL it prints, and checks that the page
+shows the refined picture (the canvas has non-black pixels and says spp 4), that a drag
+across the canvas orbits the camera (the server reports a new camera at the same distance
+from the same look-at point, and the canvas changes), that the wheel dollies, that
+the frameless order converges to the same picture as the tiled one, that the server refuses the page
+without the token, and that SIGINT stops the command with status 0. Screenshots go to
+ARTIFACTS_DIR. Exits 77 (ctest's SKIP_RETURN_CODE) when Chromium, chromedriver or
+python3-selenium is missing.
+"""
+
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import urllib.error
+import urllib.request
+
+SKIP = 77
+WAIT = 90  # seconds: generous, for a loaded two-core machine
+
+
+def skip(why):
+    print(f"SKIP: {why} (tools/setup.sh installs chromium, chromium-driver and "
+          "python3-selenium)")
+    return SKIP
+
+
+def fail(why):
+    print(f"FAIL: {why}")
+    return 1
+
+
+def start_view(octray, *extra):
+    process = subprocess.Popen(
+        [octray, "view", "whitted", "--port", "0", "--width", "160", "--height", "90",
+         "--spp", "4", "--threads", "2", *extra],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for line in process.stdout:
+        line = line.strip()
+        if line.startswith("http://"):
+            return process, line
+    process.wait()
+    raise RuntimeError("octray view printed no URL: " + process.stderr.read())
+
+
+def fetch_status(url):
+    base, token = url.split("/?token=")
+    with urllib.request.urlopen(f"{base}/api/status?token={token}", timeout=30) as response:
+        return json.load(response)
+
+
+def canvas_digest(browser):
+    """(non-black pixel count, a checksum of the canvas's pixels)."""
+    return browser.execute_script("""
+        const canvas = document.getElementById('view');
+        const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+        let lit = 0, sum = 0;
+        for (let i = 0; i < data.length; i += 4) {
+          if (data[i] + data[i + 1] + data[i + 2] > 24) lit++;
+          sum = (sum * 31 + data[i] + 7 * data[i + 1] + 13 * data[i + 2]) % 1000000007;
+        }
+        return [lit, sum];""")
+
+
+def run(octray, artifacts):
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.service import Service
+        from selenium.webdriver.common.action_chains import ActionChains
+        from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
+        from selenium.webdriver.support.ui import WebDriverWait
+    except ImportError:
+        return skip("python3-selenium is not installed")
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    driver = shutil.which("chromedriver") or (
+        "/usr/bin/chromedriver" if os.path.exists("/usr/bin/chromedriver") else None)
+    if not chromium or not driver:
+        return skip("chromium or chromedriver is not installed")
+    os.makedirs(artifacts, exist_ok=True)
+
+    process, url = start_view(octray)
+    status = 0
+    try:
+        base = url.split("/?token=")[0]
+        try:
+            urllib.request.urlopen(base + "/", timeout=30)
+            return fail("the page was served without the token")
+        except urllib.error.HTTPError as e:
+            if e.code != 403:
+                return fail(f"without the token: HTTP {e.code}, expected 403")
+
+        with tempfile.TemporaryDirectory() as profile:
+            options = webdriver.ChromeOptions()
+            options.binary_location = chromium
+            for argument in ("--headless=new", "--no-sandbox", "--disable-gpu",
+                             "--disable-dev-shm-usage", "--window-size=640,400",
+                             f"--user-data-dir={profile}"):
+                options.add_argument(argument)
+            browser = webdriver.Chrome(service=Service(driver), options=options)
+            try:
+                status = check_page(browser, url, artifacts, ActionChains, ScrollOrigin,
+                                    WebDriverWait)
+                if status == 0:
+                    status = check_frameless(browser, octray, artifacts, WebDriverWait)
+            finally:
+                browser.quit()
+    finally:
+        process.send_signal(signal.SIGINT)
+        try:
+            out, err = process.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            return fail("octray view did not stop within 60 s of SIGINT")
+    if status == 0 and process.returncode != 0:
+        return fail(f"octray view exited {process.returncode} after SIGINT: {err}")
+    if status == 0 and "stopped" not in out:
+        return fail(f"octray view did not say it stopped: {out!r}")
+    return status
+
+
+def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWait):
+    browser.set_page_load_timeout(WAIT)
+    browser.get(url)
+    # The refined first picture: the last pass's event, and its PNG drawn on the canvas.
+    WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+        "return document.body.dataset.spp === '4' && "
+        "document.getElementById('view').dataset.spp === '4'"))
+    lit, before = canvas_digest(browser)
+    browser.save_screenshot(os.path.join(artifacts, "view_loaded.png"))
+    if lit < 160 * 90 // 2:
+        return fail(f"the canvas shows {lit} lit pixels of {160 * 90}: no picture")
+    for element, text in (("spp", "4"), ("target-spp", "4")):
+        shown = browser.find_element("id", element).text
+        if shown != text:
+            return fail(f"#{element} shows {shown!r}, expected {text!r}")
+    mrays = browser.find_element("id", "mrays").text
+    if not mrays or float(mrays) <= 0:
+        return fail(f"#mrays shows {mrays!r}")
+    first = fetch_status(url)["frame"]
+
+    # A drag to the right orbits the eye about the look-at point.
+    canvas = browser.find_element("id", "view")
+    ActionChains(browser).move_to_element(canvas).click_and_hold().move_by_offset(
+        40, 0).move_by_offset(40, 10).release().perform()
+
+    def refined_after_drag(b):
+        frame = fetch_status(url)["frame"]
+        if frame["camera_version"] <= 1 or frame["preview"] or frame["spp"] != 4:
+            return False
+        shown = b.execute_script(
+            "const c = document.getElementById('view');"
+            "return [Number(c.dataset.generation), c.dataset.spp];")
+        ok = shown[0] is not None and shown[0] >= frame["generation"] and shown[1] == "4"
+        return frame if ok else False
+
+    moved = WebDriverWait(browser, WAIT).until(refined_after_drag)
+    browser.save_screenshot(os.path.join(artifacts, "view_orbited.png"))
+    eye0, eye1 = first["camera"]["eye"], moved["camera"]["eye"]
+    lookat = first["camera"]["lookat"]
+    if moved["camera"]["lookat"] != lookat:
+        return fail(f"the look-at point moved: {lookat} -> {moved['camera']['lookat']}")
+    if eye1 == eye0:
+        return fail(f"the drag left the eye at {eye0}")
+    r0, r1 = math.dist(eye0, lookat), math.dist(eye1, lookat)
+    if abs(r1 - r0) > 1e-3 * r0:
+        return fail(f"an orbit changed the distance to the look-at point: {r0} -> {r1}")
+    _, after = canvas_digest(browser)
+    if after == before:
+        return fail("the canvas did not change after the drag")
+
+    # The wheel dollies: scrolling down moves the eye away along the view.
+    ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(canvas), 0,
+                                             200).perform()
+
+    def refined_after_wheel(b):
+        frame = fetch_status(url)["frame"]
+        if (frame["camera_version"] <= moved["camera_version"] or frame["preview"]
+                or frame["spp"] != 4):
+            return False
+        return frame
+
+    dollied = WebDriverWait(browser, WAIT).until(refined_after_wheel)
+    r2 = math.dist(dollied["camera"]["eye"], lookat)
+    if not r2 > 1.01 * r1:
+        return fail(f"the wheel did not dolly out: distance {r1} -> {r2}")
+    print(f"PASS: first picture {lit} lit pixels; drag moved the eye {eye0} -> {eye1} "
+          f"(camera version {moved['camera_version']}); the wheel dollied from {r1:.3f} "
+          f"to {r2:.3f}; screenshots in {artifacts}")
+    return 0
+
+
+def check_frameless(browser, octray, artifacts, WebDriverWait):
+    """The frameless order converges to the tiled order's picture: the same canvas pixels
+    as a tiled viewer's refined first picture (the first URL's, before any drag)."""
+    tiled, tiled_url = start_view(octray)
+    frameless, frameless_url = start_view(octray, "--order", "frameless")
+    try:
+        digests = []
+        for url, name, done in (
+                (tiled_url, "view_tiled.png", lambda f: f["spp"] == 4 and not f["preview"]),
+                (frameless_url, "view_frameless.png", lambda f: f["coverage"] == 1)):
+            browser.get(url)
+
+            def converged(b):
+                frame = fetch_status(url)["frame"]
+                if not done(frame):
+                    return False
+                generation = b.execute_script(
+                    "return Number(document.getElementById('view').dataset.generation);")
+                return generation is not None and generation >= frame["generation"]
+
+            WebDriverWait(browser, WAIT).until(converged)
+            digests.append(canvas_digest(browser))
+            browser.save_screenshot(os.path.join(artifacts, name))
+    finally:
+        for process in (tiled, frameless):
+            process.send_signal(signal.SIGINT)
+            process.communicate(timeout=60)
+    if digests[0] != digests[1]:
+        return fail(f"frameless converged to another picture than tiled: {digests}")
+    print(f"PASS: the frameless order converged to the tiled picture {digests[0]}")
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    sys.exit(run(sys.argv[1], sys.argv[2]))

@@ -1,0 +1,81 @@
+// `octray view` as a user runs it: its help, and the failures before it serves (a scene
+// that cannot be loaded, an address that cannot be bound). Serving, the page and Ctrl-C
+// are checked by browser_test.py, which runs the command too.
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "tests/tools/run_octray.h"
+
+namespace {
+
+using octray::testing::run_octray;
+using octray::testing::RunResult;
+
+bool contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+const std::filesystem::path kCwd = std::filesystem::temp_directory_path();
+
+TEST(ViewCli, HelpExplainsTheTokenTheApiAndCtrlC) {
+    const RunResult r = run_octray({"view", "--help"}, kCwd);
+    EXPECT_EQ(r.status, 0) << r.output;
+    for (const char* part : {"--bind", "--port", "--preview-divisor", "token", "403", "Ctrl-C",
+                             "render/view/README.md", "Exit codes:"})
+        EXPECT_TRUE(contains(r.output, part)) << part << "\n" << r.output;
+}
+
+TEST(ViewCli, AMissingSceneIsASceneError) {
+    const RunResult r = run_octray({"view", "no_such_scene.json", "--port", "0"}, kCwd);
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "no_such_scene.json")) << r.output;
+}
+
+TEST(ViewCli, AnAddressThatCannotBeBoundIsAUsageError) {
+    const RunResult bad_host = run_octray({"view", "--bind", "256.1.2.3", "--port", "0"}, kCwd);
+    EXPECT_EQ(bad_host.status, 2) << bad_host.output;
+    EXPECT_TRUE(contains(bad_host.output, "cannot listen on 256.1.2.3")) << bad_host.output;
+
+    // A port some other socket listens on.
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+    ASSERT_EQ(listen(fd, 1), 0);
+    socklen_t size = sizeof address;
+    ASSERT_EQ(getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size), 0);
+    const std::string port = std::to_string(ntohs(address.sin_port));
+    const RunResult busy = run_octray({"view", "--port", port}, kCwd);
+    close(fd);
+    EXPECT_EQ(busy.status, 2) << busy.output;
+    EXPECT_TRUE(contains(busy.output, "cannot listen on 127.0.0.1:" + port)) << busy.output;
+}
+
+TEST(ViewCli, AForcedIsaIsChecked) {
+    const RunResult r = run_octray({"view", "--isa", "avx512"}, kCwd);
+    EXPECT_EQ(r.status, 2) << r.output;
+}
+
+// --bench serves nothing: it renders the first picture and N orbit updates and reports
+// their rates (the figures themselves are not checked: no timing in tests).
+TEST(ViewCli, BenchReportsTheFirstPictureAndTheOrbitUpdates) {
+    const RunResult r = run_octray({"view", "whitted", "--width", "64", "--height", "36",
+                                    "--threads", "1", "--bench", "12"},
+                                   kCwd);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "first picture: 64x36 at 1 spp after ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "orbit: 12 updates of 16x9 in ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "updates/s")) << r.output;
+    EXPECT_TRUE(contains(r.output, "Mrays/s")) << r.output;
+}
+
+}  // namespace

@@ -1,0 +1,427 @@
+// `octray view`'s HTTP API with a real client (httplib::Client) against a server started
+// in this process on a free port: the token, refused requests, the first picture equal to
+// a plain render bit for bit, the camera endpoint, previews, event streams, reconnects.
+
+#include "render/view/view_server.h"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "render/packet_renderer.h"
+#include "render/view/frameless.h"
+#include "render/view/view_session.h"
+#include "scene/builtin.h"
+
+namespace {
+
+using nlohmann::json;
+using octray::Scene;
+using octray::view::ServerOptions;
+using octray::view::ViewServer;
+using octray::view::ViewSession;
+using octray::view::ViewSettings;
+
+Scene small_whitted() {
+    Scene scene = octray::make_builtin_scene("whitted");
+    scene.image.width = 64;
+    scene.image.height = 36;
+    scene.image.spp = 4;
+    return scene;
+}
+
+// The raw bytes of render_packet's image of `scene`: what /api/image.f32 must return.
+std::string rendered_bytes(const Scene& scene) {
+    const octray::RenderResult result = octray::render_packet(scene);
+    return std::string(reinterpret_cast<const char*>(result.image.data()),
+                       result.image.pixel_count() * sizeof(octray::Rgb));
+}
+
+class ViewServerTest : public ::testing::Test {
+  protected:
+    virtual octray::view::PixelOrder order() const { return octray::view::PixelOrder::tiled; }
+
+    void SetUp() override {
+        ViewSettings settings;
+        settings.order = order();
+        settings.threads = 2;
+        // Long enough that a test polling the status sees a preview before it is refined,
+        // however loaded the machine.
+        settings.settle = std::chrono::milliseconds(3000);
+        session_ = std::make_unique<ViewSession>(scene_, settings);
+        server_ = std::make_unique<ViewServer>(*session_, ServerOptions{});
+        server_->start();
+        client_ = std::make_unique<httplib::Client>("127.0.0.1", server_->port());
+        client_->set_read_timeout(60, 0);
+    }
+    void TearDown() override {
+        client_.reset();
+        server_.reset();
+        session_.reset();
+    }
+
+    std::string with_token(const std::string& path) const {
+        return path + (path.find('?') == std::string::npos ? "?" : "&") +
+               "token=" + server_->token();
+    }
+
+    json status() {
+        const auto result = client_->Get(with_token("/api/status"));
+        EXPECT_TRUE(result);
+        if (!result || result->status != 200) return json{};
+        return json::parse(result->body);
+    }
+
+    // Polls the status until `done(frame)` holds (60 s at most); the frame, or null.
+    json wait_for_frame(const std::function<bool(const json&)>& done) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (std::chrono::steady_clock::now() < deadline) {
+            const json s = status();
+            if (s.contains("frame") && done(s["frame"])) return s["frame"];
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        return json{};
+    }
+
+    const Scene scene_ = small_whitted();
+    std::unique_ptr<ViewSession> session_;
+    std::unique_ptr<ViewServer> server_;
+    std::unique_ptr<httplib::Client> client_;
+};
+
+TEST_F(ViewServerTest, EveryPathWithoutTheTokenIs403) {
+    for (const char* path : {"/", "/api/status", "/api/events", "/api/image.png",
+                             "/api/image.f32", "/no/such/page", "/../etc/passwd"}) {
+        const auto result = client_->Get(path);
+        ASSERT_TRUE(result) << path;
+        EXPECT_EQ(result->status, 403) << path;
+        EXPECT_EQ(result->body.find(server_->token()), std::string::npos);
+    }
+    const auto post = client_->Post("/api/camera", R"({"eye": [0, 1, 5]})", "application/json");
+    ASSERT_TRUE(post);
+    EXPECT_EQ(post->status, 403);
+    EXPECT_EQ(session_->camera().eye.z, scene_.camera.eye.z);
+}
+
+TEST_F(ViewServerTest, AWrongTokenIs403) {
+    std::string wrong = server_->token();
+    wrong[0] = wrong[0] == 'a' ? 'b' : 'a';
+    for (const std::string& token :
+         {wrong, server_->token().substr(0, 31), std::string(), server_->token() + "0"}) {
+        const auto result = client_->Get("/api/status?token=" + token);
+        ASSERT_TRUE(result);
+        EXPECT_EQ(result->status, 403) << token;
+    }
+    const std::string cookie = "octray_token_" + std::to_string(server_->port());
+    const auto by_cookie = client_->Get("/api/status", {{"Cookie", cookie + "=" + wrong}});
+    ASSERT_TRUE(by_cookie);
+    EXPECT_EQ(by_cookie->status, 403);
+    // The cookie of another port's viewer does not open this one.
+    const auto other_port =
+        client_->Get("/api/status", {{"Cookie", "octray_token_1=" + server_->token()}});
+    ASSERT_TRUE(other_port);
+    EXPECT_EQ(other_port->status, 403);
+}
+
+TEST_F(ViewServerTest, ThePageSetsTheTokenCookieWhichThenSuffices) {
+    const auto page = client_->Get(with_token("/"));
+    ASSERT_TRUE(page);
+    ASSERT_EQ(page->status, 200);
+    EXPECT_NE(page->body.find("<canvas id=\"view\""), std::string::npos);
+    EXPECT_EQ(page->body.find("http://"), std::string::npos) << "the page loads nothing else";
+    EXPECT_EQ(page->body.find("https://"), std::string::npos) << "the page loads nothing else";
+    const std::string cookie = page->get_header_value("Set-Cookie");
+    const std::string name = "octray_token_" + std::to_string(server_->port());
+    EXPECT_EQ(cookie.rfind(name + "=" + server_->token() + ";", 0), 0u) << cookie;
+    EXPECT_NE(cookie.find("HttpOnly"), std::string::npos);
+    EXPECT_NE(cookie.find("SameSite=Strict"), std::string::npos);
+    const auto by_cookie =
+        client_->Get("/api/status", {{"Cookie", "a=b; " + name + "=" + server_->token()}});
+    ASSERT_TRUE(by_cookie);
+    EXPECT_EQ(by_cookie->status, 200);
+}
+
+TEST_F(ViewServerTest, UnknownPathsWithTheTokenAre404) {
+    for (const char* path : {"/index.html", "/api", "/api/scene", "/../whitted.json"}) {
+        const auto result = client_->Get(with_token(path));
+        ASSERT_TRUE(result) << path;
+        EXPECT_EQ(result->status, 404) << path;
+    }
+}
+
+TEST_F(ViewServerTest, BadCameraRequestsAre400AndChangeNothing) {
+    const octray::Camera before = session_->camera();
+    for (const std::string& body :
+         {std::string("not json"), std::string("[1, 2, 3]"), std::string(R"({"eye": [1, 2]})"),
+          std::string(R"({"eye": [1, 2, "3"]})"), std::string(R"({"eye": [1, 2, 1e999]})"),
+          std::string(R"({"eye": [1, 2, 1e31]})"), std::string(R"({"fov": -5})"),
+          std::string(R"({"fov": 180})"), std::string(R"({"moving": 1})"),
+          std::string(R"({"zoom": 2})"),
+          std::string(R"({"eye": [0, 0, 0], "lookat": [0, 0, 0]})"),
+          std::string(R"({"up": [0, 0, 0]})")}) {
+        const auto result = client_->Post(with_token("/api/camera"), body, "application/json");
+        ASSERT_TRUE(result) << body;
+        EXPECT_EQ(result->status, 400) << body << " -> " << result->body;
+        EXPECT_FALSE(result->body.empty()) << body;
+    }
+    EXPECT_EQ(session_->camera().eye.x, before.eye.x);
+    EXPECT_EQ(session_->camera().fov, before.fov);
+}
+
+TEST_F(ViewServerTest, AnOversizedBodyIs413) {
+    const std::string body = R"({"eye": [0, 1, 5], "pad": ")" + std::string(10000, 'x') + "\"}";
+    const auto result = client_->Post(with_token("/api/camera"), body, "application/json");
+    ASSERT_TRUE(result);
+    EXPECT_EQ(result->status, 413);
+}
+
+TEST_F(ViewServerTest, ABadExposureIs400) {
+    ASSERT_FALSE(wait_for_frame([](const json&) { return true; }).is_null());
+    for (const char* exposure : {"abc", "1e9", "nan", "", "2x"}) {
+        const auto result =
+            client_->Get(with_token(std::string("/api/image.png?exposure=") + exposure));
+        ASSERT_TRUE(result) << exposure;
+        EXPECT_EQ(result->status, 400) << exposure;
+    }
+    const auto good = client_->Get(with_token("/api/image.png?exposure=-1.5"));
+    ASSERT_TRUE(good);
+    EXPECT_EQ(good->status, 200);
+    EXPECT_EQ(good->body.substr(1, 3), "PNG");
+}
+
+// A request line that is not HTTP gets 400 from the server, which keeps serving.
+TEST_F(ViewServerTest, AMalformedRequestIs400) {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+    const std::string garbage = "\x01\x02 GARBAGE\r\n\r\n";
+    ASSERT_EQ(write(fd, garbage.data(), garbage.size()), static_cast<ssize_t>(garbage.size()));
+    char reply[256] = {};
+    const ssize_t n = read(fd, reply, sizeof reply - 1);
+    close(fd);
+    ASSERT_GT(n, 0);
+    EXPECT_EQ(std::string(reply).rfind("HTTP/1.1 400", 0), 0u) << reply;
+    EXPECT_EQ(status().is_null(), false);
+}
+
+// The first picture, once its last pass (spp = the scene's) is in, is render_packet's image
+// of the same scene bit for bit: progressive passes sum samples in the same order
+// (render/progressive.h).
+TEST_F(ViewServerTest, TheFirstPictureEqualsAPlainRenderBitForBit) {
+    const json frame = wait_for_frame([&](const json& f) { return f["spp"] == 4; });
+    ASSERT_FALSE(frame.is_null());
+    EXPECT_EQ(frame["camera_version"], 1);
+    EXPECT_EQ(frame["preview"], false);
+    EXPECT_EQ(frame["width"], 64);
+    EXPECT_EQ(frame["height"], 36);
+    const auto image = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(image);
+    ASSERT_EQ(image->status, 200);
+    EXPECT_EQ(image->get_header_value("X-Octray-Spp"), "4");
+    EXPECT_EQ(image->get_header_value("X-Octray-Width"), "64");
+    EXPECT_EQ(image->get_header_value("X-Octray-Height"), "36");
+    ASSERT_EQ(image->body.size(), 64u * 36u * 3u * sizeof(float));
+    EXPECT_TRUE(image->body == rendered_bytes(scene_)) << "the picture differs from render";
+}
+
+TEST_F(ViewServerTest, ACameraSetThroughTheApiIsRenderedExactly) {
+    const auto result =
+        client_->Post(with_token("/api/camera"), R"({"eye": [1.5, 2.5, 6.0], "moving": false})",
+                      "application/json");
+    ASSERT_TRUE(result);
+    ASSERT_EQ(result->status, 200) << result->body;
+    const int version = json::parse(result->body)["camera_version"];
+    EXPECT_GE(version, 2);
+    const json frame = wait_for_frame(
+        [&](const json& f) { return f["camera_version"] == version && f["spp"] == 4; });
+    ASSERT_FALSE(frame.is_null());
+    EXPECT_EQ(frame["camera"]["eye"], json::array({1.5, 2.5, 6.0}));
+    const auto image = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(image);
+    ASSERT_EQ(image->get_header_value("X-Octray-Camera-Version"), std::to_string(version));
+    Scene moved = scene_;
+    moved.camera.eye = octray::Vec3{1.5f, 2.5f, 6.0f};
+    EXPECT_TRUE(image->body == rendered_bytes(moved));
+    EXPECT_FALSE(image->body == rendered_bytes(scene_));
+}
+
+// While the camera moves the picture is a 1-spp preview at a quarter of the size; once it
+// has settled, the full picture follows.
+TEST_F(ViewServerTest, AMovingCameraGetsAPreviewThenTheRefinedPicture) {
+    ASSERT_FALSE(wait_for_frame([](const json& f) { return f["spp"] == 4; }).is_null());
+    const auto result =
+        client_->Post(with_token("/api/camera"), R"({"eye": [0.5, 2.0, 7.0], "moving": true})",
+                      "application/json");
+    ASSERT_TRUE(result);
+    ASSERT_EQ(result->status, 200);
+    const int version = json::parse(result->body)["camera_version"];
+    const json preview = wait_for_frame(
+        [&](const json& f) { return f["camera_version"] == version && f["preview"] == true; });
+    ASSERT_FALSE(preview.is_null());
+    EXPECT_EQ(preview["width"], 16);
+    EXPECT_EQ(preview["height"], 9);
+    EXPECT_EQ(preview["spp"], 1);
+    const json refined = wait_for_frame([&](const json& f) {
+        return f["camera_version"] == version && f["preview"] == false && f["spp"] == 4;
+    });
+    ASSERT_FALSE(refined.is_null());
+    EXPECT_EQ(refined["width"], 64);
+}
+
+// Reads one event stream until `enough` says so; the events' JSON payloads.
+std::vector<json> read_events(httplib::Client& client, const std::string& path,
+                              const std::function<bool(const std::vector<json>&)>& enough) {
+    std::vector<json> events;
+    std::string buffer;
+    client.Get(path, [&](const char* data, std::size_t size) {
+        buffer.append(data, size);
+        for (std::size_t end; (end = buffer.find("\n\n")) != std::string::npos;) {
+            const std::string message = buffer.substr(0, end);
+            buffer.erase(0, end + 2);
+            const std::size_t data_at = message.find("data: ");
+            if (message.rfind("event: frame", 0) == 0 && data_at != std::string::npos)
+                events.push_back(json::parse(message.substr(data_at + 6)));
+        }
+        return !enough(events);
+    });
+    return events;
+}
+
+// A stream announces the current picture at once, then newer ones in order, ending on the
+// last pass of a new camera. A reader that is slower than the passes skips some (the
+// stream holds only the latest picture, never a queue), so the passes seen are an
+// increasing part of 1, 2, 4.
+TEST_F(ViewServerTest, TheEventStreamAnnouncesANewCamerasPassesInOrder) {
+    ASSERT_FALSE(wait_for_frame([](const json& f) { return f["spp"] == 4; }).is_null());
+    std::thread mover([&] {
+        httplib::Client other("127.0.0.1", server_->port());
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        other.Post(with_token("/api/camera"), R"({"eye": [-1.0, 2.0, 7.0]})",
+                   "application/json");
+    });
+    const std::vector<json> events =
+        read_events(*client_, with_token("/api/events"), [](const std::vector<json>& e) {
+            return !e.empty() && e.back()["camera_version"] == 2 && e.back()["spp"] == 4;
+        });
+    mover.join();
+    ASSERT_GE(events.size(), 2u);
+    EXPECT_EQ(events.front()["camera_version"], 1);
+    EXPECT_EQ(events.front()["spp"], 4);
+    std::vector<int> passes;
+    for (std::size_t i = 1; i < events.size(); ++i) {
+        EXPECT_GT(events[i]["generation"], events[i - 1]["generation"]);
+        if (events[i]["camera_version"] == 2) passes.push_back(events[i]["spp"]);
+    }
+    ASSERT_FALSE(passes.empty());
+    EXPECT_EQ(passes.back(), 4);
+    for (std::size_t i = 0; i < passes.size(); ++i) {
+        EXPECT_TRUE(passes[i] == 1 || passes[i] == 2 || passes[i] == 4) << passes[i];
+        if (i > 0) {
+            EXPECT_GT(passes[i], passes[i - 1]);
+        }
+    }
+}
+
+// A hundred clients that open the event stream and go away, and a hundred that fetch a
+// picture, one after the other: the server still answers, and its event streams end.
+TEST_F(ViewServerTest, AHundredReconnectsLeaveTheServerRunning) {
+    ASSERT_FALSE(wait_for_frame([](const json& f) { return f["spp"] == 4; }).is_null());
+    for (int i = 0; i < 100; ++i) {
+        httplib::Client client("127.0.0.1", server_->port());
+        client.set_read_timeout(60, 0);
+        const auto events = read_events(client, with_token("/api/events"),
+                                        [](const std::vector<json>& e) { return !e.empty(); });
+        ASSERT_EQ(events.size(), 1u) << "reconnect " << i;
+        const auto image = client.Get(with_token("/api/image.png"));
+        ASSERT_TRUE(image) << "reconnect " << i;
+        ASSERT_EQ(image->status, 200);
+    }
+    const json s = status();
+    ASSERT_TRUE(s.contains("frame"));
+    EXPECT_EQ(s["frame"]["spp"], 4);
+}
+
+TEST_F(ViewServerTest, StopEndsAnOpenEventStream) {
+    ASSERT_FALSE(wait_for_frame([](const json&) { return true; }).is_null());
+    std::thread stopper([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        server_->stop();
+    });
+    // Without stop() this would read forever (the test would time out).
+    read_events(*client_, with_token("/api/events"),
+                [](const std::vector<json>&) { return false; });
+    stopper.join();
+    server_->wait();
+    SUCCEED();
+}
+
+TEST(FramelessBlocks, CoverThePictureOnceInAFixedShuffledOrder) {
+    const auto blocks = octray::view::frameless_blocks(21, 10, 8);
+    ASSERT_EQ(blocks.size(), 6u);  // 3 x 2, the last column 5 wide and the last row 2 high
+    std::vector<int> hits(21 * 10, 0);
+    for (const octray::PixelRect& r : blocks)
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) ++hits[static_cast<std::size_t>(y * 21 + x)];
+    EXPECT_EQ(std::count(hits.begin(), hits.end(), 1), 210);
+    EXPECT_EQ(octray::view::frameless_blocks(21, 10, 8), blocks) << "the order is fixed";
+    const auto many = octray::view::frameless_blocks(64, 64, 8);
+    auto row_major = many;
+    std::sort(row_major.begin(), row_major.end(), [](const auto& a, const auto& b) {
+        return a.y0 != b.y0 ? a.y0 < b.y0 : a.x0 < b.x0;
+    });
+    EXPECT_NE(many, row_major) << "the order is shuffled";
+    EXPECT_THROW(octray::view::frameless_blocks(0, 10, 8), std::invalid_argument);
+}
+
+class FramelessViewTest : public ViewServerTest {
+  protected:
+    octray::view::PixelOrder order() const override {
+        return octray::view::PixelOrder::frameless;
+    }
+};
+
+// Blocks land a batch at a time; once every block of a still camera has been rendered,
+// the picture is the tiled order's (render_packet's) bit for bit, for the first camera and
+// for a camera set later, whose sweep starts over a picture of the old one.
+TEST_F(FramelessViewTest, ConvergesToTheTiledPictureBitForBit) {
+    // 40 blocks of 8x8 in batches of 16: pictures of coverage 0.4, 0.8, then 1.
+    const json first = wait_for_frame(
+        [](const json& f) { return f["camera_version"] == 1 && f["coverage"] == 1.0; });
+    ASSERT_FALSE(first.is_null());
+    const auto image = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(image);
+    EXPECT_TRUE(image->body == rendered_bytes(scene_));
+
+    const auto result = client_->Post(with_token("/api/camera"), R"({"eye": [1.5, 2.5, 6.0]})",
+                                      "application/json");
+    ASSERT_TRUE(result);
+    ASSERT_EQ(result->status, 200);
+    const int version = json::parse(result->body)["camera_version"];
+    const json moved = wait_for_frame(
+        [&](const json& f) { return f["camera_version"] == version && f["coverage"] == 1.0; });
+    ASSERT_FALSE(moved.is_null());
+    const auto after = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(after);
+    ASSERT_EQ(after->get_header_value("X-Octray-Camera-Version"), std::to_string(version));
+    Scene scene = scene_;
+    scene.camera.eye = octray::Vec3{1.5f, 2.5f, 6.0f};
+    EXPECT_TRUE(after->body == rendered_bytes(scene));
+}
+
+}  // namespace

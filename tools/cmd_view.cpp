@@ -1,0 +1,246 @@
+// `octray view`: a scene rendering live in the browser (render/view/README.md). A thin
+// command over octray::view: load the scene, apply the overrides, serve until Ctrl-C.
+
+#include <pthread.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "kernels/dispatch.h"
+#include "render/view/view_bench.h"
+#include "render/view/view_server.h"
+#include "render/view/view_session.h"
+#include "scene/animation.h"
+#include "scene/load.h"
+#include "scene/max_depth.h"
+#include "tools/cli_checks.h"
+#include "tools/commands.h"
+
+namespace octray::tools {
+namespace {
+
+struct ViewArguments {
+    std::string scene{"whitted"};
+    std::string bind{"127.0.0.1"};
+    int port = 8090;
+    int width = 0, height = 0, spp = 0, max_depth = 0;
+    int threads = 0;
+    int preview_divisor = 4;
+    int bench = 0;  // orbit updates to measure; 0: serve
+    std::string path{"simd"};
+    std::string isa{"auto"};
+    std::string order{"tiled"};
+};
+
+CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
+
+// SIGINT and SIGTERM are blocked in every thread (the mask is inherited by the threads
+// made after it) and taken by one thread with sigwait(), which then stops the server:
+// stopping it from a signal handler would not be async-signal-safe.
+class StopOnSignal {
+  public:
+    StopOnSignal() {
+        sigemptyset(&signals_);
+        sigaddset(&signals_, SIGINT);
+        sigaddset(&signals_, SIGTERM);
+        pthread_sigmask(SIG_BLOCK, &signals_, nullptr);
+    }
+    // The signals stay blocked: the command is about to return and the process to exit,
+    // and a late Ctrl-C must not kill it before it has said that it stopped.
+    ~StopOnSignal() {
+        if (!waiter_.joinable()) return;
+        // Wake the waiter if no signal came (the server stopped on its own).
+        if (!signalled_) pthread_kill(waiter_.native_handle(), SIGTERM);
+        waiter_.join();
+    }
+    StopOnSignal(const StopOnSignal&) = delete;
+    StopOnSignal& operator=(const StopOnSignal&) = delete;
+
+    void watch(view::ViewServer& server) {
+        waiter_ = std::thread([this, &server] {
+            int received = 0;
+            sigwait(&signals_, &received);
+            signalled_ = true;
+            server.stop();
+        });
+    }
+
+  private:
+    sigset_t signals_{};
+    std::atomic<bool> signalled_{false};
+    std::thread waiter_;
+};
+
+void print_bench(const Scene& scene, const view::ViewSettings& settings,
+                 const view::ViewBenchResult& r) {
+    std::printf("octray view --bench: %s, %s path, %d threads (0 = all)\n",
+                scene.source.c_str(), render_path_name(settings.path), settings.threads);
+    std::printf("first picture: %dx%d at %d spp after %.3f s\n", r.first_width, r.first_height,
+                r.first_spp, r.first_picture_seconds);
+    std::printf(
+        "orbit: %d updates of %dx%d in %.3f s: %.1f updates/s, %.1f Mrays/s, "
+        "PNG %.0f bytes\n",
+        r.updates, r.update_width, r.update_height, r.seconds, r.updates_per_second,
+        r.mrays_per_second, r.png_bytes);
+    std::fflush(stdout);
+}
+
+void run_view(const ViewArguments& args) {
+    std::optional<StopOnSignal> stop_on_signal;
+    if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
+    Scene scene = load_scene(args.scene);
+    // An animation shows its first frame; the viewer has no time line yet.
+    if (scene.animation) {
+        scene = scene_at_frame(scene, 0);
+        scene.animation.reset();
+    }
+    if (args.width > 0) scene.image.width = args.width;
+    if (args.height > 0) scene.image.height = args.height;
+    if (args.spp > 0) scene.image.spp = args.spp;
+    if (args.max_depth > 0) scene.render.max_depth = args.max_depth;
+    validate_scene(scene);
+
+    view::ViewSettings settings;
+    settings.path = *parse_render_path(args.path);
+    try {
+        settings.isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
+    } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--isa: ") + e.what());
+    }
+    settings.threads = args.threads;
+    settings.preview_divisor = args.preview_divisor;
+    settings.order =
+        args.order == "frameless" ? view::PixelOrder::frameless : view::PixelOrder::tiled;
+
+    if (args.bench > 0) {
+        print_bench(scene, settings, view::bench_orbit(scene, settings, args.bench));
+        return;
+    }
+
+    view::ServerOptions options;
+    options.bind = args.bind;
+    options.port = args.port;
+
+    view::ViewSession session(scene, settings);
+    std::unique_ptr<view::ViewServer> server;
+    try {
+        server = std::make_unique<view::ViewServer>(session, options);
+    } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--bind/--port: ") + e.what());
+    }
+    server->start();
+    stop_on_signal->watch(*server);
+    std::cout << "octray view: " << scene.source << " (" << scene.image.width << "x"
+              << scene.image.height << ", " << scene.image.spp << " spp) at\n"
+              << "  " << server->url() << "\n"
+              << "Open that URL in a browser (it carries the access token); Ctrl-C stops.\n"
+              << std::flush;
+    server->wait();
+    session.stop();
+    std::cout << "octray view: stopped\n" << std::flush;
+}
+
+}  // namespace
+
+void add_view_command(CLI::App& app, CommandRunner& run) {
+    auto args = std::make_shared<ViewArguments>();
+    CLI::App* cmd = app.add_subcommand(
+        "view", "Watch a scene render live in a web browser, and move its camera");
+    cmd->add_option("scene", args->scene,
+                    "Scene file (JSON) or built-in spec, as for render (default whitted)")
+        ->type_name("SCENE");
+    cmd->add_option("--bind", args->bind,
+                    "Address to listen on; the default serves this machine only (use an\n"
+                    "SSH tunnel, ssh -L 8090:127.0.0.1:8090 host, to watch a remote one)")
+        ->type_name("ADDR")
+        ->capture_default_str();
+    cmd->add_option("--port", args->port,
+                    "TCP port, " + integer_range_text(0, 65535) + "; 0 = a free one")
+        ->type_name("PORT")
+        ->transform(decimal_integer(0, 65535))
+        ->capture_default_str();
+    cmd->add_option("--width", args->width,
+                    "Image width in pixels, " + integer_range_text(1, kMaxImageSide) +
+                        " (overrides the scene)")
+        ->type_name("W")
+        ->transform(decimal_integer(1, kMaxImageSide));
+    cmd->add_option("--height", args->height,
+                    "Image height in pixels, " + integer_range_text(1, kMaxImageSide) +
+                        " (overrides the scene)")
+        ->type_name("H")
+        ->transform(decimal_integer(1, kMaxImageSide));
+    cmd->add_option("--spp", args->spp,
+                    "Samples per pixel of the refined picture, " +
+                        integer_range_text(1, kMaxSamples) +
+                        ", reached in passes of 1, 2, 4, ...\n(overrides the scene)")
+        ->type_name("N")
+        ->transform(decimal_integer(1, kMaxSamples));
+    cmd->add_option("--max-depth", args->max_depth,
+                    "Reflection/refraction bounces, " + integer_range_text(1, kMaxDepthLimit) +
+                        " (overrides the scene)")
+        ->type_name("D")
+        ->transform(decimal_integer(1, kMaxDepthLimit));
+    cmd->add_option("--threads", args->threads,
+                    "Render threads, " + integer_range_text(0, kMaxThreadCount) +
+                        "; 0 = every core available")
+        ->type_name("N")
+        ->transform(decimal_integer(0, kMaxThreadCount))
+        ->capture_default_str();
+    cmd->add_option("--preview-divisor", args->preview_divisor,
+                    "While the camera moves, render width/D x height/D at 1 spp, " +
+                        integer_range_text(1, 64))
+        ->type_name("D")
+        ->transform(decimal_integer(1, 64))
+        ->capture_default_str();
+    cmd->add_option(
+           "--bench", args->bench,
+           "Serve nothing: measure the time to the first picture and the pictures\n"
+           "a second while the camera orbits, over N updates, " +
+               integer_range_text(1, 1000000) +
+               " (each rendered as a moving\ncamera is and PNG-encoded as for the page)")
+        ->type_name("N")
+        ->transform(decimal_integer(1, 1000000));
+    cmd->add_option("--order", args->order,
+                    "Pixel order: tiled (whole pictures, progressive passes, previews while\n"
+                    "moving) or frameless (8x8 blocks re-rendered in a fixed random order and\n"
+                    "shown as they land, no frame boundaries; Bishop et al. 1994)")
+        ->type_name("ORDER")
+        ->check(quiet(CLI::IsMember({"tiled", "frameless"})))
+        ->capture_default_str();
+    cmd->add_option("--path", args->path,
+                    "Render path: simd (8-ray packets) or scalar (the reference renderer)")
+        ->type_name("PATH")
+        ->check(quiet(CLI::IsMember({"scalar", "simd"})))
+        ->capture_default_str();
+    cmd->add_option("--isa", args->isa,
+                    "Instruction set of the simd path: auto, avx2, sse4.1 or sse2")
+        ->type_name("ISA")
+        ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
+        ->capture_default_str();
+    cmd->footer(
+        "The command prints a URL such as http://127.0.0.1:8090/?token=3f9c...: open it in a\n"
+        "browser. The token is 128 random bits, new each run; a request without it gets\n"
+        "403. The page shows the picture refining pass by pass (1, 2, 4, ... samples per\n"
+        "pixel) with spp, Mrays/s and frame time; drag orbits the camera about its look-at\n"
+        "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
+        "(--preview-divisor) until it stops. Nothing but the scene named here is served.\n"
+        "The HTTP API (status, events, PNG and float32 pictures, camera) is described in\n"
+        "render/view/README.md. Ctrl-C (or SIGTERM) stops the server.\n\n"
+        "Examples:\n"
+        "  octray view                                  # the built-in whitted scene\n"
+        "  octray view scene.json --port 0              # any free port\n"
+        "  octray view random:1024 --width 640 --height 360 --spp 16\n"
+        "  octray view whitted --width 640 --height 360 --threads 2 --bench 200\n\n" +
+        exit_code_help());
+    cmd->callback([args, &run] { run.action = [args] { run_view(*args); }; });
+}
+
+}  // namespace octray::tools
