@@ -2,7 +2,6 @@
 // The ray-sphere test shared by the brute-force kernels (brute_force.h) and the BVH leaves
 // (bvh_single_ray.h, bvh_packet_traversal.h): one arithmetic, so both find the same t.
 //
-//
 // Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
 // (packet_math.h; kernels/README.md, "the ODR rule").
 
