@@ -84,14 +84,6 @@ struct RenderArguments {
 
 // ---- Pre-flight: everything that can be checked before the first frame ----------------
 
-// Physical memory: the default --max-memory (0 if unknown: no limit).
-std::uint64_t physical_memory_bytes() {
-    const long pages = ::sysconf(_SC_PHYS_PAGES);
-    const long page_size = ::sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || page_size <= 0) return 0;
-    return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
-}
-
 // The library's RequestError is a mistake on the command line: exit 2, as a parse error.
 template <class F>
 auto usage_errors(F&& f) -> decltype(f()) {
@@ -212,7 +204,7 @@ void run_render(const RenderArguments& args) {
     if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
     if (!args.aov.empty()) settings.aovs = parse_aov_option(args.aov);
     settings.options.accel = parse_accel_option(args.accel);
-    std::uint64_t memory_limit = physical_memory_bytes();
+    std::uint64_t memory_limit = machine_memory_bytes();  // 0 if unknown: no limit
     if (!args.max_memory.empty()) {
         const auto limit = parse_memory_size(args.max_memory);
         if (!limit)
