@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -117,6 +118,56 @@ std::string cookie_value(const std::string& header, const std::string& name) {
     return {};
 }
 
+// Query parameter `name` as an integer in [lo, hi]; 400 naming it otherwise.
+int integer_param(const httplib::Request& req, const std::string& name, int lo, int hi) {
+    if (!req.has_param(name))
+        throw BadRequest(400, name + ": missing (expected an integer in [" +
+                                  std::to_string(lo) + ", " + std::to_string(hi) + "])");
+    const std::string text = req.get_param_value(name);
+    char* end = nullptr;
+    errno = 0;
+    const long value = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || errno != 0 || value < lo || value > hi)
+        throw BadRequest(400, name + ": expected an integer in [" + std::to_string(lo) + ", " +
+                                  std::to_string(hi) + "], found \"" + text + "\"");
+    return static_cast<int>(value);
+}
+
+// The `exposure` query parameter: stops in [-64, 64], default 0.
+float exposure_param(const httplib::Request& req) {
+    if (!req.has_param("exposure")) return 0.0f;
+    const std::string text = req.get_param_value("exposure");
+    char* end = nullptr;
+    const float value = std::strtof(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !std::isfinite(value) || std::fabs(value) > 64)
+        throw BadRequest(400, "exposure: expected a number of stops in [-64, 64]");
+    return value;
+}
+
+// {"x": X, "y": Y, "width": W, "height": H, "rgb": [r, g, b]}: the linear value of pixel
+// (x, y) of `image` (non-finite values as the strings "nan", "inf", "-inf").
+json pixel_json(const httplib::Request& req, const Image& image) {
+    const int x = integer_param(req, "x", 0, image.width() - 1);
+    const int y = integer_param(req, "y", 0, image.height() - 1);
+    const Rgb& p = image.at(x, y);
+    const auto value = [](float v) -> json {
+        if (std::isnan(v)) return "nan";
+        if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+        return v;
+    };
+    return json{{"x", x},
+                {"y", y},
+                {"width", image.width()},
+                {"height", image.height()},
+                {"rgb", json::array({value(p.r), value(p.g), value(p.b)})}};
+}
+
+std::string float_bytes(const Image& image) {
+    static_assert(sizeof(Rgb) == 3 * sizeof(float));
+    return std::string(reinterpret_cast<const char*>(image.data()),
+                       image.pixel_count() * sizeof(Rgb));
+}
+
 void set_common_headers(httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -126,7 +177,8 @@ void set_common_headers(httplib::Response& res) {
 }  // namespace
 
 struct ViewServer::Impl {
-    ViewSession& session;
+    ViewSession* session_ptr;        // a scene, or
+    const CompareView* compare_ptr;  // two images (`octray view A.exr B.exr`)
     ServerOptions options;
     std::string token;
     std::string cookie_name;
@@ -137,7 +189,8 @@ struct ViewServer::Impl {
     std::atomic<bool> listener_done{false};
     std::mutex stop_mutex;
 
-    Impl(ViewSession& s, ServerOptions o) : session(s), options(std::move(o)) {
+    Impl(ViewSession* s, const CompareView* c, ServerOptions o)
+        : session_ptr(s), compare_ptr(c), options(std::move(o)) {
         token = options.token.empty() ? random_token() : options.token;
     }
 
@@ -148,6 +201,8 @@ struct ViewServer::Impl {
     }
 
     void routes();
+    void scene_routes();
+    void compare_routes();
 };
 
 void ViewServer::Impl::routes() {
@@ -193,8 +248,17 @@ void ViewServer::Impl::routes() {
         res.set_content(kViewPage, "text/html; charset=utf-8");
     });
 
-    server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-        json status{{"scene", session.scene().source},
+    if (session_ptr != nullptr)
+        scene_routes();
+    else
+        compare_routes();
+}
+
+void ViewServer::Impl::scene_routes() {
+    ViewSession& session = *session_ptr;
+    server.Get("/api/status", [&session](const httplib::Request&, httplib::Response& res) {
+        json status{{"mode", "scene"},
+                    {"scene", session.scene().source},
                     {"full_width", session.scene().image.width},
                     {"full_height", session.scene().image.height}};
         if (const auto frame = session.latest()) status["frame"] = frame_json(*frame);
@@ -202,30 +266,31 @@ void ViewServer::Impl::routes() {
         res.set_content(status.dump(), "application/json");
     });
 
-    server.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
-        res.set_chunked_content_provider(
-            "text/event-stream", [this, last = std::uint64_t{0}, last_error = std::string()](
-                                     std::size_t, httplib::DataSink& sink) mutable {
-                const auto frame = session.wait_newer(last, kHeartbeat);
-                if (stopping || session.stopped()) {
-                    sink.done();
-                    return true;
-                }
-                std::string message = ": heartbeat\n\n";
-                if (std::string error = session.error(); error != last_error) {
-                    last_error = error;
-                    if (!error.empty()) {
-                        message =
-                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
-                            "\n\n";
+    server.Get(
+        "/api/events", [this, &session](const httplib::Request&, httplib::Response& res) {
+            res.set_chunked_content_provider(
+                "text/event-stream",
+                [this, &session, last = std::uint64_t{0}, last_error = std::string()](
+                    std::size_t, httplib::DataSink& sink) mutable {
+                    const auto frame = session.wait_newer(last, kHeartbeat);
+                    if (stopping || session.stopped()) {
+                        sink.done();
+                        return true;
                     }
-                } else if (frame && frame->generation > last) {
-                    last = frame->generation;
-                    message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
-                }
-                return sink.write(message.data(), message.size());
-            });
-    });
+                    std::string message = ": heartbeat\n\n";
+                    if (std::string error = session.error(); error != last_error) {
+                        last_error = error;
+                        if (!error.empty()) {
+                            message = "event: render-error\ndata: " +
+                                      json{{"message", error}}.dump() + "\n\n";
+                        }
+                    } else if (frame && frame->generation > last) {
+                        last = frame->generation;
+                        message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                    }
+                    return sink.write(message.data(), message.size());
+                });
+        });
 
     const auto image_headers = [](httplib::Response& res, const ViewFrame& frame) {
         res.set_header("X-Octray-Generation", std::to_string(frame.generation));
@@ -235,47 +300,107 @@ void ViewServer::Impl::routes() {
         res.set_header("X-Octray-Camera-Version", std::to_string(frame.camera_version));
     };
 
-    server.Get("/api/image.png", [this, image_headers](const httplib::Request& req,
-                                                       httplib::Response& res) {
-        const auto frame = session.latest();
-        if (!frame) throw BadRequest(503, "no picture yet");
-        float exposure = 0.0f;
-        if (req.has_param("exposure")) {
-            const std::string text = req.get_param_value("exposure");
-            char* end = nullptr;
-            const float value = std::strtof(text.c_str(), &end);
-            if (text.empty() || *end != '\0' || !std::isfinite(value) || std::fabs(value) > 64)
-                throw BadRequest(400, "exposure: expected a number of stops in [-64, 64]");
-            exposure = value;
-        }
-        image_headers(res, *frame);
-        res.set_content(encode_png_rgb8(frame->image.width(), frame->image.height(),
-                                        tone_map_srgb8(frame->image, exposure)),
-                        "image/png");
-    });
+    server.Get("/api/image.png",
+               [&session, image_headers](const httplib::Request& req, httplib::Response& res) {
+                   const auto frame = session.latest();
+                   if (!frame) throw BadRequest(503, "no picture yet");
+                   const float exposure = exposure_param(req);
+                   image_headers(res, *frame);
+                   res.set_content(encode_png_rgb8(frame->image.width(), frame->image.height(),
+                                                   tone_map_srgb8(frame->image, exposure)),
+                                   "image/png");
+               });
 
     // The picture as it is: little-endian float32 R, G, B per pixel, row 0 on top, for
     // tests and tools that compare exactly.
-    server.Get("/api/image.f32", [this, image_headers](const httplib::Request&,
-                                                       httplib::Response& res) {
+    server.Get("/api/image.f32",
+               [&session, image_headers](const httplib::Request&, httplib::Response& res) {
+                   const auto frame = session.latest();
+                   if (!frame) throw BadRequest(503, "no picture yet");
+                   image_headers(res, *frame);
+                   res.set_content(float_bytes(frame->image), "application/octet-stream");
+               });
+
+    // The linear value under the page's cursor, of the latest picture (whose size the
+    // answer repeats: a preview is smaller than the refined picture).
+    server.Get("/api/pixel", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto frame = session.latest();
         if (!frame) throw BadRequest(503, "no picture yet");
-        image_headers(res, *frame);
-        static_assert(sizeof(Rgb) == 3 * sizeof(float));
-        res.set_content(std::string(reinterpret_cast<const char*>(frame->image.data()),
-                                    frame->image.pixel_count() * sizeof(Rgb)),
-                        "application/octet-stream");
+        json answer = pixel_json(req, frame->image);
+        answer["generation"] = frame->generation;
+        res.set_content(answer.dump(), "application/json");
     });
 
-    server.Post("/api/camera", [this](const httplib::Request& req, httplib::Response& res) {
+    server.Post("/api/camera", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto [camera, moving] = parse_camera_request(req.body, session.camera());
         const std::uint64_t version = session.set_camera(camera, moving);
         res.set_content(json{{"camera_version", version}}.dump(), "application/json");
     });
 }
 
+void ViewServer::Impl::compare_routes() {
+    const CompareView& view = *compare_ptr;
+    server.Get("/api/status", [&view](const httplib::Request&, httplib::Response& res) {
+        const json status{{"mode", "compare"},
+                          {"a", view.path_a},
+                          {"b", view.path_b},
+                          {"full_width", view.result.width},
+                          {"full_height", view.result.height},
+                          {"heatmap_width", view.heatmap.image.width},
+                          {"heatmap_height", view.heatmap.image.height},
+                          {"heatmap_zoom", view.heatmap.zoom},
+                          {"heatmap_legend", view.heatmap.legend},
+                          {"heatmap_min", view.heatmap.scale_min},
+                          {"heatmap_max", view.heatmap.scale_max},
+                          {"compare", json::parse(view.figures_json)}};
+        res.set_content(status.dump(), "application/json");
+    });
+    // Exactly what `octray compare --json A B` prints.
+    server.Get("/api/compare", [&view](const httplib::Request&, httplib::Response& res) {
+        res.set_content(view.figures_json, "application/json");
+    });
+    // picture=a (default), b or diff: the linear RGB picture.
+    const auto picture = [&view](const httplib::Request& req) -> const Image& {
+        const std::string name =
+            req.has_param("picture") ? req.get_param_value("picture") : "a";
+        if (name == "a") return view.rgb_a;
+        if (name == "b") return view.rgb_b;
+        if (name == "diff") return view.rgb_diff;
+        throw BadRequest(400,
+                         "picture: expected a, b, diff or heatmap, found \"" + name + "\"");
+    };
+    server.Get("/api/image.png", [&view, picture](const httplib::Request& req,
+                                                  httplib::Response& res) {
+        const float exposure = exposure_param(req);
+        if (req.has_param("picture") && req.get_param_value("picture") == "heatmap") {
+            const Rgb8Image& map = view.heatmap.image;
+            res.set_content(encode_png_rgb8(map.width, map.height, map.rgb), "image/png");
+            return;
+        }
+        const Image& image = picture(req);
+        res.set_content(
+            encode_png_rgb8(image.width(), image.height(), tone_map_srgb8(image, exposure)),
+            "image/png");
+    });
+    server.Get("/api/image.f32",
+               [picture](const httplib::Request& req, httplib::Response& res) {
+                   const Image& image = picture(req);
+                   res.set_header("X-Octray-Width", std::to_string(image.width()));
+                   res.set_header("X-Octray-Height", std::to_string(image.height()));
+                   res.set_content(float_bytes(image), "application/octet-stream");
+               });
+    server.Get("/api/pixel", [picture](const httplib::Request& req, httplib::Response& res) {
+        res.set_content(pixel_json(req, picture(req)).dump(), "application/json");
+    });
+}
+
 ViewServer::ViewServer(ViewSession& session, ServerOptions options)
-    : impl_(std::make_unique<Impl>(session, std::move(options))) {
+    : ViewServer(std::make_unique<Impl>(&session, nullptr, std::move(options))) {}
+
+ViewServer::ViewServer(const CompareView& images, ServerOptions options)
+    : ViewServer(std::make_unique<Impl>(nullptr, &images, std::move(options))) {}
+
+ViewServer::ViewServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {
     impl_->routes();
     const std::string& host = impl_->options.bind;
     const auto failure = [&](int port) {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "render/view/compare_view.h"
 #include "render/view/view_session.h"
 
 namespace octray::view {
@@ -23,6 +24,9 @@ class ViewServer {
     // Binds the socket (nothing is served before start()). Throws std::runtime_error
     // naming the address if it cannot be bound. `session` must outlive the server.
     ViewServer(ViewSession& session, ServerOptions options);
+    // `octray view A.exr B.exr`: serves the two images, their difference, the heatmap and
+    // the figures of `images` (no renderer, no camera). `images` must outlive the server.
+    ViewServer(const CompareView& images, ServerOptions options);
     ~ViewServer();  // stop()
     ViewServer(const ViewServer&) = delete;
     ViewServer& operator=(const ViewServer&) = delete;
@@ -44,6 +48,7 @@ class ViewServer {
 
   private:
     struct Impl;
+    explicit ViewServer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };
 

@@ -425,3 +425,35 @@ TEST_F(FramelessViewTest, ConvergesToTheTiledPictureBitForBit) {
 }
 
 }  // namespace
+
+namespace {
+
+// The value under the cursor is the float pixel of the latest picture; outside it, 400.
+TEST_F(ViewServerTest, ThePixelEndpointReadsTheLatestPicture) {
+    ASSERT_FALSE(
+        wait_for_frame([&](const json& f) { return f["spp"] == scene_.image.spp; }).is_null());
+    const auto bytes = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(bytes);
+    ASSERT_EQ(bytes->status, 200);
+    const int x = 17, y = 9;
+    float expected[3];
+    std::memcpy(expected,
+                bytes->body.data() +
+                    (static_cast<std::size_t>(y) * scene_.image.width + x) * 3 * sizeof(float),
+                sizeof(expected));
+    const auto pixel = client_->Get(with_token("/api/pixel?x=17&y=9"));
+    ASSERT_TRUE(pixel);
+    ASSERT_EQ(pixel->status, 200);
+    const json answer = json::parse(pixel->body);
+    EXPECT_EQ(answer["width"], scene_.image.width);
+    EXPECT_EQ(answer["height"], scene_.image.height);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(answer["rgb"][c].get<float>(), expected[c]) << c;
+    for (const char* query : {"x=64&y=0", "x=0&y=36", "x=-1&y=0", "x=0", "y=0", "x=1e1&y=0",
+                              "x=&y=0", "x=0x1&y=0"}) {
+        const auto bad = client_->Get(with_token(std::string("/api/pixel?") + query));
+        ASSERT_TRUE(bad) << query;
+        EXPECT_EQ(bad->status, 400) << query << " -> " << bad->body;
+    }
+}
+
+}  // namespace
