@@ -13,9 +13,12 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "kernels/dispatch.h"
+#include "render/batch/frame_loop.h"
+#include "render/batch/plan.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
 #include "render/view/compare_view.h"
@@ -108,10 +111,12 @@ void serve(view::ViewServer& server, StopOnSignal& stop_on_signal, const std::st
     server.wait();
 }
 
-std::unique_ptr<view::ViewServer> make_server(const ViewArguments& args, auto& source) {
+std::unique_ptr<view::ViewServer> make_server(const ViewArguments& args, auto& source,
+                                              std::optional<view::SaveSettings> save = {}) {
     view::ServerOptions options;
     options.bind = args.bind;
     options.port = args.port;
+    options.save = std::move(save);
     try {
         return std::make_unique<view::ViewServer>(source, options);
     } catch (const std::runtime_error& e) {
@@ -152,7 +157,9 @@ void run_view(const ViewArguments& args) {
     }
     std::optional<StopOnSignal> stop_on_signal;
     if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
-    Scene scene = load_scene(args.inputs.empty() ? std::string("whitted") : args.inputs[0]);
+    const std::string spec = args.inputs.empty() ? std::string("whitted") : args.inputs[0];
+    // The digest names the scene in the header of a saved picture, as in `octray render`'s.
+    auto [scene, sha256] = batch::load_scene_and_digest(spec, args.threads);
     // An animation shows its first frame; the viewer has no time line yet.
     if (scene.animation) {
         scene = scene_at_frame(scene, 0);
@@ -182,7 +189,16 @@ void run_view(const ViewArguments& args) {
     }
 
     view::ViewSession session(scene, settings);
-    const auto server = make_server(args, session);
+    view::SaveSettings save;
+    save.spec = spec;
+    save.sha256 = sha256;
+    batch::BatchSettings batch_settings;
+    batch_settings.path = settings.path;
+    batch_settings.isa = settings.isa;
+    save.path_label = batch::render_path_label(batch_settings);
+    if (args.path != "simd") save.render_arguments += " --path " + args.path;
+    if (args.isa != "auto") save.render_arguments += " --isa " + args.isa;
+    const auto server = make_server(args, session, save);
     serve(*server, *stop_on_signal,
           scene.source + " (" + std::to_string(scene.image.width) + "x" +
               std::to_string(scene.image.height) + ", " + std::to_string(scene.image.spp) +
@@ -277,6 +293,8 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "pixel) with spp, Mrays/s and frame time; drag orbits the camera about its look-at\n"
         "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
         "(--preview-divisor) until it stops. The mouse shows the linear RGB value under it.\n"
+        "Save writes the refined picture as octray render writes it, to a file name in the\n"
+        "current directory, and shows the octray render command line that makes it.\n"
         "Nothing but the scene (or the two images) named here is served.\n\n"
         "With two images, octray view A B compares them as octray compare A B does (same\n"
         "defaults, same figures) and the page flips between A, B, |A - B| and the error\n"

@@ -3,22 +3,30 @@
 #include <httplib.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 #include <utility>
 
+#include "render/batch/digest.h"
+#include "render/batch/frame_loop.h"
+#include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/view/page.h"
 #include "render/view/token.h"
 #include "render/view/tone_map.h"
+#include "scene/load.h"
 #include "scene/scene_error.h"
 
 namespace octray::view {
@@ -168,6 +176,51 @@ std::string float_bytes(const Image& image) {
                        image.pixel_count() * sizeof(Rgb));
 }
 
+// A file name for POST /api/save: letters, digits, '.', '_', '-', '+' only (so no '/',
+// no space, nothing a shell would read), not starting with '.' or '-', no "..", ending
+// in .exr.
+void check_save_name(const std::string& name) {
+    const auto bad = [&](const std::string& why) {
+        return BadRequest(400, "save: file name \"" + name + "\" " + why +
+                                   " (a plain name such as view.exr, written in the "
+                                   "directory octray view was started in)");
+    };
+    if (name.empty() || name.size() > 200) throw bad("must have 1 to 200 characters");
+    if (name.find('/') != std::string::npos || name.find("..") != std::string::npos)
+        throw bad("must not contain '/' or '..'");
+    for (const char c : name) {
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-' &&
+            c != '+')
+            throw bad("may only hold letters, digits, '.', '_', '-' and '+'");
+    }
+    if (name[0] == '.' || name[0] == '-') throw bad("must not start with '.' or '-'");
+    std::string lower = name;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower.size() < 5 || lower.compare(lower.size() - 4, 4, ".exr") != 0)
+        throw bad("must end in .exr");
+}
+
+// `text` as one shell word: as it is when it holds only safe characters, else quoted.
+std::string shell_word(const std::string& text) {
+    bool safe = !text.empty();
+    for (const char c : text) {
+        if (!std::isalnum(static_cast<unsigned char>(c)) &&
+            std::string_view("._-+/:=,").find(c) == std::string_view::npos)
+            safe = false;
+    }
+    if (safe) return text;
+    std::string quoted = "'";
+    for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
+bool same_camera(const Camera& a, const Camera& b) {
+    const auto same = [](const Vec3& u, const Vec3& v) {
+        return u.x == v.x && u.y == v.y && u.z == v.z;
+    };
+    return same(a.eye, b.eye) && same(a.lookat, b.lookat) && same(a.up, b.up) && a.fov == b.fov;
+}
+
 void set_common_headers(httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -201,6 +254,7 @@ struct ViewServer::Impl {
     }
 
     void routes();
+    json save(ViewSession& session, const std::string& body) const;
     void scene_routes();
     void compare_routes();
 };
@@ -331,11 +385,98 @@ void ViewServer::Impl::scene_routes() {
         res.set_content(answer.dump(), "application/json");
     });
 
+    if (options.save) {
+        server.Post("/api/save",
+                    [this, &session](const httplib::Request& req, httplib::Response& res) {
+                        res.set_content(save(session, req.body).dump(), "application/json");
+                    });
+    }
+
     server.Post("/api/camera", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto [camera, moving] = parse_camera_request(req.body, session.camera());
         const std::uint64_t version = session.set_camera(camera, moving);
         res.set_content(json{{"camera_version", version}}.dump(), "application/json");
     });
+}
+
+// POST /api/save: the refined picture as `octray render` writes it (render/view/README.md).
+json ViewServer::Impl::save(ViewSession& session, const std::string& body) const {
+    const SaveSettings& settings = *options.save;
+    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    if (request.is_discarded() || !request.is_object() || !request.contains("name") ||
+        !request["name"].is_string())
+        throw BadRequest(400, "save: expected {\"name\": \"view.exr\", \"overwrite\": false}");
+    bool overwrite = false;
+    for (const auto& [key, value] : request.items()) {
+        if (key == "overwrite") {
+            if (!value.is_boolean())
+                throw BadRequest(400, "save.overwrite: expected true or false");
+            overwrite = value.get<bool>();
+        } else if (key != "name") {
+            throw BadRequest(400,
+                             "save: unknown key \"" + key + "\" (expected name, overwrite)");
+        }
+    }
+    const std::string name = request["name"].get<std::string>();
+    check_save_name(name);
+    const auto frame = session.latest();
+    if (!frame || frame->preview || frame->spp < frame->target_spp)
+        throw BadRequest(409, "save: the picture is still refining; save once it has all " +
+                                  std::to_string(session.scene().image.spp) + " spp");
+    if (frame->rays.total() == 0)
+        throw BadRequest(409, "save: needs the tiled order (frameless pictures are not saved)");
+    namespace fs = std::filesystem;
+    const fs::path directory(settings.directory);
+    const auto refuse_existing = [&](const std::string& file) {
+        if (!overwrite && fs::exists(directory / file))
+            throw BadRequest(
+                409, "save: " + file + " exists; ask to overwrite it (\"overwrite\": true)");
+    };
+    refuse_existing(name);
+
+    Scene posed = session.scene();
+    posed.camera = frame->camera;
+    batch::BatchScene identity;
+    identity.spec = settings.spec;
+    identity.sha256 = settings.sha256;
+    identity.scene = posed;
+    // A moved camera is a new scene: written beside the image as JSON (`octray scene`'s
+    // writer), named in the header and the command line instead of the original.
+    const bool moved = !same_camera(frame->camera, session.scene().camera);
+    std::string scene_file;
+    if (moved) {
+        scene_file = name.substr(0, name.size() - 4) + ".json";
+        refuse_existing(scene_file);
+        const std::string text = scene_to_json(posed);
+        write_file_atomically((directory / scene_file).string(), [&](const std::string& tmp) {
+            std::ofstream out(tmp, std::ios::binary);
+            out << text;
+            out.close();
+            if (!out) throw IoError("cannot write " + tmp);
+        });
+        identity.spec = scene_file;
+        identity.sha256 = batch::sha256_hex(text);
+    }
+    RenderResult result;
+    result.image = frame->image;
+    result.rect = PixelRect{0, 0, frame->image.width(), frame->image.height()};
+    result.full_width = frame->image.width();
+    result.full_height = frame->image.height();
+    result.rays = frame->rays;
+    result.seconds = frame->render_seconds;
+    const ExrAttributes attributes = batch::render_exr_attributes(
+        identity, posed, 0, result, settings.path_label, posed.image.spp, std::string());
+    write_exr((directory / name).string(),
+              make_exr_image(result, ExrWriteOptions{}, attributes));
+
+    std::string command =
+        "octray render " + shell_word(identity.spec) + " --width " +
+        std::to_string(posed.image.width) + " --height " + std::to_string(posed.image.height) +
+        " --spp " + std::to_string(posed.image.spp) + " --max-depth " +
+        std::to_string(posed.render.max_depth) + settings.render_arguments + " -o " + name;
+    json answer{{"file", name}, {"command", command}, {"camera_moved", moved}};
+    answer["scene_file"] = moved ? json(scene_file) : json(nullptr);
+    return answer;
 }
 
 void ViewServer::Impl::compare_routes() {

@@ -285,8 +285,14 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
         return compiled ? render_packet(*compiled, pass_options, settings_.isa)
                         : render_reference(scene, pass_options);
     };
+    RayCounts rays;
+    double render_seconds = 0.0;
     const batch::PassCallback on_pass = [&](const RenderResult& so_far, int samples_so_far) {
+        rays += so_far.rays;
+        render_seconds += so_far.seconds;
         ViewFrame frame;
+        frame.rays = rays;
+        frame.render_seconds = render_seconds;
         frame.image = so_far.image;
         frame.camera_version = version;
         frame.camera = camera;

@@ -53,6 +53,10 @@ struct ViewFrame {
     // Frameless: the part of the picture rendered with this camera so far (1: all of it,
     // at the scene's spp; the rest still shows earlier cameras). Tiled: always 1.
     double coverage = 1.0;
+    // Tiled: the rays and render time of every pass of this camera so far (what `octray
+    // render` writes in its header). Frameless: not counted (zero).
+    RayCounts rays;
+    double render_seconds = 0.0;
 };
 
 class ViewSession {

@@ -41,14 +41,14 @@ def fail(why):
     return 1
 
 
-def start_view(octray, *extra):
+def start_view(octray, *extra, cwd=None):
     return start_command([octray, "view", "whitted", "--port", "0", "--width", "160",
-                          "--height", "90", "--spp", "4", "--threads", "2", *extra])
+                          "--height", "90", "--spp", "4", "--threads", "2", *extra], cwd)
 
 
-def start_command(command):
+def start_command(command, cwd=None):
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)
+                               text=True, cwd=cwd)
     for line in process.stdout:
         line = line.strip()
         if line.startswith("http://"):
@@ -116,6 +116,8 @@ def run(octray, artifacts):
                                     WebDriverWait)
                 if status == 0:
                     status = check_frameless(browser, octray, artifacts, WebDriverWait)
+                if status == 0:
+                    status = check_save(browser, octray, WebDriverWait)
                 if status == 0:
                     status = check_compare(browser, octray, artifacts, ActionChains,
                                            WebDriverWait)
@@ -236,6 +238,33 @@ def check_frameless(browser, octray, artifacts, WebDriverWait):
     if digests[0] != digests[1]:
         return fail(f"frameless converged to another picture than tiled: {digests}")
     print(f"PASS: the frameless order converged to the tiled picture {digests[0]}")
+    return 0
+
+
+def check_save(browser, octray, WebDriverWait):
+    """The save button writes the refined picture in the viewer's directory and shows the
+    octray render command line that makes it again."""
+    with tempfile.TemporaryDirectory() as folder:
+        process, url = start_view(octray, cwd=folder)
+        try:
+            browser.get(url)
+            WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return document.body.dataset.spp === '4';"))
+            name = browser.find_element("id", "save-name")
+            name.clear()
+            name.send_keys("saved.exr")
+            browser.find_element("id", "save").click()
+            command = WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return document.getElementById('save-result').dataset.command;"))
+        finally:
+            process.send_signal(signal.SIGINT)
+            process.communicate(timeout=60)
+        expected = "octray render whitted --width 160 --height 90 --spp 4 --max-depth "
+        if not command.startswith(expected) or not command.endswith(" -o saved.exr"):
+            return fail(f"save showed the command {command!r}")
+        if not os.path.exists(os.path.join(folder, "saved.exr")):
+            return fail("save did not write saved.exr in the viewer's directory")
+    print(f"PASS: save wrote saved.exr and showed {command}")
     return 0
 
 
