@@ -180,8 +180,7 @@ void run_view(const ViewArguments& args) {
     }
     settings.threads = args.threads;
     settings.preview_divisor = args.preview_divisor;
-    settings.order =
-        args.order == "frameless" ? view::PixelOrder::frameless : view::PixelOrder::tiled;
+    settings.order = view::parse_pixel_order(args.order).value_or(view::PixelOrder::tiled);
 
     if (args.bench > 0) {
         print_bench(scene, settings, view::bench_orbit(scene, settings, args.bench));
@@ -271,10 +270,11 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->transform(decimal_integer(1, 1000000));
     cmd->add_option("--order", args->order,
                     "Pixel order: tiled (whole pictures, progressive passes, previews while\n"
-                    "moving) or frameless (8x8 blocks re-rendered in a fixed random order and\n"
-                    "shown as they land, no frame boundaries; Bishop et al. 1994)")
+                    "moving), rows (the same, one tile a row: row-major) or frameless (8x8\n"
+                    "blocks re-rendered in a fixed random order and shown as they land, no\n"
+                    "frame boundaries; Bishop et al. 1994); the page can switch it")
         ->type_name("ORDER")
-        ->check(quiet(CLI::IsMember({"tiled", "frameless"})))
+        ->check(quiet(CLI::IsMember({"tiled", "rows", "frameless"})))
         ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer)")
@@ -293,6 +293,7 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "pixel) with spp, Mrays/s and frame time; drag orbits the camera about its look-at\n"
         "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
         "(--preview-divisor) until it stops. The mouse shows the linear RGB value under it.\n"
+        "The page switches threads, spp, max depth and the order while it runs.\n"
         "Save writes the refined picture as octray render writes it, to a file name in the\n"
         "current directory, and shows the octray render command line that makes it.\n"
         "Nothing but the scene (or the two images) named here is served.\n\n"

@@ -27,6 +27,7 @@
 #include "render/view/token.h"
 #include "render/view/tone_map.h"
 #include "scene/load.h"
+#include "scene/max_depth.h"
 #include "scene/scene_error.h"
 
 namespace octray::view {
@@ -37,6 +38,10 @@ using nlohmann::json;
 // How often an idle event stream writes a comment line: the write that fails tells the
 // server a tab has closed, so the stream's worker thread is back within about this long.
 constexpr std::chrono::milliseconds kHeartbeat{250};
+
+// The page's switches take what `octray view --threads` and `--spp` take.
+constexpr int kMaxSwitchThreads = 4096;
+constexpr int kMaxSwitchSpp = 1 << 20;
 
 json vec3_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 
@@ -311,10 +316,17 @@ void ViewServer::Impl::routes() {
 void ViewServer::Impl::scene_routes() {
     ViewSession& session = *session_ptr;
     server.Get("/api/status", [&session](const httplib::Request&, httplib::Response& res) {
+        const Scene scene = session.scene();
+        const RenderSwitches switches = session.switches();
         json status{{"mode", "scene"},
-                    {"scene", session.scene().source},
-                    {"full_width", session.scene().image.width},
-                    {"full_height", session.scene().image.height}};
+                    {"scene", scene.source},
+                    {"full_width", scene.image.width},
+                    {"full_height", scene.image.height},
+                    {"settings",
+                     {{"threads", switches.threads},
+                      {"spp", switches.spp},
+                      {"max_depth", switches.max_depth},
+                      {"order", to_string(switches.order)}}}};
         if (const auto frame = session.latest()) status["frame"] = frame_json(*frame);
         if (const std::string error = session.error(); !error.empty()) status["error"] = error;
         res.set_content(status.dump(), "application/json");
@@ -392,6 +404,44 @@ void ViewServer::Impl::scene_routes() {
                     });
     }
 
+    // The page's switches: {"threads": N, "spp": N, "max_depth": N, "order": "tiled" |
+    // "rows" | "frameless"}, every key optional; a change re-renders the current camera.
+    server.Post("/api/settings", [&session](const httplib::Request& req,
+                                            httplib::Response& res) {
+        const json request = json::parse(req.body, nullptr, /*allow_exceptions=*/false);
+        if (request.is_discarded() || !request.is_object())
+            throw BadRequest(400, "settings: expected a JSON object such as {\"spp\": 16}");
+        RenderSwitches switches = session.switches();
+        const auto integer = [](const json& value, const std::string& what, int lo, int hi) {
+            if (!value.is_number_integer() || value.get<long long>() < lo ||
+                value.get<long long>() > hi)
+                throw BadRequest(400, "settings." + what + ": expected an integer in [" +
+                                          std::to_string(lo) + ", " + std::to_string(hi) + "]");
+            return static_cast<int>(value.get<long long>());
+        };
+        for (const auto& [key, value] : request.items()) {
+            if (key == "threads") {
+                switches.threads = integer(value, key, 0, kMaxSwitchThreads);
+            } else if (key == "spp") {
+                switches.spp = integer(value, key, 1, kMaxSwitchSpp);
+            } else if (key == "max_depth") {
+                switches.max_depth = integer(value, key, 1, kMaxDepthLimit);
+            } else if (key == "order") {
+                const auto order = value.is_string()
+                                       ? parse_pixel_order(value.get<std::string>())
+                                       : std::nullopt;
+                if (!order)
+                    throw BadRequest(400, "settings.order: expected tiled, rows or frameless");
+                switches.order = *order;
+            } else {
+                throw BadRequest(400, "settings: unknown key \"" + key +
+                                          "\" (expected threads, spp, max_depth, order)");
+            }
+        }
+        session.reconfigure(switches);
+        res.set_content(json{{"ok", true}}.dump(), "application/json");
+    });
+
     server.Post("/api/camera", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto [camera, moving] = parse_camera_request(req.body, session.camera());
         const std::uint64_t version = session.set_camera(camera, moving);
@@ -420,9 +470,11 @@ json ViewServer::Impl::save(ViewSession& session, const std::string& body) const
     const std::string name = request["name"].get<std::string>();
     check_save_name(name);
     const auto frame = session.latest();
-    if (!frame || frame->preview || frame->spp < frame->target_spp)
+    Scene posed = session.scene();
+    if (!frame || frame->preview || frame->spp < frame->target_spp ||
+        frame->target_spp != posed.image.spp || frame->max_depth != posed.render.max_depth)
         throw BadRequest(409, "save: the picture is still refining; save once it has all " +
-                                  std::to_string(session.scene().image.spp) + " spp");
+                                  std::to_string(posed.image.spp) + " spp");
     if (frame->rays.total() == 0)
         throw BadRequest(409, "save: needs the tiled order (frameless pictures are not saved)");
     namespace fs = std::filesystem;
@@ -434,7 +486,7 @@ json ViewServer::Impl::save(ViewSession& session, const std::string& body) const
     };
     refuse_existing(name);
 
-    Scene posed = session.scene();
+    const Camera scene_camera = posed.camera;
     posed.camera = frame->camera;
     batch::BatchScene identity;
     identity.spec = settings.spec;
@@ -442,7 +494,7 @@ json ViewServer::Impl::save(ViewSession& session, const std::string& body) const
     identity.scene = posed;
     // A moved camera is a new scene: written beside the image as JSON (`octray scene`'s
     // writer), named in the header and the command line instead of the original.
-    const bool moved = !same_camera(frame->camera, session.scene().camera);
+    const bool moved = !same_camera(frame->camera, scene_camera);
     std::string scene_file;
     if (moved) {
         scene_file = name.substr(0, name.size() - 4) + ".json";

@@ -256,6 +256,15 @@ def check_save(browser, octray, WebDriverWait):
             browser.find_element("id", "save").click()
             command = WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
                 "return document.getElementById('save-result').dataset.command;"))
+            # The spp switch: the server re-renders up to the new spp.
+            browser.execute_script(
+                "const spp = document.getElementById('spp-switch'); spp.value = '2';"
+                "spp.dispatchEvent(new Event('change'));")
+            WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return document.getElementById('target-spp').textContent === '2' && "
+                "document.body.dataset.spp === '2';"))
+            if fetch_status(url)["settings"]["spp"] != 2:
+                return fail("the spp switch did not reach the server")
         finally:
             process.send_signal(signal.SIGINT)
             process.communicate(timeout=60)
@@ -264,7 +273,7 @@ def check_save(browser, octray, WebDriverWait):
             return fail(f"save showed the command {command!r}")
         if not os.path.exists(os.path.join(folder, "saved.exr")):
             return fail("save did not write saved.exr in the viewer's directory")
-    print(f"PASS: save wrote saved.exr and showed {command}")
+    print(f"PASS: save wrote saved.exr and showed {command}; the spp switch re-rendered")
     return 0
 
 

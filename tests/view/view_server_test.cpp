@@ -581,3 +581,59 @@ TEST(ViewSave, WritesWhatRenderWrites) {
 }
 
 }  // namespace
+
+namespace {
+
+// The page's switches: spp, max depth, order (and threads) re-render the current camera,
+// and the refined picture is then `octray render`'s of the scene with those values.
+TEST_F(ViewServerTest, SwitchesReRenderWithTheNewValues) {
+    ASSERT_FALSE(
+        wait_for_frame([&](const json& f) { return f["spp"] == scene_.image.spp; }).is_null());
+    for (const std::string& body :
+         {std::string(R"({"spp": 0})"), std::string(R"({"spp": 1.5})"),
+          std::string(R"({"max_depth": 0})"), std::string(R"({"max_depth": 65})"),
+          std::string(R"({"threads": -1})"), std::string(R"({"order": "spiral"})"),
+          std::string(R"({"order": 1})"), std::string(R"({"depth": 2})"), std::string("[]"),
+          std::string("nope")}) {
+        const auto result =
+            client_->Post(with_token("/api/settings"), body, "application/json");
+        ASSERT_TRUE(result) << body;
+        EXPECT_EQ(result->status, 400) << body << " -> " << result->body;
+    }
+    EXPECT_EQ(status()["settings"]["spp"], scene_.image.spp);
+    for (const char* order : {"rows", "frameless", "tiled"}) {
+        const std::string body =
+            std::string(R"({"spp": 2, "max_depth": 2, "threads": 1, "order": ")") + order +
+            "\"}";
+        const auto result =
+            client_->Post(with_token("/api/settings"), body, "application/json");
+        ASSERT_TRUE(result);
+        ASSERT_EQ(result->status, 200) << result->body;
+        const json s = status();
+        EXPECT_EQ(s["settings"]["order"], order);
+        EXPECT_EQ(s["settings"]["spp"], 2);
+        EXPECT_EQ(s["settings"]["max_depth"], 2);
+        EXPECT_EQ(s["settings"]["threads"], 1);
+        ASSERT_FALSE(wait_for_frame([](const json& f) {
+                         return f["target_spp"] == 2 && f["spp"] == 2 && f["coverage"] == 1.0 &&
+                                !f["preview"].get<bool>();
+                     }).is_null());
+        Scene expected = scene_;
+        expected.image.spp = 2;
+        expected.render.max_depth = 2;
+        // Wait until the picture is of the switched scene (the old one had target 4).
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        std::string got;
+        const std::string want = rendered_bytes(expected);
+        while (std::chrono::steady_clock::now() < deadline) {
+            const auto bytes = client_->Get(with_token("/api/image.f32"));
+            ASSERT_TRUE(bytes);
+            got = bytes->body;
+            if (got == want) break;
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        EXPECT_TRUE(got == want) << order << ": the refined picture is not render's";
+    }
+}
+
+}  // namespace
