@@ -293,6 +293,10 @@ void ViewServer::Impl::routes() {
         } catch (const SceneError& e) {
             res.status = 400;
             res.set_content(std::string(e.what()) + "\n", "text/plain");
+        } catch (const IoError& e) {
+            // A file save could not write (a full disk, a read-only directory): not a bug.
+            res.status = 500;
+            res.set_content(std::string(e.what()) + "\n", "text/plain");
         } catch (const std::exception& e) {
             res.status = 500;
             res.set_content(std::string("internal error: ") + e.what() + "\n", "text/plain");
