@@ -13,8 +13,15 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "kernels/dispatch.h"
+#include "render/batch/frame_loop.h"
+#include "render/batch/plan.h"
+#include "render/image/image_compare.h"
+#include "render/image/image_io.h"
+#include "render/view/compare_view.h"
 #include "render/view/view_bench.h"
 #include "render/view/view_server.h"
 #include "render/view/view_session.h"
@@ -28,7 +35,7 @@ namespace octray::tools {
 namespace {
 
 struct ViewArguments {
-    std::string scene{"whitted"};
+    std::vector<std::string> inputs;  // SCENE, or A B (two images to compare)
     std::string bind{"127.0.0.1"};
     int port = 8090;
     int width = 0, height = 0, spp = 0, max_depth = 0;
@@ -93,10 +100,66 @@ void print_bench(const Scene& scene, const view::ViewSettings& settings,
     std::fflush(stdout);
 }
 
+// Serves until Ctrl-C (or SIGTERM); `what` says what is served, for the first line.
+void serve(view::ViewServer& server, StopOnSignal& stop_on_signal, const std::string& what) {
+    server.start();
+    stop_on_signal.watch(server);
+    std::cout << "octray view: " << what << " at\n"
+              << "  " << server.url() << "\n"
+              << "Open that URL in a browser (it carries the access token); Ctrl-C stops.\n"
+              << std::flush;
+    server.wait();
+}
+
+std::unique_ptr<view::ViewServer> make_server(const ViewArguments& args, auto& source,
+                                              std::optional<view::SaveSettings> save = {}) {
+    view::ServerOptions options;
+    options.bind = args.bind;
+    options.port = args.port;
+    options.save = std::move(save);
+    try {
+        return std::make_unique<view::ViewServer>(source, options);
+    } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--bind/--port: ") + e.what());
+    }
+}
+
+// `octray view A B`: the two images as `octray compare A B` reads and compares them, with
+// its exit codes for images that cannot be read (4) or compared (3).
+void run_compare_view(const ViewArguments& args) {
+    if (args.width > 0 || args.height > 0 || args.spp > 0 || args.max_depth > 0 ||
+        args.bench > 0 || args.order != "tiled")
+        throw UsageError(
+            "--width, --height, --spp, --max-depth, --order and --bench apply to a scene; "
+            "with two images (A B) the viewer compares them");
+    StopOnSignal stop_on_signal;  // before any thread is made
+    const std::string& a = args.inputs[0];
+    const std::string& b = args.inputs[1];
+    view::CompareView images;
+    try {
+        images = view::load_compare_view(a, b);
+    } catch (const ImageMismatch& e) {
+        std::cerr << "octray: view: " << e.what() << " (A = " << a << ", B = " << b << ")\n";
+        throw CommandExit{3};  // as `octray compare`
+    }
+    const auto server = make_server(args, images);
+    serve(*server, stop_on_signal,
+          a + " against " + b + " (" + std::to_string(images.result.width) + "x" +
+              std::to_string(images.result.height) + ", " +
+              std::string(to_string(images.result.verdict)) + ")");
+    std::cout << "octray view: stopped\n" << std::flush;
+}
+
 void run_view(const ViewArguments& args) {
+    if (args.inputs.size() == 2) {
+        run_compare_view(args);
+        return;
+    }
     std::optional<StopOnSignal> stop_on_signal;
     if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
-    Scene scene = load_scene(args.scene);
+    const std::string spec = args.inputs.empty() ? std::string("whitted") : args.inputs[0];
+    // The digest names the scene in the header of a saved picture, as in `octray render`'s.
+    auto [scene, sha256] = batch::load_scene_and_digest(spec, args.threads);
     // An animation shows its first frame; the viewer has no time line yet.
     if (scene.animation) {
         scene = scene_at_frame(scene, 0);
@@ -117,33 +180,28 @@ void run_view(const ViewArguments& args) {
     }
     settings.threads = args.threads;
     settings.preview_divisor = args.preview_divisor;
-    settings.order =
-        args.order == "frameless" ? view::PixelOrder::frameless : view::PixelOrder::tiled;
+    settings.order = view::parse_pixel_order(args.order).value_or(view::PixelOrder::tiled);
 
     if (args.bench > 0) {
         print_bench(scene, settings, view::bench_orbit(scene, settings, args.bench));
         return;
     }
 
-    view::ServerOptions options;
-    options.bind = args.bind;
-    options.port = args.port;
-
     view::ViewSession session(scene, settings);
-    std::unique_ptr<view::ViewServer> server;
-    try {
-        server = std::make_unique<view::ViewServer>(session, options);
-    } catch (const std::runtime_error& e) {
-        throw UsageError(std::string("--bind/--port: ") + e.what());
-    }
-    server->start();
-    stop_on_signal->watch(*server);
-    std::cout << "octray view: " << scene.source << " (" << scene.image.width << "x"
-              << scene.image.height << ", " << scene.image.spp << " spp) at\n"
-              << "  " << server->url() << "\n"
-              << "Open that URL in a browser (it carries the access token); Ctrl-C stops.\n"
-              << std::flush;
-    server->wait();
+    view::SaveSettings save;
+    save.spec = spec;
+    save.sha256 = sha256;
+    batch::BatchSettings batch_settings;
+    batch_settings.path = settings.path;
+    batch_settings.isa = settings.isa;
+    save.path_label = batch::render_path_label(batch_settings);
+    if (args.path != "simd") save.render_arguments += " --path " + args.path;
+    if (args.isa != "auto") save.render_arguments += " --isa " + args.isa;
+    const auto server = make_server(args, session, save);
+    serve(*server, *stop_on_signal,
+          scene.source + " (" + std::to_string(scene.image.width) + "x" +
+              std::to_string(scene.image.height) + ", " + std::to_string(scene.image.spp) +
+              " spp)");
     session.stop();
     std::cout << "octray view: stopped\n" << std::flush;
 }
@@ -154,9 +212,11 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
     auto args = std::make_shared<ViewArguments>();
     CLI::App* cmd = app.add_subcommand(
         "view", "Watch a scene render live in a web browser, and move its camera");
-    cmd->add_option("scene", args->scene,
-                    "Scene file (JSON) or built-in spec, as for render (default whitted)")
-        ->type_name("SCENE");
+    cmd->add_option("scene", args->inputs,
+                    "Scene file (JSON) or built-in spec, as for render (default whitted);\n"
+                    "or two images A B (OpenEXR or PNG) to compare as octray compare does")
+        ->type_name("SCENE | A B")
+        ->expected(1, 2);
     cmd->add_option("--bind", args->bind,
                     "Address to listen on; the default serves this machine only (use an\n"
                     "SSH tunnel, ssh -L 8090:127.0.0.1:8090 host, to watch a remote one)")
@@ -210,10 +270,11 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->transform(decimal_integer(1, 1000000));
     cmd->add_option("--order", args->order,
                     "Pixel order: tiled (whole pictures, progressive passes, previews while\n"
-                    "moving) or frameless (8x8 blocks re-rendered in a fixed random order and\n"
-                    "shown as they land, no frame boundaries; Bishop et al. 1994)")
+                    "moving), rows (the same, one tile a row: row-major) or frameless (8x8\n"
+                    "blocks re-rendered in a fixed random order and shown as they land, no\n"
+                    "frame boundaries; Bishop et al. 1994); the page can switch it")
         ->type_name("ORDER")
-        ->check(quiet(CLI::IsMember({"tiled", "frameless"})))
+        ->check(quiet(CLI::IsMember({"tiled", "rows", "frameless"})))
         ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer)")
@@ -231,14 +292,22 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "403. The page shows the picture refining pass by pass (1, 2, 4, ... samples per\n"
         "pixel) with spp, Mrays/s and frame time; drag orbits the camera about its look-at\n"
         "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
-        "(--preview-divisor) until it stops. Nothing but the scene named here is served.\n"
+        "(--preview-divisor) until it stops. The mouse shows the linear RGB value under it.\n"
+        "The page switches threads, spp, max depth and the order while it runs.\n"
+        "Save writes the refined picture as octray render writes it, to a file name in the\n"
+        "current directory, and shows the octray render command line that makes it.\n"
+        "Nothing but the scene (or the two images) named here is served.\n\n"
+        "With two images, octray view A B compares them as octray compare A B does (same\n"
+        "defaults, same figures) and the page flips between A, B, |A - B| and the error\n"
+        "heatmap; an image that cannot be read exits 4, two that cannot be compared exit 3.\n"
         "The HTTP API (status, events, PNG and float32 pictures, camera) is described in\n"
         "render/view/README.md. Ctrl-C (or SIGTERM) stops the server.\n\n"
         "Examples:\n"
         "  octray view                                  # the built-in whitted scene\n"
         "  octray view scene.json --port 0              # any free port\n"
         "  octray view random:1024 --width 640 --height 360 --spp 16\n"
-        "  octray view whitted --width 640 --height 360 --threads 2 --bench 200\n\n" +
+        "  octray view whitted --width 640 --height 360 --threads 2 --bench 200\n"
+        "  octray view ref.exr out.exr                  # A/B: difference and heatmap\n\n" +
         exit_code_help());
     cmd->callback([args, &run] { run.action = [args] { run_view(*args); }; });
 }

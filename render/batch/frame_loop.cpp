@@ -87,8 +87,11 @@ class BatchRunner {
     std::string owner_;  // octray.owner of this run's unfinished passes
 };
 
-ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
-                                      const RenderResult& result, int samples_so_far) const {
+}  // namespace
+
+ExrAttributes render_exr_attributes(const BatchScene& scene, const Scene& posed, int frame,
+                                    const RenderResult& result, const std::string& path_label,
+                                    int samples_so_far, const std::string& owner) {
     const auto [date, utc_offset] = capture_date();
     ExrAttributes a;
     a.strings = {
@@ -96,7 +99,7 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
         {"capDate", date},
         {"octray.scene", scene.spec},
         {"octray.sceneSha256", scene.sha256},
-        {"octray.path", render_path_label(settings_)},
+        {"octray.path", path_label},
         // A string keeps all 64 bits of the seed.
         {"octray.seed", std::to_string(posed.render.seed)},
     };
@@ -108,7 +111,7 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
     };
     if (samples_so_far < posed.image.spp) {
         a.ints.emplace_back(kSamplesSoFarAttribute, samples_so_far);
-        a.strings.emplace_back(kOwnerAttribute, owner_);
+        a.strings.emplace_back(kOwnerAttribute, owner);
     }
     // Ray counts are 64-bit; a double holds them exactly up to 2^53 (9e15 rays).
     a.doubles = {
@@ -124,6 +127,14 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
     const double fps = scene.scene.animation ? scene.scene.animation->fps : kStillFps;
     a.rationals = {{"framesPerSecond", exr_rational(fps)}};
     return a;
+}
+
+namespace {
+
+ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
+                                      const RenderResult& result, int samples_so_far) const {
+    return render_exr_attributes(scene, posed, frame, result, render_path_label(settings_),
+                                 samples_so_far, owner_);
 }
 
 void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job,

@@ -3,21 +3,31 @@
 #include <httplib.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 #include <utility>
 
+#include "render/batch/digest.h"
+#include "render/batch/frame_loop.h"
+#include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/view/page.h"
 #include "render/view/token.h"
 #include "render/view/tone_map.h"
+#include "scene/load.h"
+#include "scene/max_depth.h"
 #include "scene/scene_error.h"
 
 namespace octray::view {
@@ -28,6 +38,10 @@ using nlohmann::json;
 // How often an idle event stream writes a comment line: the write that fails tells the
 // server a tab has closed, so the stream's worker thread is back within about this long.
 constexpr std::chrono::milliseconds kHeartbeat{250};
+
+// The page's switches take what `octray view --threads` and `--spp` take.
+constexpr int kMaxSwitchThreads = 4096;
+constexpr int kMaxSwitchSpp = 1 << 20;
 
 json vec3_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 
@@ -117,6 +131,101 @@ std::string cookie_value(const std::string& header, const std::string& name) {
     return {};
 }
 
+// Query parameter `name` as an integer in [lo, hi]; 400 naming it otherwise.
+int integer_param(const httplib::Request& req, const std::string& name, int lo, int hi) {
+    if (!req.has_param(name))
+        throw BadRequest(400, name + ": missing (expected an integer in [" +
+                                  std::to_string(lo) + ", " + std::to_string(hi) + "])");
+    const std::string text = req.get_param_value(name);
+    char* end = nullptr;
+    errno = 0;
+    const long value = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || errno != 0 || value < lo || value > hi)
+        throw BadRequest(400, name + ": expected an integer in [" + std::to_string(lo) + ", " +
+                                  std::to_string(hi) + "], found \"" + text + "\"");
+    return static_cast<int>(value);
+}
+
+// The `exposure` query parameter: stops in [-64, 64], default 0.
+float exposure_param(const httplib::Request& req) {
+    if (!req.has_param("exposure")) return 0.0f;
+    const std::string text = req.get_param_value("exposure");
+    char* end = nullptr;
+    const float value = std::strtof(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !std::isfinite(value) || std::fabs(value) > 64)
+        throw BadRequest(400, "exposure: expected a number of stops in [-64, 64]");
+    return value;
+}
+
+// {"x": X, "y": Y, "width": W, "height": H, "rgb": [r, g, b]}: the linear value of pixel
+// (x, y) of `image` (non-finite values as the strings "nan", "inf", "-inf").
+json pixel_json(const httplib::Request& req, const Image& image) {
+    const int x = integer_param(req, "x", 0, image.width() - 1);
+    const int y = integer_param(req, "y", 0, image.height() - 1);
+    const Rgb& p = image.at(x, y);
+    const auto value = [](float v) -> json {
+        if (std::isnan(v)) return "nan";
+        if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+        return v;
+    };
+    return json{{"x", x},
+                {"y", y},
+                {"width", image.width()},
+                {"height", image.height()},
+                {"rgb", json::array({value(p.r), value(p.g), value(p.b)})}};
+}
+
+std::string float_bytes(const Image& image) {
+    static_assert(sizeof(Rgb) == 3 * sizeof(float));
+    return std::string(reinterpret_cast<const char*>(image.data()),
+                       image.pixel_count() * sizeof(Rgb));
+}
+
+// A file name for POST /api/save: letters, digits, '.', '_', '-', '+' only (so no '/',
+// no space, nothing a shell would read), not starting with '.' or '-', no "..", ending
+// in .exr.
+void check_save_name(const std::string& name) {
+    const auto bad = [&](const std::string& why) {
+        return BadRequest(400, "save: file name \"" + name + "\" " + why +
+                                   " (a plain name such as view.exr, written in the "
+                                   "directory octray view was started in)");
+    };
+    if (name.empty() || name.size() > 200) throw bad("must have 1 to 200 characters");
+    if (name.find('/') != std::string::npos || name.find("..") != std::string::npos)
+        throw bad("must not contain '/' or '..'");
+    for (const char c : name) {
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-' &&
+            c != '+')
+            throw bad("may only hold letters, digits, '.', '_', '-' and '+'");
+    }
+    if (name[0] == '.' || name[0] == '-') throw bad("must not start with '.' or '-'");
+    std::string lower = name;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower.size() < 5 || lower.compare(lower.size() - 4, 4, ".exr") != 0)
+        throw bad("must end in .exr");
+}
+
+// `text` as one shell word: as it is when it holds only safe characters, else quoted.
+std::string shell_word(const std::string& text) {
+    bool safe = !text.empty();
+    for (const char c : text) {
+        if (!std::isalnum(static_cast<unsigned char>(c)) &&
+            std::string_view("._-+/:=,").find(c) == std::string_view::npos)
+            safe = false;
+    }
+    if (safe) return text;
+    std::string quoted = "'";
+    for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
+bool same_camera(const Camera& a, const Camera& b) {
+    const auto same = [](const Vec3& u, const Vec3& v) {
+        return u.x == v.x && u.y == v.y && u.z == v.z;
+    };
+    return same(a.eye, b.eye) && same(a.lookat, b.lookat) && same(a.up, b.up) && a.fov == b.fov;
+}
+
 void set_common_headers(httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -126,7 +235,8 @@ void set_common_headers(httplib::Response& res) {
 }  // namespace
 
 struct ViewServer::Impl {
-    ViewSession& session;
+    ViewSession* session_ptr;        // a scene, or
+    const CompareView* compare_ptr;  // two images (`octray view A.exr B.exr`)
     ServerOptions options;
     std::string token;
     std::string cookie_name;
@@ -137,7 +247,8 @@ struct ViewServer::Impl {
     std::atomic<bool> listener_done{false};
     std::mutex stop_mutex;
 
-    Impl(ViewSession& s, ServerOptions o) : session(s), options(std::move(o)) {
+    Impl(ViewSession* s, const CompareView* c, ServerOptions o)
+        : session_ptr(s), compare_ptr(c), options(std::move(o)) {
         token = options.token.empty() ? random_token() : options.token;
     }
 
@@ -148,6 +259,9 @@ struct ViewServer::Impl {
     }
 
     void routes();
+    json save(ViewSession& session, const std::string& body) const;
+    void scene_routes();
+    void compare_routes();
 };
 
 void ViewServer::Impl::routes() {
@@ -179,6 +293,10 @@ void ViewServer::Impl::routes() {
         } catch (const SceneError& e) {
             res.status = 400;
             res.set_content(std::string(e.what()) + "\n", "text/plain");
+        } catch (const IoError& e) {
+            // A file save could not write (a full disk, a read-only directory): not a bug.
+            res.status = 500;
+            res.set_content(std::string(e.what()) + "\n", "text/plain");
         } catch (const std::exception& e) {
             res.status = 500;
             res.set_content(std::string("internal error: ") + e.what() + "\n", "text/plain");
@@ -193,39 +311,56 @@ void ViewServer::Impl::routes() {
         res.set_content(kViewPage, "text/html; charset=utf-8");
     });
 
-    server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-        json status{{"scene", session.scene().source},
-                    {"full_width", session.scene().image.width},
-                    {"full_height", session.scene().image.height}};
+    if (session_ptr != nullptr)
+        scene_routes();
+    else
+        compare_routes();
+}
+
+void ViewServer::Impl::scene_routes() {
+    ViewSession& session = *session_ptr;
+    server.Get("/api/status", [&session](const httplib::Request&, httplib::Response& res) {
+        const Scene scene = session.scene();
+        const RenderSwitches switches = session.switches();
+        json status{{"mode", "scene"},
+                    {"scene", scene.source},
+                    {"full_width", scene.image.width},
+                    {"full_height", scene.image.height},
+                    {"settings",
+                     {{"threads", switches.threads},
+                      {"spp", switches.spp},
+                      {"max_depth", switches.max_depth},
+                      {"order", to_string(switches.order)}}}};
         if (const auto frame = session.latest()) status["frame"] = frame_json(*frame);
         if (const std::string error = session.error(); !error.empty()) status["error"] = error;
         res.set_content(status.dump(), "application/json");
     });
 
-    server.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
-        res.set_chunked_content_provider(
-            "text/event-stream", [this, last = std::uint64_t{0}, last_error = std::string()](
-                                     std::size_t, httplib::DataSink& sink) mutable {
-                const auto frame = session.wait_newer(last, kHeartbeat);
-                if (stopping || session.stopped()) {
-                    sink.done();
-                    return true;
-                }
-                std::string message = ": heartbeat\n\n";
-                if (std::string error = session.error(); error != last_error) {
-                    last_error = error;
-                    if (!error.empty()) {
-                        message =
-                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
-                            "\n\n";
+    server.Get(
+        "/api/events", [this, &session](const httplib::Request&, httplib::Response& res) {
+            res.set_chunked_content_provider(
+                "text/event-stream",
+                [this, &session, last = std::uint64_t{0}, last_error = std::string()](
+                    std::size_t, httplib::DataSink& sink) mutable {
+                    const auto frame = session.wait_newer(last, kHeartbeat);
+                    if (stopping || session.stopped()) {
+                        sink.done();
+                        return true;
                     }
-                } else if (frame && frame->generation > last) {
-                    last = frame->generation;
-                    message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
-                }
-                return sink.write(message.data(), message.size());
-            });
-    });
+                    std::string message = ": heartbeat\n\n";
+                    if (std::string error = session.error(); error != last_error) {
+                        last_error = error;
+                        if (!error.empty()) {
+                            message = "event: render-error\ndata: " +
+                                      json{{"message", error}}.dump() + "\n\n";
+                        }
+                    } else if (frame && frame->generation > last) {
+                        last = frame->generation;
+                        message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                    }
+                    return sink.write(message.data(), message.size());
+                });
+        });
 
     const auto image_headers = [](httplib::Response& res, const ViewFrame& frame) {
         res.set_header("X-Octray-Generation", std::to_string(frame.generation));
@@ -235,47 +370,234 @@ void ViewServer::Impl::routes() {
         res.set_header("X-Octray-Camera-Version", std::to_string(frame.camera_version));
     };
 
-    server.Get("/api/image.png", [this, image_headers](const httplib::Request& req,
-                                                       httplib::Response& res) {
-        const auto frame = session.latest();
-        if (!frame) throw BadRequest(503, "no picture yet");
-        float exposure = 0.0f;
-        if (req.has_param("exposure")) {
-            const std::string text = req.get_param_value("exposure");
-            char* end = nullptr;
-            const float value = std::strtof(text.c_str(), &end);
-            if (text.empty() || *end != '\0' || !std::isfinite(value) || std::fabs(value) > 64)
-                throw BadRequest(400, "exposure: expected a number of stops in [-64, 64]");
-            exposure = value;
-        }
-        image_headers(res, *frame);
-        res.set_content(encode_png_rgb8(frame->image.width(), frame->image.height(),
-                                        tone_map_srgb8(frame->image, exposure)),
-                        "image/png");
-    });
+    server.Get("/api/image.png",
+               [&session, image_headers](const httplib::Request& req, httplib::Response& res) {
+                   const auto frame = session.latest();
+                   if (!frame) throw BadRequest(503, "no picture yet");
+                   const float exposure = exposure_param(req);
+                   image_headers(res, *frame);
+                   res.set_content(encode_png_rgb8(frame->image.width(), frame->image.height(),
+                                                   tone_map_srgb8(frame->image, exposure)),
+                                   "image/png");
+               });
 
     // The picture as it is: little-endian float32 R, G, B per pixel, row 0 on top, for
     // tests and tools that compare exactly.
-    server.Get("/api/image.f32", [this, image_headers](const httplib::Request&,
-                                                       httplib::Response& res) {
+    server.Get("/api/image.f32",
+               [&session, image_headers](const httplib::Request&, httplib::Response& res) {
+                   const auto frame = session.latest();
+                   if (!frame) throw BadRequest(503, "no picture yet");
+                   image_headers(res, *frame);
+                   res.set_content(float_bytes(frame->image), "application/octet-stream");
+               });
+
+    // The linear value under the page's cursor, of the latest picture (whose size the
+    // answer repeats: a preview is smaller than the refined picture).
+    server.Get("/api/pixel", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto frame = session.latest();
         if (!frame) throw BadRequest(503, "no picture yet");
-        image_headers(res, *frame);
-        static_assert(sizeof(Rgb) == 3 * sizeof(float));
-        res.set_content(std::string(reinterpret_cast<const char*>(frame->image.data()),
-                                    frame->image.pixel_count() * sizeof(Rgb)),
-                        "application/octet-stream");
+        json answer = pixel_json(req, frame->image);
+        answer["generation"] = frame->generation;
+        res.set_content(answer.dump(), "application/json");
     });
 
-    server.Post("/api/camera", [this](const httplib::Request& req, httplib::Response& res) {
+    if (options.save) {
+        server.Post("/api/save",
+                    [this, &session](const httplib::Request& req, httplib::Response& res) {
+                        res.set_content(save(session, req.body).dump(), "application/json");
+                    });
+    }
+
+    // The page's switches: {"threads": N, "spp": N, "max_depth": N, "order": "tiled" |
+    // "rows" | "frameless"}, every key optional; a change re-renders the current camera.
+    server.Post("/api/settings", [&session](const httplib::Request& req,
+                                            httplib::Response& res) {
+        const json request = json::parse(req.body, nullptr, /*allow_exceptions=*/false);
+        if (request.is_discarded() || !request.is_object())
+            throw BadRequest(400, "settings: expected a JSON object such as {\"spp\": 16}");
+        RenderSwitches switches = session.switches();
+        const auto integer = [](const json& value, const std::string& what, int lo, int hi) {
+            if (!value.is_number_integer() || value.get<long long>() < lo ||
+                value.get<long long>() > hi)
+                throw BadRequest(400, "settings." + what + ": expected an integer in [" +
+                                          std::to_string(lo) + ", " + std::to_string(hi) + "]");
+            return static_cast<int>(value.get<long long>());
+        };
+        for (const auto& [key, value] : request.items()) {
+            if (key == "threads") {
+                switches.threads = integer(value, key, 0, kMaxSwitchThreads);
+            } else if (key == "spp") {
+                switches.spp = integer(value, key, 1, kMaxSwitchSpp);
+            } else if (key == "max_depth") {
+                switches.max_depth = integer(value, key, 1, kMaxDepthLimit);
+            } else if (key == "order") {
+                const auto order = value.is_string()
+                                       ? parse_pixel_order(value.get<std::string>())
+                                       : std::nullopt;
+                if (!order)
+                    throw BadRequest(400, "settings.order: expected tiled, rows or frameless");
+                switches.order = *order;
+            } else {
+                throw BadRequest(400, "settings: unknown key \"" + key +
+                                          "\" (expected threads, spp, max_depth, order)");
+            }
+        }
+        session.reconfigure(switches);
+        res.set_content(json{{"ok", true}}.dump(), "application/json");
+    });
+
+    server.Post("/api/camera", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto [camera, moving] = parse_camera_request(req.body, session.camera());
         const std::uint64_t version = session.set_camera(camera, moving);
         res.set_content(json{{"camera_version", version}}.dump(), "application/json");
     });
 }
 
+// POST /api/save: the refined picture as `octray render` writes it (render/view/README.md).
+json ViewServer::Impl::save(ViewSession& session, const std::string& body) const {
+    const SaveSettings& settings = *options.save;
+    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    if (request.is_discarded() || !request.is_object() || !request.contains("name") ||
+        !request["name"].is_string())
+        throw BadRequest(400, "save: expected {\"name\": \"view.exr\", \"overwrite\": false}");
+    bool overwrite = false;
+    for (const auto& [key, value] : request.items()) {
+        if (key == "overwrite") {
+            if (!value.is_boolean())
+                throw BadRequest(400, "save.overwrite: expected true or false");
+            overwrite = value.get<bool>();
+        } else if (key != "name") {
+            throw BadRequest(400,
+                             "save: unknown key \"" + key + "\" (expected name, overwrite)");
+        }
+    }
+    const std::string name = request["name"].get<std::string>();
+    check_save_name(name);
+    const auto frame = session.latest();
+    Scene posed = session.scene();
+    if (!frame || frame->preview || frame->spp < frame->target_spp ||
+        frame->target_spp != posed.image.spp || frame->max_depth != posed.render.max_depth)
+        throw BadRequest(409, "save: the picture is still refining; save once it has all " +
+                                  std::to_string(posed.image.spp) + " spp");
+    if (frame->rays.total() == 0)
+        throw BadRequest(409, "save: needs the tiled order (frameless pictures are not saved)");
+    namespace fs = std::filesystem;
+    const fs::path directory(settings.directory);
+    const auto refuse_existing = [&](const std::string& file) {
+        if (!overwrite && fs::exists(directory / file))
+            throw BadRequest(
+                409, "save: " + file + " exists; ask to overwrite it (\"overwrite\": true)");
+    };
+    refuse_existing(name);
+
+    const Camera scene_camera = posed.camera;
+    posed.camera = frame->camera;
+    batch::BatchScene identity;
+    identity.spec = settings.spec;
+    identity.sha256 = settings.sha256;
+    identity.scene = posed;
+    // A moved camera is a new scene: written beside the image as JSON (`octray scene`'s
+    // writer), named in the header and the command line instead of the original.
+    const bool moved = !same_camera(frame->camera, scene_camera);
+    std::string scene_file;
+    if (moved) {
+        scene_file = name.substr(0, name.size() - 4) + ".json";
+        refuse_existing(scene_file);
+        const std::string text = scene_to_json(posed);
+        write_file_atomically((directory / scene_file).string(), [&](const std::string& tmp) {
+            std::ofstream out(tmp, std::ios::binary);
+            out << text;
+            out.close();
+            if (!out) throw IoError("cannot write " + tmp);
+        });
+        identity.spec = scene_file;
+        identity.sha256 = batch::sha256_hex(text);
+    }
+    RenderResult result;
+    result.image = frame->image;
+    result.rect = PixelRect{0, 0, frame->image.width(), frame->image.height()};
+    result.full_width = frame->image.width();
+    result.full_height = frame->image.height();
+    result.rays = frame->rays;
+    result.seconds = frame->render_seconds;
+    const ExrAttributes attributes = batch::render_exr_attributes(
+        identity, posed, 0, result, settings.path_label, posed.image.spp, std::string());
+    write_exr((directory / name).string(),
+              make_exr_image(result, ExrWriteOptions{}, attributes));
+
+    std::string command =
+        "octray render " + shell_word(identity.spec) + " --width " +
+        std::to_string(posed.image.width) + " --height " + std::to_string(posed.image.height) +
+        " --spp " + std::to_string(posed.image.spp) + " --max-depth " +
+        std::to_string(posed.render.max_depth) + settings.render_arguments + " -o " + name;
+    json answer{{"file", name}, {"command", command}, {"camera_moved", moved}};
+    answer["scene_file"] = moved ? json(scene_file) : json(nullptr);
+    return answer;
+}
+
+void ViewServer::Impl::compare_routes() {
+    const CompareView& view = *compare_ptr;
+    server.Get("/api/status", [&view](const httplib::Request&, httplib::Response& res) {
+        const json status{{"mode", "compare"},
+                          {"a", view.path_a},
+                          {"b", view.path_b},
+                          {"full_width", view.result.width},
+                          {"full_height", view.result.height},
+                          {"heatmap_width", view.heatmap.image.width},
+                          {"heatmap_height", view.heatmap.image.height},
+                          {"heatmap_zoom", view.heatmap.zoom},
+                          {"heatmap_legend", view.heatmap.legend},
+                          {"heatmap_min", view.heatmap.scale_min},
+                          {"heatmap_max", view.heatmap.scale_max},
+                          {"compare", json::parse(view.figures_json)}};
+        res.set_content(status.dump(), "application/json");
+    });
+    // Exactly what `octray compare --json A B` prints.
+    server.Get("/api/compare", [&view](const httplib::Request&, httplib::Response& res) {
+        res.set_content(view.figures_json, "application/json");
+    });
+    // picture=a (default), b or diff: the linear RGB picture.
+    const auto picture = [&view](const httplib::Request& req) -> const Image& {
+        const std::string name =
+            req.has_param("picture") ? req.get_param_value("picture") : "a";
+        if (name == "a") return view.rgb_a;
+        if (name == "b") return view.rgb_b;
+        if (name == "diff") return view.rgb_diff;
+        throw BadRequest(400,
+                         "picture: expected a, b, diff or heatmap, found \"" + name + "\"");
+    };
+    server.Get("/api/image.png", [&view, picture](const httplib::Request& req,
+                                                  httplib::Response& res) {
+        const float exposure = exposure_param(req);
+        if (req.has_param("picture") && req.get_param_value("picture") == "heatmap") {
+            const Rgb8Image& map = view.heatmap.image;
+            res.set_content(encode_png_rgb8(map.width, map.height, map.rgb), "image/png");
+            return;
+        }
+        const Image& image = picture(req);
+        res.set_content(
+            encode_png_rgb8(image.width(), image.height(), tone_map_srgb8(image, exposure)),
+            "image/png");
+    });
+    server.Get("/api/image.f32",
+               [picture](const httplib::Request& req, httplib::Response& res) {
+                   const Image& image = picture(req);
+                   res.set_header("X-Octray-Width", std::to_string(image.width()));
+                   res.set_header("X-Octray-Height", std::to_string(image.height()));
+                   res.set_content(float_bytes(image), "application/octet-stream");
+               });
+    server.Get("/api/pixel", [picture](const httplib::Request& req, httplib::Response& res) {
+        res.set_content(pixel_json(req, picture(req)).dump(), "application/json");
+    });
+}
+
 ViewServer::ViewServer(ViewSession& session, ServerOptions options)
-    : impl_(std::make_unique<Impl>(session, std::move(options))) {
+    : ViewServer(std::make_unique<Impl>(&session, nullptr, std::move(options))) {}
+
+ViewServer::ViewServer(const CompareView& images, ServerOptions options)
+    : ViewServer(std::make_unique<Impl>(nullptr, &images, std::move(options))) {}
+
+ViewServer::ViewServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {
     impl_->routes();
     const std::string& host = impl_->options.bind;
     const auto failure = [&](int port) {

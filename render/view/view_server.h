@@ -4,18 +4,32 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "render/view/compare_view.h"
 #include "render/view/view_session.h"
 
 namespace octray::view {
 
+// What POST /api/save needs to write the current picture as `octray render` would: the
+// scene's identity for the EXR header and the command line that renders it again.
+struct SaveSettings {
+    std::string spec;        // the scene as given on the command line (octray.scene)
+    std::string sha256;      // its digest (octray.sceneSha256)
+    std::string path_label;  // octray.path: "simd (avx2)", "scalar"
+    // Options of the render command line beyond the size, spp and depth ("--path scalar").
+    std::string render_arguments;
+    std::string directory = ".";  // where files are written: the working directory
+};
+
 struct ServerOptions {
-    std::string bind = "127.0.0.1";  // loopback only unless the user says otherwise
-    int port = 0;                    // 0: a free port, chosen by the kernel
-    std::string token;               // empty: random_token()
-    std::size_t max_body = 4096;     // bytes; a longer request body gets 413
-    int http_threads = 16;           // requests served at once (an event stream holds one)
+    std::string bind = "127.0.0.1";    // loopback only unless the user says otherwise
+    int port = 0;                      // 0: a free port, chosen by the kernel
+    std::string token;                 // empty: random_token()
+    std::size_t max_body = 4096;       // bytes; a longer request body gets 413
+    int http_threads = 16;             // requests served at once (an event stream holds one)
+    std::optional<SaveSettings> save;  // absent: no /api/save
 };
 
 class ViewServer {
@@ -23,6 +37,9 @@ class ViewServer {
     // Binds the socket (nothing is served before start()). Throws std::runtime_error
     // naming the address if it cannot be bound. `session` must outlive the server.
     ViewServer(ViewSession& session, ServerOptions options);
+    // `octray view A.exr B.exr`: serves the two images, their difference, the heatmap and
+    // the figures of `images` (no renderer, no camera). `images` must outlive the server.
+    ViewServer(const CompareView& images, ServerOptions options);
     ~ViewServer();  // stop()
     ViewServer(const ViewServer&) = delete;
     ViewServer& operator=(const ViewServer&) = delete;
@@ -44,6 +61,7 @@ class ViewServer {
 
   private:
     struct Impl;
+    explicit ViewServer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };
 

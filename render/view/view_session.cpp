@@ -43,7 +43,64 @@ ViewSession::ViewSession(Scene scene, ViewSettings settings)
 
 ViewSession::~ViewSession() { stop(); }
 
+const char* to_string(PixelOrder order) {
+    switch (order) {
+        case PixelOrder::tiled:
+            return "tiled";
+        case PixelOrder::rows:
+            return "rows";
+        case PixelOrder::frameless:
+            return "frameless";
+    }
+    return "tiled";
+}
+
+std::optional<PixelOrder> parse_pixel_order(const std::string& name) {
+    for (const PixelOrder order : {PixelOrder::tiled, PixelOrder::rows, PixelOrder::frameless})
+        if (name == to_string(order)) return order;
+    return std::nullopt;
+}
+
+Scene ViewSession::scene() const {
+    std::lock_guard lock(mutex_);
+    return scene_;
+}
+
+RenderSwitches ViewSession::switches() const {
+    std::lock_guard lock(mutex_);
+    return RenderSwitches{settings_.threads, scene_.image.spp, scene_.render.max_depth,
+                          settings_.order};
+}
+
+void ViewSession::reconfigure(const RenderSwitches& switches) {
+    std::lock_guard guard(reconfigure_mutex_);
+    Scene next = scene();
+    next.image.spp = switches.spp;
+    next.render.max_depth = switches.max_depth;
+    validate_scene(next);  // throws SceneError: nothing changes
+    {
+        std::lock_guard lock(mutex_);
+        if (stop_) return;
+        restart_ = true;
+        cancel_ = true;
+    }
+    changed_.notify_all();
+    if (thread_.joinable()) thread_.join();
+    {
+        std::lock_guard lock(mutex_);
+        scene_ = std::move(next);
+        settings_.threads = switches.threads;
+        settings_.order = switches.order;
+        restart_ = false;
+        cancel_ = false;
+        ++camera_version_;  // the current camera again, under the new switches
+        moving_ = false;
+    }
+    thread_ = std::thread([this] { run(); });
+}
+
 void ViewSession::stop() {
+    std::lock_guard guard(reconfigure_mutex_);
     {
         std::lock_guard lock(mutex_);
         stop_ = true;
@@ -84,8 +141,11 @@ std::uint64_t ViewSession::set_camera(const Camera& camera, bool moving) {
     // The whole scene would be validated again for every move of the mouse; the camera's
     // rules need only the camera and the image size, so a scene of nothing else checks them.
     Scene probe;
-    probe.source = scene_.source;
-    probe.image = scene_.image;
+    {
+        std::lock_guard lock(mutex_);  // reconfigure() may replace scene_
+        probe.source = scene_.source;
+        probe.image = scene_.image;
+    }
     probe.camera = camera;
     validate_scene(probe);
     std::uint64_t version = 0;
@@ -115,14 +175,15 @@ void ViewSession::run() {
     bool refined = true;             // whether that picture was the full progressive one
     Clock::time_point last_preview;
     std::unique_lock lock(mutex_);
-    while (!stop_) {
+    while (!stop_ && !restart_) {
         if (camera_version_ == done_version && refined) {
             changed_.wait(lock);
             continue;
         }
         if (camera_version_ == done_version && !refined &&
-            changed_.wait_until(lock, last_preview + settings_.settle,
-                                [&] { return stop_ || camera_version_ != done_version; })) {
+            changed_.wait_until(lock, last_preview + settings_.settle, [&] {
+                return stop_ || restart_ || camera_version_ != done_version;
+            })) {
             continue;  // moved again (or stopping) before it settled
         }
         const std::uint64_t version = camera_version_;
@@ -178,7 +239,7 @@ void ViewSession::run_frameless() {
     if (settings_.threads > 0) arena.emplace(settings_.threads);
 
     std::unique_lock lock(mutex_);
-    while (!stop_) {
+    while (!stop_ && !restart_) {
         if (camera_version_ == version && fresh >= blocks.size()) {
             changed_.wait(lock);
             continue;
@@ -254,6 +315,10 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
     RenderOptions options;
     options.threads = settings_.threads;
     options.cancel = &cancel_;
+    if (settings_.order == PixelOrder::rows) {
+        options.tile_width = scene.image.width;  // one tile a row: row-major order
+        options.tile_height = 1;
+    }
     const auto start = Clock::now();
     RenderResult result = settings_.path == RenderPath::simd
                               ? render_packet(scene, options, settings_.isa)
@@ -277,6 +342,10 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
     RenderOptions options;
     options.threads = settings_.threads;
     options.cancel = &cancel_;
+    if (settings_.order == PixelOrder::rows) {
+        options.tile_width = scene.image.width;  // one tile a row: row-major order
+        options.tile_height = 1;
+    }
     const auto start = Clock::now();
     // The SIMD path compiles the scene once for all passes of this camera.
     std::optional<CompiledScene> compiled;
@@ -285,13 +354,20 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
         return compiled ? render_packet(*compiled, pass_options, settings_.isa)
                         : render_reference(scene, pass_options);
     };
+    RayCounts rays;
+    double render_seconds = 0.0;
     const batch::PassCallback on_pass = [&](const RenderResult& so_far, int samples_so_far) {
+        rays += so_far.rays;
+        render_seconds += so_far.seconds;
         ViewFrame frame;
+        frame.rays = rays;
+        frame.render_seconds = render_seconds;
         frame.image = so_far.image;
         frame.camera_version = version;
         frame.camera = camera;
         frame.spp = samples_so_far;
         frame.target_spp = scene.image.spp;
+        frame.max_depth = scene.render.max_depth;
         frame.pass_seconds = so_far.seconds;
         frame.frame_seconds = seconds_since(start);
         frame.mrays_per_second = mrays_per_second(so_far);

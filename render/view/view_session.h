@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -23,6 +24,7 @@ namespace octray::view {
 // The order in which a picture's pixels are rendered and shown.
 enum class PixelOrder {
     tiled,      // whole pictures: progressive passes (and previews while moving)
+    rows,       // as tiled, each tile one row of the picture (row-major within a pass)
     frameless,  // blocks in a fixed random permutation, shown as they land (frameless.h)
 };
 
@@ -38,6 +40,18 @@ struct ViewSettings {
     std::chrono::milliseconds settle{300};
 };
 
+// What the page may switch while the viewer runs (POST /api/settings).
+struct RenderSwitches {
+    int threads = 0;
+    int spp = 1;
+    int max_depth = 1;
+    PixelOrder order = PixelOrder::tiled;
+};
+
+// "tiled", "rows", "frameless"; and the order a name stands for.
+const char* to_string(PixelOrder order);
+std::optional<PixelOrder> parse_pixel_order(const std::string& name);
+
 // One published picture and how it was made.
 struct ViewFrame {
     Image image;                       // linear RGB, row 0 on top
@@ -47,12 +61,17 @@ struct ViewFrame {
     bool preview = false;           // reduced resolution while the camera moves
     int spp = 0;                    // samples per pixel so far
     int target_spp = 0;             // the scene's spp: the last pass
+    int max_depth = 0;              // the scene's max depth when it was rendered
     double pass_seconds = 0.0;      // this pass
     double frame_seconds = 0.0;     // every pass so far of this camera
     double mrays_per_second = 0.0;  // this pass: rays traced / pass_seconds
     // Frameless: the part of the picture rendered with this camera so far (1: all of it,
     // at the scene's spp; the rest still shows earlier cameras). Tiled: always 1.
     double coverage = 1.0;
+    // Tiled: the rays and render time of every pass of this camera so far (what `octray
+    // render` writes in its header). Frameless: not counted (zero).
+    RayCounts rays;
+    double render_seconds = 0.0;
 };
 
 class ViewSession {
@@ -63,8 +82,13 @@ class ViewSession {
     ViewSession(const ViewSession&) = delete;
     ViewSession& operator=(const ViewSession&) = delete;
 
-    // The scene as loaded (its camera is the initial one).
-    const Scene& scene() const { return scene_; }
+    // The scene as loaded (its camera is the initial one), with the switches applied.
+    Scene scene() const;
+    RenderSwitches switches() const;
+    // Applies new switches: the render in flight is abandoned, the render thread restarts
+    // with them and renders the current camera again (a new camera version). Throws
+    // SceneError for values the scene rules refuse (spp, max depth out of range).
+    void reconfigure(const RenderSwitches& switches);
 
     // The latest picture, nullptr before the first one.
     std::shared_ptr<const ViewFrame> latest() const;
@@ -95,8 +119,12 @@ class ViewSession {
     bool render_passes(const Camera& camera, std::uint64_t version);
     void publish(ViewFrame frame);
 
-    const Scene scene_;
-    const ViewSettings settings_;
+    // Changed only by reconfigure(), while the render thread is stopped; read by other
+    // threads under mutex_ (scene(), switches()).
+    Scene scene_;
+    ViewSettings settings_;
+    std::mutex reconfigure_mutex_;  // one reconfigure() or stop() at a time
+    bool restart_ = false;          // the render thread is to return for reconfigure()
 
     mutable std::mutex mutex_;
     mutable std::condition_variable changed_;  // camera set, picture published, or stop

@@ -7,7 +7,9 @@ Starts `octray view` on a free port, opens the URL it prints, and checks that th
 shows the refined picture (the canvas has non-black pixels and says spp 4), that a drag
 across the canvas orbits the camera (the server reports a new camera at the same distance
 from the same look-at point, and the canvas changes), that the wheel dollies, that
-the frameless order converges to the same picture as the tiled one, that the server refuses the page
+the frameless order converges to the same picture as the tiled one, that
+`octray view A.exr B.exr` shows compare's verdict, the heatmap and the value under the
+cursor, that the server refuses the page
 without the token, and that SIGINT stops the command with status 0. Screenshots go to
 ARTIFACTS_DIR. Exits 77 (ctest's SKIP_RETURN_CODE) when Chromium, chromedriver or
 python3-selenium is missing.
@@ -39,11 +41,14 @@ def fail(why):
     return 1
 
 
-def start_view(octray, *extra):
-    process = subprocess.Popen(
-        [octray, "view", "whitted", "--port", "0", "--width", "160", "--height", "90",
-         "--spp", "4", "--threads", "2", *extra],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def start_view(octray, *extra, cwd=None):
+    return start_command([octray, "view", "whitted", "--port", "0", "--width", "160",
+                          "--height", "90", "--spp", "4", "--threads", "2", *extra], cwd)
+
+
+def start_command(command, cwd=None):
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, cwd=cwd)
     for line in process.stdout:
         line = line.strip()
         if line.startswith("http://"):
@@ -111,6 +116,11 @@ def run(octray, artifacts):
                                     WebDriverWait)
                 if status == 0:
                     status = check_frameless(browser, octray, artifacts, WebDriverWait)
+                if status == 0:
+                    status = check_save(browser, octray, WebDriverWait)
+                if status == 0:
+                    status = check_compare(browser, octray, artifacts, ActionChains,
+                                           WebDriverWait)
             finally:
                 browser.quit()
     finally:
@@ -228,6 +238,98 @@ def check_frameless(browser, octray, artifacts, WebDriverWait):
     if digests[0] != digests[1]:
         return fail(f"frameless converged to another picture than tiled: {digests}")
     print(f"PASS: the frameless order converged to the tiled picture {digests[0]}")
+    return 0
+
+
+def check_save(browser, octray, WebDriverWait):
+    """The save button writes the refined picture in the viewer's directory and shows the
+    octray render command line that makes it again."""
+    with tempfile.TemporaryDirectory() as folder:
+        process, url = start_view(octray, cwd=folder)
+        try:
+            browser.get(url)
+            WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return document.body.dataset.spp === '4';"))
+            name = browser.find_element("id", "save-name")
+            name.clear()
+            name.send_keys("saved.exr")
+            browser.find_element("id", "save").click()
+            command = WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return document.getElementById('save-result').dataset.command;"))
+            # The spp switch: the server re-renders up to the new spp.
+            browser.execute_script(
+                "const spp = document.getElementById('spp-switch'); spp.value = '2';"
+                "spp.dispatchEvent(new Event('change'));")
+            WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return document.getElementById('target-spp').textContent === '2' && "
+                "document.body.dataset.spp === '2';"))
+            if fetch_status(url)["settings"]["spp"] != 2:
+                return fail("the spp switch did not reach the server")
+        finally:
+            process.send_signal(signal.SIGINT)
+            process.communicate(timeout=60)
+        expected = "octray render whitted --width 160 --height 90 --spp 4 --max-depth "
+        if not command.startswith(expected) or not command.endswith(" -o saved.exr"):
+            return fail(f"save showed the command {command!r}")
+        if not os.path.exists(os.path.join(folder, "saved.exr")):
+            return fail("save did not write saved.exr in the viewer's directory")
+    print(f"PASS: save wrote saved.exr and showed {command}; the spp switch re-rendered")
+    return 0
+
+
+def check_compare(browser, octray, artifacts, ActionChains, WebDriverWait):
+    """`octray view A.exr B.exr`: the page shows compare's verdict, flips to the heatmap
+    (drawn at the heatmap's size, not black), and shows the linear value under the cursor
+    as the server reads it."""
+    with tempfile.TemporaryDirectory() as folder:
+        a, b = os.path.join(folder, "a.exr"), os.path.join(folder, "b.exr")
+        for spp, path in ((1, a), (4, b)):
+            subprocess.run([octray, "render", "whitted", "--width", "160", "--height", "90",
+                            "--spp", str(spp), "--threads", "2", "-o", path], check=True,
+                           capture_output=True, timeout=WAIT)
+        process, url = start_command([octray, "view", a, b, "--port", "0"])
+        try:
+            status = fetch_status(url)
+            browser.get(url)
+            WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(
+                "return document.getElementById('view').dataset.picture === 'a';"))
+            verdict = browser.execute_script(
+                "return document.getElementById('figures').dataset.verdict;")
+            if verdict != status["compare"]["verdict"]:
+                return fail(f"the page shows verdict {verdict}, compare says "
+                            f"{status['compare']['verdict']}")
+            browser.save_screenshot(os.path.join(artifacts, "view_compare_a.png"))
+            canvas = browser.find_element("id", "view")
+            canvas.click()
+            canvas.send_keys("h")
+            WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(
+                "const c = document.getElementById('view');"
+                f"return c.dataset.picture === 'heatmap' && c.width === {status['heatmap_width']};"))
+            lit, _ = canvas_digest(browser)
+            if lit == 0:
+                return fail("the heatmap is black")
+            browser.save_screenshot(os.path.join(artifacts, "view_compare_heatmap.png"))
+            # The value under the cursor: the top-left pixel's |A - B| (the heatmap's).
+            canvas.send_keys("a")
+            WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(
+                "return document.getElementById('view').dataset.picture === 'a';"))
+            ActionChains(browser).move_to_element_with_offset(canvas, 0, 0).perform()
+            shown = WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(
+                "return document.getElementById('pixel').dataset.rgb;"))
+            text = browser.execute_script("return document.getElementById('pixel').textContent;")
+            x, y = [int(v) for v in text.split(")")[0].strip("(").split(",")]
+            base, token = url.split("/?token=")
+            with urllib.request.urlopen(f"{base}/api/pixel?token={token}&picture=a&x={x}&y={y}",
+                                        timeout=30) as response:
+                expected = json.load(response)["rgb"]
+            if json.loads(shown) != expected:
+                return fail(f"the page shows {shown} at ({x}, {y}), the server {expected}")
+        finally:
+            process.send_signal(signal.SIGINT)
+            out, err = process.communicate(timeout=60)
+        if process.returncode != 0:
+            return fail(f"octray view A B exited {process.returncode}: {err}")
+    print(f"PASS: the A/B page shows {verdict} and the heatmap; the cursor reads {text}")
     return 0
 
 

@@ -78,4 +78,32 @@ TEST(ViewCli, BenchReportsTheFirstPictureAndTheOrbitUpdates) {
     EXPECT_TRUE(contains(r.output, "Mrays/s")) << r.output;
 }
 
+// `octray view A B` reads and compares the images before it serves, and fails as
+// `octray compare A B` does: 4 for an image that cannot be read, 3 for two that cannot be
+// compared; scene options with two images are a usage error.
+TEST(ViewCli, TwoImagesFailAsCompareFails) {
+    const std::filesystem::path dir = kCwd / ("octray_view_cli_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    for (const auto& [size, name] : {std::pair{"16", "a.exr"}, std::pair{"8", "b.exr"}}) {
+        const RunResult r = run_octray(
+            {"render", "whitted", "--width", size, "--height", "8", "--spp", "1", "-o", name},
+            dir);
+        ASSERT_EQ(r.status, 0) << r.output;
+    }
+    const RunResult missing = run_octray({"view", "a.exr", "missing.exr", "--port", "0"}, dir);
+    EXPECT_EQ(missing.status, 4) << missing.output;
+    EXPECT_TRUE(contains(missing.output, "missing.exr")) << missing.output;
+    const RunResult mismatch = run_octray({"view", "a.exr", "b.exr", "--port", "0"}, dir);
+    EXPECT_EQ(mismatch.status, 3) << mismatch.output;
+    const RunResult compare = run_octray({"compare", "a.exr", "b.exr"}, dir);
+    EXPECT_EQ(compare.status, 3) << compare.output;
+    const RunResult scene_option =
+        run_octray({"view", "a.exr", "a.exr", "--spp", "4", "--port", "0"}, dir);
+    EXPECT_EQ(scene_option.status, 2) << scene_option.output;
+    EXPECT_TRUE(contains(scene_option.output, "apply to a scene")) << scene_option.output;
+    const RunResult three = run_octray({"view", "a.exr", "a.exr", "a.exr"}, dir);
+    EXPECT_EQ(three.status, 2) << three.output;
+    std::filesystem::remove_all(dir);
+}
+
 }  // namespace

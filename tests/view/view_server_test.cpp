@@ -14,16 +14,21 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 
+#include "render/batch/result_exr.h"
+#include "render/image/image_io.h"
+#include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/view/frameless.h"
 #include "render/view/view_session.h"
 #include "scene/builtin.h"
+#include "scene/load.h"
 
 namespace {
 
@@ -422,6 +427,213 @@ TEST_F(FramelessViewTest, ConvergesToTheTiledPictureBitForBit) {
     Scene scene = scene_;
     scene.camera.eye = octray::Vec3{1.5f, 2.5f, 6.0f};
     EXPECT_TRUE(after->body == rendered_bytes(scene));
+}
+
+}  // namespace
+
+namespace {
+
+// The value under the cursor is the float pixel of the latest picture; outside it, 400.
+TEST_F(ViewServerTest, ThePixelEndpointReadsTheLatestPicture) {
+    ASSERT_FALSE(
+        wait_for_frame([&](const json& f) { return f["spp"] == scene_.image.spp; }).is_null());
+    const auto bytes = client_->Get(with_token("/api/image.f32"));
+    ASSERT_TRUE(bytes);
+    ASSERT_EQ(bytes->status, 200);
+    const int x = 17, y = 9;
+    float expected[3];
+    std::memcpy(expected,
+                bytes->body.data() +
+                    (static_cast<std::size_t>(y) * scene_.image.width + x) * 3 * sizeof(float),
+                sizeof(expected));
+    const auto pixel = client_->Get(with_token("/api/pixel?x=17&y=9"));
+    ASSERT_TRUE(pixel);
+    ASSERT_EQ(pixel->status, 200);
+    const json answer = json::parse(pixel->body);
+    EXPECT_EQ(answer["width"], scene_.image.width);
+    EXPECT_EQ(answer["height"], scene_.image.height);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(answer["rgb"][c].get<float>(), expected[c]) << c;
+    for (const char* query : {"x=64&y=0", "x=0&y=36", "x=-1&y=0", "x=0", "y=0", "x=1e1&y=0",
+                              "x=&y=0", "x=0x1&y=0"}) {
+        const auto bad = client_->Get(with_token(std::string("/api/pixel?") + query));
+        ASSERT_TRUE(bad) << query;
+        EXPECT_EQ(bad->status, 400) << query << " -> " << bad->body;
+    }
+}
+
+}  // namespace
+
+namespace {
+
+// POST /api/save writes the refined picture as `octray render` writes the same scene and
+// spp (same pixels, same header attributes), in the save directory only, refusing names
+// with a path and files that exist unless asked; a moved camera writes its scene beside.
+TEST(ViewSave, WritesWhatRenderWrites) {
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("octray_view_save_" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const Scene scene = small_whitted();
+    ViewSettings settings;
+    settings.threads = 2;
+    ViewSession session(scene, settings);
+    ServerOptions options;
+    octray::view::SaveSettings save;
+    save.spec = "whitted";
+    save.sha256 = "0123";
+    save.path_label = "simd (test)";
+    save.directory = dir.string();
+    options.save = save;
+    ViewServer server(session, options);
+    server.start();
+    httplib::Client client("127.0.0.1", server.port());
+    client.set_read_timeout(60, 0);
+    const std::string url = "/api/save?token=" + server.token();
+    const auto post = [&](const std::string& body) {
+        auto result = client.Post(url, body, "application/json");
+        EXPECT_TRUE(result);
+        return result;
+    };
+    // 409 while the picture refines: retried until it is refined.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    const auto save_refined = [&](const std::string& body) {
+        for (;;) {
+            auto result = client.Post(url, body, "application/json");
+            if (!result || result->status != 409 || std::chrono::steady_clock::now() > deadline)
+                return result;
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+    };
+    auto saved = save_refined(R"({"name": "view.exr"})");
+    ASSERT_TRUE(saved);
+    ASSERT_EQ(saved->status, 200) << saved->body;
+    const json answer = json::parse(saved->body);
+    EXPECT_EQ(answer["command"],
+              "octray render whitted --width 64 --height 36 --spp 4 --max-depth " +
+                  std::to_string(scene.render.max_depth) + " -o view.exr");
+    EXPECT_EQ(answer["camera_moved"], false);
+
+    // The pixels `octray render` writes: render_packet through the same EXR writer.
+    const fs::path expected_path = dir / "expected.exr";
+    octray::write_exr(expected_path.string(),
+                      octray::make_exr_image(octray::render_packet(scene), {}, {}));
+    const octray::ChannelImage got = octray::read_image((dir / "view.exr").string());
+    const octray::ChannelImage expected = octray::read_image(expected_path.string());
+    EXPECT_EQ(got.format, expected.format);
+    EXPECT_EQ(got.channel_names, expected.channel_names);
+    EXPECT_EQ(got.planes, expected.planes);
+    const octray::ExrAttributes attributes =
+        octray::read_exr_attributes((dir / "view.exr").string());
+    const auto find_string = [&](const std::string& name) {
+        for (const auto& [key, value] : attributes.strings)
+            if (key == name) return value;
+        return std::string("(absent)");
+    };
+    const auto find_int = [&](const std::string& name) {
+        for (const auto& [key, value] : attributes.ints)
+            if (key == name) return value;
+        return -1;
+    };
+    EXPECT_EQ(find_string("octray.scene"), "whitted");
+    EXPECT_EQ(find_string("octray.sceneSha256"), "0123");
+    EXPECT_EQ(find_string("octray.path"), "simd (test)");
+    EXPECT_EQ(find_int("samplesPerPixel"), 4);
+    EXPECT_EQ(find_int("octray.maxDepth"), scene.render.max_depth);
+
+    // Existing files, bad names, bad bodies.
+    EXPECT_EQ(post(R"({"name": "view.exr"})")->status, 409);
+    EXPECT_EQ(post(R"({"name": "view.exr", "overwrite": true})")->status, 200);
+    for (const char* body :
+         {R"({"name": "../view.exr"})", R"({"name": "sub/view.exr"})",
+          R"({"name": "/tmp/v.exr"})", R"({"name": "..exr"})", R"({"name": ".hidden.exr"})",
+          R"({"name": "-o.exr"})", R"({"name": "view.png"})", R"({"name": "a b.exr"})",
+          R"({"name": ""})", R"({"name": 3})", R"({"name": "v.exr", "overwrite": 1})",
+          R"({"name": "v.exr", "x": 1})", "not json"}) {
+        const auto result = post(body);
+        EXPECT_EQ(result->status, 400) << body << " -> " << result->body;
+    }
+    EXPECT_FALSE(fs::exists(dir / "v.exr"));
+
+    // A moved camera: its scene is written beside the picture and named in the command.
+    octray::Camera moved = scene.camera;
+    moved.eye.x += 1.0f;
+    session.set_camera(moved, false);
+    // Until the moved camera's picture is refined, the old one would be saved: wait for it.
+    while (session.latest()->camera_version < 2 || session.latest()->spp < 4)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    saved = save_refined(R"({"name": "moved.exr"})");
+    ASSERT_TRUE(saved);
+    ASSERT_EQ(saved->status, 200) << saved->body;
+    const json moved_answer = json::parse(saved->body);
+    EXPECT_EQ(moved_answer["camera_moved"], true);
+    EXPECT_EQ(moved_answer["scene_file"], "moved.json");
+    EXPECT_EQ(moved_answer["command"].get<std::string>().rfind("octray render moved.json ", 0),
+              0u);
+    const Scene reloaded = octray::load_scene((dir / "moved.json").string());
+    EXPECT_EQ(reloaded.camera.eye.x, moved.eye.x);
+    octray::write_exr(expected_path.string(),
+                      octray::make_exr_image(octray::render_packet(reloaded), {}, {}));
+    EXPECT_EQ(octray::read_image((dir / "moved.exr").string()).planes,
+              octray::read_image(expected_path.string()).planes);
+    server.stop();
+    fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// The page's switches: spp, max depth, order (and threads) re-render the current camera,
+// and the refined picture is then `octray render`'s of the scene with those values.
+TEST_F(ViewServerTest, SwitchesReRenderWithTheNewValues) {
+    ASSERT_FALSE(
+        wait_for_frame([&](const json& f) { return f["spp"] == scene_.image.spp; }).is_null());
+    for (const std::string& body :
+         {std::string(R"({"spp": 0})"), std::string(R"({"spp": 1.5})"),
+          std::string(R"({"max_depth": 0})"), std::string(R"({"max_depth": 65})"),
+          std::string(R"({"threads": -1})"), std::string(R"({"order": "spiral"})"),
+          std::string(R"({"order": 1})"), std::string(R"({"depth": 2})"), std::string("[]"),
+          std::string("nope")}) {
+        const auto result =
+            client_->Post(with_token("/api/settings"), body, "application/json");
+        ASSERT_TRUE(result) << body;
+        EXPECT_EQ(result->status, 400) << body << " -> " << result->body;
+    }
+    EXPECT_EQ(status()["settings"]["spp"], scene_.image.spp);
+    for (const char* order : {"rows", "frameless", "tiled"}) {
+        const std::string body =
+            std::string(R"({"spp": 2, "max_depth": 2, "threads": 1, "order": ")") + order +
+            "\"}";
+        const auto result =
+            client_->Post(with_token("/api/settings"), body, "application/json");
+        ASSERT_TRUE(result);
+        ASSERT_EQ(result->status, 200) << result->body;
+        const json s = status();
+        EXPECT_EQ(s["settings"]["order"], order);
+        EXPECT_EQ(s["settings"]["spp"], 2);
+        EXPECT_EQ(s["settings"]["max_depth"], 2);
+        EXPECT_EQ(s["settings"]["threads"], 1);
+        ASSERT_FALSE(wait_for_frame([](const json& f) {
+                         return f["target_spp"] == 2 && f["spp"] == 2 && f["coverage"] == 1.0 &&
+                                !f["preview"].get<bool>();
+                     }).is_null());
+        Scene expected = scene_;
+        expected.image.spp = 2;
+        expected.render.max_depth = 2;
+        // Wait until the picture is of the switched scene (the old one had target 4).
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        std::string got;
+        const std::string want = rendered_bytes(expected);
+        while (std::chrono::steady_clock::now() < deadline) {
+            const auto bytes = client_->Get(with_token("/api/image.f32"));
+            ASSERT_TRUE(bytes);
+            got = bytes->body;
+            if (got == want) break;
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        EXPECT_TRUE(got == want) << order << ": the refined picture is not render's";
+    }
 }
 
 }  // namespace
