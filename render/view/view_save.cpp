@@ -1,0 +1,149 @@
+#include "render/view/view_save.h"
+
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <string_view>
+
+#include "render/batch/digest.h"
+#include "render/batch/frame_loop.h"
+#include "render/batch/result_exr.h"
+#include "render/image/image_io.h"
+#include "render/view/http_error.h"
+#include "scene/load.h"
+
+namespace octray::view {
+namespace {
+
+using nlohmann::json;
+
+// A file name for POST /api/save: letters, digits, '.', '_', '-', '+' only (so no '/',
+// no space, nothing a shell would read), not starting with '.' or '-', no "..", ending
+// in .exr.
+void check_save_name(const std::string& name) {
+    const auto bad = [&](const std::string& why) {
+        return BadRequest(400, "save: file name \"" + name + "\" " + why +
+                                   " (a plain name such as view.exr, written in the "
+                                   "directory octray view was started in)");
+    };
+    if (name.empty() || name.size() > 200) throw bad("must have 1 to 200 characters");
+    if (name.find('/') != std::string::npos || name.find("..") != std::string::npos)
+        throw bad("must not contain '/' or '..'");
+    for (const char c : name) {
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-' &&
+            c != '+')
+            throw bad("may only hold letters, digits, '.', '_', '-' and '+'");
+    }
+    if (name[0] == '.' || name[0] == '-') throw bad("must not start with '.' or '-'");
+    std::string lower = name;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower.size() < 5 || lower.compare(lower.size() - 4, 4, ".exr") != 0)
+        throw bad("must end in .exr");
+}
+
+// `text` as one shell word: as it is when it holds only safe characters, else quoted.
+std::string shell_word(const std::string& text) {
+    bool safe = !text.empty();
+    for (const char c : text) {
+        if (!std::isalnum(static_cast<unsigned char>(c)) &&
+            std::string_view("._-+/:=,").find(c) == std::string_view::npos)
+            safe = false;
+    }
+    if (safe) return text;
+    std::string quoted = "'";
+    for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
+bool same_camera(const Camera& a, const Camera& b) {
+    const auto same = [](const Vec3& u, const Vec3& v) {
+        return u.x == v.x && u.y == v.y && u.z == v.z;
+    };
+    return same(a.eye, b.eye) && same(a.lookat, b.lookat) && same(a.up, b.up) && a.fov == b.fov;
+}
+
+}  // namespace
+
+// POST /api/save: the refined picture as `octray render` writes it (render/view/README.md).
+nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
+                         const std::string& body) {
+    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    if (request.is_discarded() || !request.is_object() || !request.contains("name") ||
+        !request["name"].is_string())
+        throw BadRequest(400, "save: expected {\"name\": \"view.exr\", \"overwrite\": false}");
+    bool overwrite = false;
+    for (const auto& [key, value] : request.items()) {
+        if (key == "overwrite") {
+            if (!value.is_boolean())
+                throw BadRequest(400, "save.overwrite: expected true or false");
+            overwrite = value.get<bool>();
+        } else if (key != "name") {
+            throw BadRequest(400,
+                             "save: unknown key \"" + key + "\" (expected name, overwrite)");
+        }
+    }
+    const std::string name = request["name"].get<std::string>();
+    check_save_name(name);
+    const auto frame = session.latest();
+    Scene posed = session.scene();
+    if (!frame || frame->preview || frame->spp < frame->target_spp ||
+        frame->target_spp != posed.image.spp || frame->max_depth != posed.render.max_depth)
+        throw BadRequest(409, "save: the picture is still refining; save once it has all " +
+                                  std::to_string(posed.image.spp) + " spp");
+    if (frame->rays.total() == 0)
+        throw BadRequest(409, "save: needs the tiled order (frameless pictures are not saved)");
+    namespace fs = std::filesystem;
+    const fs::path directory(settings.directory);
+    const auto refuse_existing = [&](const std::string& file) {
+        if (!overwrite && fs::exists(directory / file))
+            throw BadRequest(
+                409, "save: " + file + " exists; ask to overwrite it (\"overwrite\": true)");
+    };
+    refuse_existing(name);
+
+    const Camera scene_camera = posed.camera;
+    posed.camera = frame->camera;
+    batch::BatchScene identity;
+    identity.spec = settings.spec;
+    identity.sha256 = settings.sha256;
+    identity.scene = posed;
+    // A moved camera is a new scene: written beside the image as JSON (`octray scene`'s
+    // writer), named in the header and the command line instead of the original.
+    const bool moved = !same_camera(frame->camera, scene_camera);
+    std::string scene_file;
+    if (moved) {
+        scene_file = name.substr(0, name.size() - 4) + ".json";
+        refuse_existing(scene_file);
+        const std::string text = scene_to_json(posed);
+        write_file_atomically((directory / scene_file).string(), [&](const std::string& tmp) {
+            std::ofstream out(tmp, std::ios::binary);
+            out << text;
+            out.close();
+            if (!out) throw IoError("cannot write " + tmp);
+        });
+        identity.spec = scene_file;
+        identity.sha256 = batch::sha256_hex(text);
+    }
+    RenderResult result;
+    result.image = frame->image;
+    result.rect = PixelRect{0, 0, frame->image.width(), frame->image.height()};
+    result.full_width = frame->image.width();
+    result.full_height = frame->image.height();
+    result.rays = frame->rays;
+    result.seconds = frame->render_seconds;
+    const ExrAttributes attributes = batch::render_exr_attributes(
+        identity, posed, 0, result, settings.path_label, posed.image.spp, std::string());
+    write_exr((directory / name).string(),
+              make_exr_image(result, ExrWriteOptions{}, attributes));
+
+    std::string command =
+        "octray render " + shell_word(identity.spec) + " --width " +
+        std::to_string(posed.image.width) + " --height " + std::to_string(posed.image.height) +
+        " --spp " + std::to_string(posed.image.spp) + " --max-depth " +
+        std::to_string(posed.render.max_depth) + settings.render_arguments + " -o " + name;
+    json answer{{"file", name}, {"command", command}, {"camera_moved", moved}};
+    answer["scene_file"] = moved ? json(scene_file) : json(nullptr);
+    return answer;
+}
+
+}  // namespace octray::view
