@@ -34,6 +34,20 @@ double mrays_per_second(const RenderResult& result) {
                : 0.0;
 }
 
+// The options of a render of `width` pixels across: the threads asked for, the cancel
+// flag, and for the rows order one tile per row (row-major order).
+RenderOptions render_options(const ViewSettings& settings, int width,
+                             const std::atomic<bool>* cancel) {
+    RenderOptions options;
+    options.threads = settings.threads;
+    options.cancel = cancel;
+    if (settings.order == PixelOrder::rows) {
+        options.tile_width = width;
+        options.tile_height = 1;
+    }
+    return options;
+}
+
 }  // namespace
 
 ViewSession::ViewSession(Scene scene, ViewSettings settings)
@@ -312,13 +326,7 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
     scene.image.width = std::max(1, (scene_.image.width + d - 1) / d);
     scene.image.height = std::max(1, (scene_.image.height + d - 1) / d);
     scene.image.spp = 1;
-    RenderOptions options;
-    options.threads = settings_.threads;
-    options.cancel = &cancel_;
-    if (settings_.order == PixelOrder::rows) {
-        options.tile_width = scene.image.width;  // one tile a row: row-major order
-        options.tile_height = 1;
-    }
+    RenderOptions options = render_options(settings_, scene.image.width, &cancel_);
     const auto start = Clock::now();
     RenderResult result = settings_.path == RenderPath::simd
                               ? render_packet(scene, options, settings_.isa)
@@ -339,13 +347,7 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
 bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
     Scene scene = scene_;
     scene.camera = camera;
-    RenderOptions options;
-    options.threads = settings_.threads;
-    options.cancel = &cancel_;
-    if (settings_.order == PixelOrder::rows) {
-        options.tile_width = scene.image.width;  // one tile a row: row-major order
-        options.tile_height = 1;
-    }
+    RenderOptions options = render_options(settings_, scene.image.width, &cancel_);
     const auto start = Clock::now();
     // The SIMD path compiles the scene once for all passes of this camera.
     std::optional<CompiledScene> compiled;

@@ -19,6 +19,7 @@
 #include "render/view/view_session.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
+#include "view_fixtures.h"
 
 namespace {
 
@@ -28,18 +29,7 @@ using octray::view::ServerOptions;
 using octray::view::ViewServer;
 using octray::view::ViewSession;
 using octray::view::ViewSettings;
-
-Scene small_whitted() {
-    Scene scene = octray::make_builtin_scene("whitted");
-    scene.image.width = 64;
-    scene.image.height = 36;
-    scene.image.spp = 4;
-    return scene;
-}
-
-}  // namespace
-
-namespace {
+using octray::view::test::small_whitted;
 
 // POST /api/save writes the refined picture as `octray render` writes the same scene and
 // spp (same pixels, same header attributes), in the save directory only, refusing names

@@ -29,6 +29,7 @@
 #include "render/view/view_session.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
+#include "view_fixtures.h"
 
 namespace {
 
@@ -38,14 +39,7 @@ using octray::view::ServerOptions;
 using octray::view::ViewServer;
 using octray::view::ViewSession;
 using octray::view::ViewSettings;
-
-Scene small_whitted() {
-    Scene scene = octray::make_builtin_scene("whitted");
-    scene.image.width = 64;
-    scene.image.height = 36;
-    scene.image.spp = 4;
-    return scene;
-}
+using octray::view::test::small_whitted;
 
 // The raw bytes of render_packet's image of `scene`: what /api/image.f32 must return.
 std::string rendered_bytes(const Scene& scene) {
