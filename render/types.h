@@ -28,6 +28,12 @@ inline std::optional<RenderPath> parse_render_path(std::string_view name) {
     return std::nullopt;
 }
 
+// The most samples per pixel and worker threads a render takes from its user: `octray
+// render --spp/--threads`, `octray view`'s switches (tools/cli_checks.h builds the options'
+// checks and help from these).
+inline constexpr int kMaxSamplesPerPixel = 1 << 20;
+inline constexpr int kMaxRenderThreads = 4096;
+
 struct RayCounts {
     std::uint64_t primary = 0;
     std::uint64_t shadow = 0;

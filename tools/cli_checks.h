@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "core/pixel_rect.h"
+#include "render/types.h"
 
 namespace CLI {
 class App;
@@ -32,11 +33,11 @@ std::optional<std::uint64_t> parse_decimal_integer(std::string_view text);
 
 // Limits of integer options that more than one command shares; each option's help text
 // and its check are both made from them (integer_range_text, decimal_integer).
-inline constexpr std::uint64_t kMaxImageSide = 65536;                // --width, --height
-inline constexpr std::uint64_t kMaxSamples = 1u << 20;               // --spp
-inline constexpr std::uint64_t kMaxThreadCount = 4096;               // --threads
-inline constexpr std::uint64_t kMaxTileSide = octray::kMaxTileSide;  // --tile WxH
-inline constexpr std::uint64_t kMaxShardCount = 1u << 20;            // --shard-count
+inline constexpr std::uint64_t kMaxImageSide = 65536;                      // --width, --height
+inline constexpr std::uint64_t kMaxSamples = octray::kMaxSamplesPerPixel;  // --spp
+inline constexpr std::uint64_t kMaxThreadCount = octray::kMaxRenderThreads;  // --threads
+inline constexpr std::uint64_t kMaxTileSide = octray::kMaxTileSide;          // --tile WxH
+inline constexpr std::uint64_t kMaxShardCount = 1u << 20;                    // --shard-count
 // An upper limit that only says "fits an int": the range reads as open (">= lo").
 inline constexpr std::uint64_t kNoIntegerLimit = 2147483647;
 

@@ -36,10 +36,6 @@ using nlohmann::json;
 // server a tab has closed, so the stream's worker thread is back within about this long.
 constexpr std::chrono::milliseconds kHeartbeat{250};
 
-// The page's switches take what `octray view --threads` and `--spp` take.
-constexpr int kMaxSwitchThreads = 4096;
-constexpr int kMaxSwitchSpp = 1 << 20;
-
 json vec3_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 
 json frame_json(const ViewFrame& frame) {
@@ -371,9 +367,9 @@ void ViewServer::Impl::scene_routes() {
         };
         for (const auto& [key, value] : request.items()) {
             if (key == "threads") {
-                switches.threads = integer(value, key, 0, kMaxSwitchThreads);
+                switches.threads = integer(value, key, 0, kMaxRenderThreads);
             } else if (key == "spp") {
-                switches.spp = integer(value, key, 1, kMaxSwitchSpp);
+                switches.spp = integer(value, key, 1, kMaxSamplesPerPixel);
             } else if (key == "max_depth") {
                 switches.max_depth = integer(value, key, 1, kMaxDepthLimit);
             } else if (key == "order") {
