@@ -235,8 +235,11 @@ void choose_simd_configs(const BenchRun& run, BenchScene& bs) {
                 bs.simd_configs.begin(), bs.simd_configs.end(),
                 [&](const SimdConfig& c) { return c.bvh == use_bvh && c.lanes == l; });
             if (seen) continue;
+            const std::uint32_t secondary =
+                o.packet_lanes_for_secondary ? l : kBvhSecondaryLanesAuto;
             bs.simd_configs.push_back(
-                {use_bvh, l, use_bvh ? make_scene_view(compiled, bs.bvh, l) : bs.view, accel});
+                {use_bvh, l,
+                 use_bvh ? make_scene_view(compiled, bs.bvh, l, secondary) : bs.view, accel});
         }
     }
 }
@@ -371,7 +374,10 @@ void measure_octray_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun
                 row.mode = "packet8";
                 row.isa = isa_name(isa);
                 row.accel = config.bvh ? "bvh" : "none";
-                row.packet_min_lanes = config.lanes;
+                // The lanes rule the rays were traced under (secondary rays: their own).
+                row.packet_min_lanes = config.bvh && rs.workload == Workload::secondary
+                                           ? config.view.bvh_secondary_min_lanes
+                                           : config.lanes;
                 measure_ray_set(
                     run, rs, std::move(row),
                     detail::octray_simd_tracer(run.arena, kernel_table(isa), config.view),

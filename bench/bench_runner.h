@@ -42,6 +42,9 @@ struct BenchOptions {
     // and, with a BVH, the live lanes below which a packet goes on ray by ray.
     std::vector<Accel> accels{Accel::automatic};
     std::vector<std::uint32_t> packet_lanes{kBvhPacketMinLanes};
+    // Whether packet_lanes also holds for secondary rays; if not (the default), they follow
+    // the renderer's rule (kBvhSecondaryRayByRayMinSpheres: single rays in large BVHs).
+    bool packet_lanes_for_secondary = false;
     // Brute force (accel none) is skipped on scenes with more spheres than this: on 10^6
     // spheres a frame of it would take hours.
     std::uint32_t brute_force_max_spheres = 1u << 14;

@@ -151,7 +151,8 @@ kernels::SceneView make_scene_view(const CompiledScene& c) {
 }
 
 kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& bvh,
-                                   std::uint32_t packet_min_lanes) {
+                                   std::uint32_t packet_min_lanes,
+                                   std::uint32_t secondary_min_lanes) {
     kernels::SceneView v = make_scene_view(scene);
     if (bvh.nodes.empty()) return v;
     v.bvh_nodes = bvh.nodes.data();
@@ -159,6 +160,10 @@ kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& 
     v.bvh_r2 = bvh.r2.data(), v.bvh_object = bvh.object.data();
     for (int a = 0; a < 3; ++a) v.bvh_lo[a] = bvh.lo[a], v.bvh_hi[a] = bvh.hi[a];
     v.bvh_packet_min_lanes = packet_min_lanes;
+    v.bvh_secondary_min_lanes =
+        secondary_min_lanes != kBvhSecondaryLanesAuto            ? secondary_min_lanes
+        : scene.spheres.count >= kBvhSecondaryRayByRayMinSpheres ? kernels::kPacketWidth + 1
+                                                                 : packet_min_lanes;
     v.bvh_shadow_sort_min_spheres = kBvhShadowSortMinSpheres;
     return v;
 }

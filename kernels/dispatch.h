@@ -57,9 +57,19 @@ inline constexpr std::uint32_t kBvhPacketMinLanes = 2;
 // (measured: docs/performance-log.md, "BVH: millions of spheres against Embree").
 inline constexpr std::uint32_t kBvhShadowSortMinSpheres = 32768;
 
+// From this many spheres on, secondary rays go ray by ray through the BVH from the root:
+// their packets hold rays from different tiny spheres heading anywhere, and single rays
+// are faster (measured: docs/performance-log.md, "Secondary rays ray by ray").
+inline constexpr std::uint32_t kBvhSecondaryRayByRayMinSpheres = 131072;
+
+// secondary_min_lanes: pick by the scene's size (kBvhSecondaryRayByRayMinSpheres).
+inline constexpr std::uint32_t kBvhSecondaryLanesAuto = ~0u;
+
 // The same with the spheres' BVH built from `scene` (kernels/bvh_build.h); both must outlive
-// the view. An empty BVH (no spheres) leaves the view brute force.
+// the view. An empty BVH (no spheres) leaves the view brute force. `packet_min_lanes` for
+// primary and shadow rays, `secondary_min_lanes` for secondary rays (SceneView).
 kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& bvh,
-                                   std::uint32_t packet_min_lanes = kBvhPacketMinLanes);
+                                   std::uint32_t packet_min_lanes = kBvhPacketMinLanes,
+                                   std::uint32_t secondary_min_lanes = kBvhSecondaryLanesAuto);
 
 }  // namespace octray

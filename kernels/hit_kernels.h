@@ -26,9 +26,13 @@ inline std::uint32_t live_bits(std::uint32_t base, std::uint32_t count) {
 }
 
 template <class Arch>
-void closest_hit(const SceneView& s, const RayStream& rays, std::uint32_t count, float t_min,
-                 const HitStream& hits) {
-    if (s.bvh_nodes == nullptr) return closest_hit_all<Arch>(s, rays, count, t_min, hits);
+void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t count,
+                 float t_min, const HitStream& hits) {
+    if (scene.bvh_nodes == nullptr)
+        return closest_hit_all<Arch>(scene, rays, count, t_min, hits);
+    // Secondary rays switch to single rays by their own rule (SceneView).
+    SceneView s = scene;
+    if (t_min == 0.0f) s.bvh_packet_min_lanes = s.bvh_secondary_min_lanes;
     using F = xsimd::batch<float, Arch>;
     constexpr std::uint32_t W = F::size;
     BvhPacket p;

@@ -20,7 +20,8 @@ struct KernelTable {
     std::uint32_t (*camera_rays)(const SceneView& scene, const CameraSamples& samples,
                                  std::uint32_t count, const RayStream& out);
 
-    // Closest hit on (t_min, inf) for `count` rays.
+    // Closest hit on (t_min, inf) for `count` rays: primary rays with t_min = ε_s,
+    // secondary rays with t_min = 0 (SceneView::bvh_secondary_min_lanes).
     void (*closest_hit)(const SceneView& scene, const RayStream& rays, std::uint32_t count,
                         float t_min, const HitStream& hits);
 

@@ -80,6 +80,11 @@ struct SceneView {
     // A packet with fewer live lanes than this goes on ray by ray (single-ray traversal);
     // 0 or 1: packets all the way, 9: single rays only.
     std::uint32_t bvh_packet_min_lanes;
+    // The same for secondary rays (closest_hit with t_min 0: reflected and refracted rays,
+    // which start on surfaces at any depth and spread). 9 in large BVHs, where neighbouring
+    // pixels' secondary rays leave different tiny spheres in unrelated directions and share
+    // too few nodes for a packet to pay (kernels/dispatch.h).
+    std::uint32_t bvh_secondary_min_lanes;
     // Shadow rays are regrouped by origin and direction before tracing (hit_kernels.h,
     // any_hit) in BVHs of at least this many spheres.
     std::uint32_t bvh_shadow_sort_min_spheres;

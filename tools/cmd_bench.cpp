@@ -156,7 +156,10 @@ void run_bench_command(const BenchArguments& a) {
     o.isas = parse_list<Isa>(a.isas, "--isa", parse_isa, o.isas);
     o.paths = parse_list<RenderPath>(a.paths, "--path", parse_render_path, o.paths);
     o.accels = parse_list<Accel>(a.accels, "--accel", parse_accel, o.accels);
-    if (!a.packet_lanes.empty()) o.packet_lanes = a.packet_lanes;
+    if (!a.packet_lanes.empty()) {
+        o.packet_lanes = a.packet_lanes;
+        o.packet_lanes_for_secondary = true;
+    }
     for (Isa isa : o.isas)
         if (!isa_supported(isa))
             throw UsageError(std::string("--isa ") + isa_name(isa) +
@@ -278,8 +281,10 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option("--packet-lanes", a->packet_lanes,
                     "With the BVH: packets with fewer live lanes go on ray by ray, each " +
                         integer_range_text(0, kMaxPacketLanes) + "; 0 packets only, " +
-                        std::to_string(kMaxPacketLanes) + " single rays only [default: " +
-                        std::to_string(kBvhPacketMinLanes) + "]")
+                        std::to_string(kMaxPacketLanes) +
+                        " single rays only [default: " + std::to_string(kBvhPacketMinLanes) +
+                        "; secondary rays " + std::to_string(kMaxPacketLanes) + " from " +
+                        std::to_string(kBvhSecondaryRayByRayMinSpheres) + " spheres on]")
         ->delimiter(',')
         ->type_name("LIST")
         ->transform(decimal_integer(0, kMaxPacketLanes));

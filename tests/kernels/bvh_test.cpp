@@ -309,6 +309,27 @@ TEST(SphereBvh, LeavesAreSmallPartsOfTheRoot) {
     EXPECT_LT(leaf_areas / leaves / root, 0.05);
 }
 
+// Secondary rays go ray by ray from kBvhSecondaryRayByRayMinSpheres spheres on, unless
+// told otherwise; smaller scenes and the other rays follow packet_min_lanes.
+TEST(SphereBvh, SecondaryRaysGoRayByRayInLargeScenes) {
+    for (const std::uint32_t count :
+         {kBvhSecondaryRayByRayMinSpheres - 1, kBvhSecondaryRayByRayMinSpheres}) {
+        std::vector<Object> o;
+        for (std::uint32_t i = 0; i < count; ++i)
+            o.push_back(sphere({static_cast<float>(i % 64), static_cast<float>(i / 64 % 64),
+                                static_cast<float>(i / 4096)},
+                               0.25f));
+        const CompiledScene c = compile_scene(scene_of(o));
+        const SphereBvh bvh = build_sphere_bvh(c.spheres);
+        const bool large = count >= kBvhSecondaryRayByRayMinSpheres;
+        EXPECT_EQ(make_scene_view(c, bvh, 3).bvh_packet_min_lanes, 3u);
+        EXPECT_EQ(make_scene_view(c, bvh, 3).bvh_secondary_min_lanes,
+                  large ? kPacketWidth + 1 : 3u)
+            << count << " spheres";
+        EXPECT_EQ(make_scene_view(c, bvh, 3, 5).bvh_secondary_min_lanes, 5u);
+    }
+}
+
 TEST(SphereBvh, NoSpheresNoTree) {
     const CompiledScene c = compile_scene(scene_of({plane({0, 0, 0}, {0, 1, 0})}));
     const SphereBvh bvh = build_sphere_bvh(c.spheres);
@@ -511,10 +532,17 @@ class BvhTraversalTest : public ::testing::Test {
         const auto n = static_cast<std::uint32_t>(rays.size() - 3);
         RaySoA soa(rays);
         int mismatches = 0;
-        for (const float t_min : {0.0f, 1e-3f}) {
+        // Secondary rays (t_min 0) by the same rule as the others, and ray by ray as in
+        // large BVHs (SceneView::bvh_secondary_min_lanes).
+        for (const auto& [t_min, secondary] :
+             {std::pair{0.0f, packet_min_lanes}, std::pair{0.0f, kPacketWidth + 1},
+              std::pair{1e-3f, packet_min_lanes}}) {
+            SCOPED_TRACE("secondary rays' min lanes " + std::to_string(secondary));
+            kernels::SceneView v = view;
+            v.bvh_secondary_min_lanes = secondary;
             AlignedVector<float> t(padded(n), -7.0f), t0(padded(n), -7.0f);
             AlignedVector<std::int32_t> id(padded(n), -7);
-            k.closest_hit(view, soa.stream(), n, t_min, {t.data(), id.data()});
+            k.closest_hit(v, soa.stream(), n, t_min, {t.data(), id.data()});
             for (std::uint32_t i = 0; i < n && mismatches < 10; ++i) {
                 Ray r = rays[i];
                 r.t_min = t_min;
