@@ -1,5 +1,5 @@
 // The scalar build of the user-geometry sphere callbacks (bench/embree_user_spheres.h),
-// and the run-time choice between it and the AVX2 build.
+// and the run-time choice between it and the AVX2 and AVX-512 builds.
 
 #include "bench/embree_user_spheres.h"
 
@@ -81,7 +81,14 @@ const EmbreeSphereCallbacks& embree_sphere_callbacks() {
                                                     scalar::occlude_spheres, "scalar"};
     static const EmbreeSphereCallbacks avx2_build{avx2::intersect_spheres,
                                                   avx2::occlude_spheres, "avx2"};
-    return isa_supported(Isa::avx2) ? avx2_build : scalar_build;
+    static const EmbreeSphereCallbacks avx512_build{avx512::intersect_spheres,
+                                                    avx512::occlude_spheres, "avx512"};
+    // libgcc's CPU model counts AVX-512 only where the OS saves the ZMM state (XCR0).
+    const bool avx512 = isa_supported(Isa::avx2) && __builtin_cpu_supports("avx512f") &&
+                        __builtin_cpu_supports("avx512vl") &&
+                        __builtin_cpu_supports("avx512bw") &&
+                        __builtin_cpu_supports("avx512dq");
+    return avx512 ? avx512_build : isa_supported(Isa::avx2) ? avx2_build : scalar_build;
 }
 
 }  // namespace octray::bench

@@ -5,10 +5,11 @@
 // rendering model's robust sphere form (render/README.md). Embree then builds a BVH of
 // objects (BVH8<object> on AVX2) and calls the callbacks from its packet traversal.
 //
-// The callbacks come in two builds, picked at run time like octray's kernels: AVX2 + FMA
-// (8 lanes of xsimd at a time, in embree_user_spheres_avx2.cpp, compiled with those flags)
-// and plain C++ one lane at a time for CPUs without AVX2. Only embree_baseline.cpp uses
-// this header.
+// The callbacks come in three builds, picked at run time like octray's kernels: AVX-512
+// (16 lanes of xsimd at a time, embree_user_spheres_avx512.cpp), AVX2 + FMA (8 lanes,
+// embree_user_spheres_avx2.cpp), both one body (embree_user_spheres_simd.h) compiled with
+// their flags, and plain C++ one lane at a time for CPUs without AVX2. Only
+// embree_baseline.cpp uses this header.
 
 #include <embree3/rtcore.h>
 
@@ -25,13 +26,13 @@ struct EmbreeSphereData {
 struct EmbreeSphereCallbacks {
     RTCIntersectFunctionN intersect;
     RTCOccludedFunctionN occluded;
-    const char* name;  // "avx2" or "scalar"
+    const char* name;  // "avx512", "avx2" or "scalar"
 };
 
 // The best build this CPU runs.
 const EmbreeSphereCallbacks& embree_sphere_callbacks();
 
-// The two builds (the AVX2 one hands packets narrower than 8 to the scalar one).
+// The builds: each hands packets narrower than its width to the next narrower one.
 namespace scalar {
 void intersect_spheres(const RTCIntersectFunctionNArguments* args);
 void occlude_spheres(const RTCOccludedFunctionNArguments* args);
@@ -40,5 +41,9 @@ namespace avx2 {
 void intersect_spheres(const RTCIntersectFunctionNArguments* args);
 void occlude_spheres(const RTCOccludedFunctionNArguments* args);
 }  // namespace avx2
+namespace avx512 {
+void intersect_spheres(const RTCIntersectFunctionNArguments* args);
+void occlude_spheres(const RTCOccludedFunctionNArguments* args);
+}  // namespace avx512
 
 }  // namespace octray::bench
