@@ -3,6 +3,7 @@
 // is read; the cameras flip the row index when turning a pixel into a ray.
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "core/aligned.h"
@@ -27,6 +28,21 @@ class Image {
         : width_(width),
           height_(height),
           pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {}
+
+    // A width x height image with undefined pixels in the storage of `spare` (left empty),
+    // where it holds exactly that many pixels: a frame loop hands back the frame it has
+    // written, and the next frame then touches no freshly mapped pages. Fresh storage
+    // otherwise.
+    static Image reuse(Image&& spare, int width, int height) {
+        Image image;
+        const std::size_t n =
+            static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+        if (spare.pixels_.size() != n) return Image(width, height, Uninitialized{});
+        image.width_ = width, image.height_ = height;
+        image.pixels_ = std::move(spare.pixels_);
+        spare = Image();
+        return image;
+    }
 
     int width() const { return width_; }
     int height() const { return height_; }

@@ -503,7 +503,10 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     result.full_width = scene.width;
     result.full_height = scene.height;
     // Every pixel of the rectangle is written by its tile.
-    result.image = Image(rect.width(), rect.height(), Image::Uninitialized{});
+    result.image =
+        options.spare_image != nullptr
+            ? Image::reuse(std::move(*options.spare_image), rect.width(), rect.height())
+            : Image(rect.width(), rect.height(), Image::Uninitialized{});
     RenderTarget target{result.image, rect, sample_range};
     if (options.samples) {
         result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});

@@ -324,7 +324,10 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
     result.full_width = scene.image.width;
     result.full_height = scene.image.height;
     // Every pixel of the rectangle is written by its tile.
-    result.image = Image(rect.width(), rect.height(), Image::Uninitialized{});
+    result.image =
+        options.spare_image != nullptr
+            ? Image::reuse(std::move(*options.spare_image), rect.width(), rect.height())
+            : Image(rect.width(), rect.height(), Image::Uninitialized{});
     if (partial_samples)
         result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});
     tbb::combinable<RayCounts> counts;

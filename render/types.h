@@ -66,6 +66,10 @@ struct RenderOptions {
     // finished tile's pixel count to *pixels_done (progress).
     const std::atomic<bool>* cancel = nullptr;
     std::atomic<std::uint64_t>* pixels_done = nullptr;
+    // A spent image whose storage the render may take for its own (Image::reuse: when
+    // the pixel counts agree; it is left empty then). The frame loop hands back each frame
+    // it has written, so a batch maps its frame's pages once, not once per frame.
+    Image* spare_image = nullptr;
     // Render only these pixels of the full image (render/README.md, "Crops"): the result
     // image is crop-sized and each pixel equals the same pixel of the full render bit for
     // bit. Must be non-empty and inside the image (else std::invalid_argument).

@@ -77,14 +77,19 @@ class BatchRunner {
     ExrAttributes attributes(const BatchScene& scene, const Scene& posed, int frame,
                              const RenderResult& result, int samples_so_far) const;
     void write_outputs(const BatchScene& scene, const BatchJob& job, const Scene& posed,
-                       const RenderResult& result, const AovImages& aovs,
-                       int samples_so_far) const;
+                       const RenderResult& result, const AovImages& aovs, int samples_so_far);
 
     const std::vector<BatchScene>& scenes_;
     const BatchSettings& settings_;
     BatchObserver& observer_;
     const std::atomic<bool>* cancel_;
     std::string owner_;  // octray.owner of this run's unfinished passes
+    // The last frame written: the next frame renders into its storage (RenderOptions::
+    // spare_image), so only a run's first frame maps fresh pages for its pixels.
+    Image spare_frame_;
+    // The channels of the last EXR written, converted into again by the next (the same
+    // reason: make_exr_image's `spare`).
+    std::vector<ExrChannel> spare_channels_;
 };
 
 }  // namespace
@@ -139,17 +144,19 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
 
 void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job,
                                 const Scene& posed, const RenderResult& result,
-                                const AovImages& aovs, int samples_so_far) const {
+                                const AovImages& aovs, int samples_so_far) {
     if (settings_.png_output) {
         write_png_preview(job.output, result.image);
         return;
     }
     ExrImage exr = make_exr_image(result, settings_.exr,
-                                  attributes(scene, posed, job.frame, result, samples_so_far));
+                                  attributes(scene, posed, job.frame, result, samples_so_far),
+                                  std::move(spare_channels_));
     if (aovs.set.any())
         append_aov_channels(exr, aovs,
                             settings_.exr.float32 ? ExrPixelType::float32 : ExrPixelType::half);
     write_exr(job.output, exr);
+    spare_channels_ = std::move(exr.channels);
     if (!job.png.empty()) write_png_preview(job.png, result.image);
 }
 
@@ -243,6 +250,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         options.cancel = cancel_;
         options.pixels_done = observer_.pixel_counter();
         options.crop = scene.crop;
+        options.spare_image = &spare_frame_;
         // Writing (EXR and PNG encoding) is timed apart from tracing: the frame line and
         // the summary report each, and the rate is rays over trace time alone.
         const auto trace_started = Clock::now();
@@ -269,6 +277,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         out.report.trace_seconds =
             std::chrono::duration<double>(Clock::now() - trace_started).count() - write_seconds;
         timed_write(result, posed.image.spp);
+        spare_frame_ = std::move(result.image);
         out.report.write_seconds = write_seconds;
         out.report.load_seconds = scene.load_seconds;
         out.report.compile_seconds = result.compile_seconds;

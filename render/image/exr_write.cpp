@@ -284,10 +284,12 @@ std::uint32_t ExrChannel::uint_value(std::size_t k) const {
 }
 
 ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* values,
-                            std::size_t count, std::size_t stride) {
+                            std::size_t count, std::size_t stride,
+                            std::vector<unsigned char> storage) {
     if (type == ExrPixelType::uint32)
         throw std::invalid_argument("make_exr_channel: floats make half or float channels");
-    ExrChannel c{std::move(name), type, std::vector<unsigned char>(count * sample_size(type))};
+    storage.resize(count * sample_size(type));  // every byte is written below
+    ExrChannel c{std::move(name), type, std::move(storage)};
     unsigned char* out = c.samples.data();
     for (std::size_t k = 0; k < count; ++k) {
         const float v = values[k * stride];
@@ -333,7 +335,7 @@ ExrRational exr_rational(double value) {
 
 ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
                         int full_height, const ExrWriteOptions& options,
-                        const ExrAttributes& attributes) {
+                        const ExrAttributes& attributes, std::vector<ExrChannel> spare) {
     if (image.width() != data_window.width() || image.height() != data_window.height())
         throw std::invalid_argument("make_exr_image: a " + std::to_string(image.width()) + "x" +
                                     std::to_string(image.height()) +
@@ -347,9 +349,12 @@ ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_widt
     const ExrPixelType type = options.float32 ? ExrPixelType::float32 : ExrPixelType::half;
     const float* rgb = reinterpret_cast<const float*>(image.data());
     const std::size_t n = image.pixel_count();
-    exr.channels.push_back(make_exr_channel("R", type, rgb + 0, n, 3));
-    exr.channels.push_back(make_exr_channel("G", type, rgb + 1, n, 3));
-    exr.channels.push_back(make_exr_channel("B", type, rgb + 2, n, 3));
+    const auto storage = [&spare](std::size_t k) {
+        return k < spare.size() ? std::move(spare[k].samples) : std::vector<unsigned char>();
+    };
+    exr.channels.push_back(make_exr_channel("R", type, rgb + 0, n, 3, storage(0)));
+    exr.channels.push_back(make_exr_channel("G", type, rgb + 1, n, 3, storage(1)));
+    exr.channels.push_back(make_exr_channel("B", type, rgb + 2, n, 3, storage(2)));
     return exr;
 }
 

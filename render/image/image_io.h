@@ -114,9 +114,12 @@ struct ExrChannel {
 };
 
 // A half or float32 channel from `count` floats at `values`, `stride` floats apart
-// (half rounds to nearest even, as OpenEXR's half does).
+// (half rounds to nearest even, as OpenEXR's half does). Its samples go into `storage`
+// (a written frame's, handed on): storage of the right size is neither zeroed nor mapped
+// afresh.
 ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* values,
-                            std::size_t count, std::size_t stride = 1);
+                            std::size_t count, std::size_t stride = 1,
+                            std::vector<unsigned char> storage = {});
 // A uint32 channel.
 ExrChannel make_exr_channel(std::string name, const std::vector<std::uint32_t>& values);
 
@@ -137,9 +140,12 @@ struct ExrImage {
 // R, G, B channels (half, or float32 with options.float32) of `image`; the data window is
 // `data_window` (the image's size) inside a display window of (0, 0)-(full_width,
 // full_height). Throws std::invalid_argument if the sizes disagree.
+// `spare`: channels of an image already written, whose storage R, G and B take in turn
+// (make_exr_channel), so that a frame loop converts each frame into the same memory.
 ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
                         int full_height, const ExrWriteOptions& options,
-                        const ExrAttributes& attributes = {});
+                        const ExrAttributes& attributes = {},
+                        std::vector<ExrChannel> spare = {});
 // (A render's make_exr_image(RenderResult, ...) is in render/batch/result_exr.h.)
 
 // Writes `image` as a scanline OpenEXR file, atomically. Throws IoError naming the path

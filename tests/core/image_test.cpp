@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <utility>
 
 #include "core/aligned.h"
 
@@ -24,6 +25,23 @@ TEST(Image, NonSquareDimensionsAreKeptApart) {
     EXPECT_EQ(img.width(), 4);
     EXPECT_EQ(img.height(), 2);
     EXPECT_EQ(img.data()[3], Rgb(7.0f));  // (3, 0) is in the first row, not (0, 3)
+}
+
+// A batch renders each frame into the last one's storage (RenderOptions::spare_image).
+TEST(Image, ReuseTakesTheSparesStorageOnlyWhenThePixelCountsAgree) {
+    Image spare(6, 4);
+    const Rgb* storage = spare.data();
+    const Image taken = Image::reuse(std::move(spare), 8, 3);  // 24 pixels either way
+    EXPECT_EQ(taken.data(), storage);
+    EXPECT_EQ(taken.width(), 8);
+    EXPECT_EQ(taken.height(), 3);
+    EXPECT_EQ(spare.pixel_count(), 0u);  // NOLINT(bugprone-use-after-move): left empty
+
+    Image other(5, 5);
+    const Image fresh = Image::reuse(std::move(other), 8, 3);
+    EXPECT_EQ(fresh.pixel_count(), 24u);
+    EXPECT_EQ(fresh.width(), 8);
+    EXPECT_EQ(other.pixel_count(), 25u);  // NOLINT(bugprone-use-after-move): untouched
 }
 
 TEST(AlignedVector, StorageIsSixtyFourByteAligned) {

@@ -64,13 +64,14 @@ class ImageIoTest : public ::testing::Test {
 
 // A smooth HDR image (lossy codecs are built for such content) whose rows and columns are
 // all distinguishable: red grows to the right, green downwards, blue goes above 1.
-Image gradient_image(int width, int height) {
+Image gradient_image(int width, int height, float scale = 1.0f) {
     Image image(width, height);
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
-            image.at(x, y) = Rgb(0.05f + 0.9f * static_cast<float>(x) / width,
-                                 0.05f + 0.9f * static_cast<float>(y) / height,
-                                 1.0f + 3.0f * static_cast<float>(x + y) / (width + height));
+            image.at(x, y) =
+                Rgb(scale * (0.05f + 0.9f * static_cast<float>(x) / width),
+                    scale * (0.05f + 0.9f * static_cast<float>(y) / height),
+                    scale * (1.0f + 3.0f * static_cast<float>(x + y) / (width + height)));
     return image;
 }
 
@@ -144,6 +145,35 @@ TEST(ExrCompressionNames, RoundTripEveryName) {
     EXPECT_FALSE(parse_exr_compression("ZIP").has_value());
     EXPECT_FALSE(parse_exr_compression("zip ").has_value());
     EXPECT_FALSE(parse_exr_compression("jpeg").has_value());
+}
+
+// A frame loop converts each frame into the last one's channels (make_exr_image's spare):
+// the same storage, and values as from fresh storage, half or float, larger or smaller.
+TEST(ExrChannels, SpareStorageIsTakenAndFullyOverwritten) {
+    const Image first = gradient_image(9, 5), second = gradient_image(9, 5, 0.5f);
+    for (const bool float32 : {false, true}) {
+        SCOPED_TRACE(float32 ? "float" : "half");
+        const ExrWriteOptions options{float32, ExrCompression::zip};
+        ExrImage a = make_exr_image(first, PixelRect{0, 0, 9, 5}, 9, 9, options);
+        std::vector<const unsigned char*> storage;
+        for (const ExrChannel& c : a.channels) storage.push_back(c.samples.data());
+        const ExrImage fresh = make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options);
+        const ExrImage reused = make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options, {},
+                                               std::move(a.channels));
+        ASSERT_EQ(reused.channels.size(), 3u);
+        for (std::size_t k = 0; k < 3; ++k) {
+            EXPECT_EQ(reused.channels[k].samples.data(), storage[k]);
+            EXPECT_EQ(reused.channels[k].name, fresh.channels[k].name);
+            EXPECT_EQ(reused.channels[k].samples, fresh.channels[k].samples);
+        }
+    }
+    // Spare channels of another size are resized: the values are still the image's.
+    const ExrImage small =
+        make_exr_image(gradient_image(2, 2), PixelRect{0, 0, 2, 2}, 2, 2, {});
+    const ExrImage big = make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}, {},
+                                        std::vector<ExrChannel>(small.channels));
+    EXPECT_EQ(big.channels[0].samples,
+              make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}).channels[0].samples);
 }
 
 TEST_F(ImageIoTest, ExrRoundTripsEveryCompressionHalfAndFloat) {
