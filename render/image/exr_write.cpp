@@ -26,6 +26,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "render/image/half_bits.h"
 #include "render/image/image_io.h"
 
 namespace octray {
@@ -291,14 +292,14 @@ ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* va
     storage.resize(count * sample_size(type));  // every byte is written below
     ExrChannel c{std::move(name), type, std::move(storage)};
     unsigned char* out = c.samples.data();
+    if (type == ExrPixelType::half) {
+        // The samples are bytes; std::vector's storage is aligned for any scalar type.
+        floats_to_half_bits(values, count, stride, reinterpret_cast<std::uint16_t*>(out));
+        return c;
+    }
     for (std::size_t k = 0; k < count; ++k) {
         const float v = values[k * stride];
-        if (type == ExrPixelType::half) {
-            const std::uint16_t bits = half(v).bits();
-            std::memcpy(out + 2 * k, &bits, sizeof bits);
-        } else {
-            std::memcpy(out + 4 * k, &v, sizeof v);
-        }
+        std::memcpy(out + 4 * k, &v, sizeof v);
     }
     return c;
 }
