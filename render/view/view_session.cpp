@@ -1,8 +1,5 @@
 #include "render/view/view_session.h"
 
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -235,7 +232,8 @@ void ViewSession::run() {
 // Frameless: one framebuffer, re-rendered a batch of blocks at a time in the permutation
 // of frameless_blocks, continuing where the last camera left off (the oldest pixels are
 // renewed first); each batch is published at once. A camera that stays still is rendered
-// once over (a full sweep), which is then exactly the tiled order's picture.
+// once over (a full sweep), which is then exactly the tiled order's picture. The SIMD path
+// compiles the scene and builds its BVH once (PreparedScene); a new camera only re-aims it.
 void ViewSession::run_frameless() {
     const int width = scene_.image.width, height = scene_.image.height;
     const std::vector<PixelRect> blocks =
@@ -243,14 +241,16 @@ void ViewSession::run_frameless() {
     // About 16 pictures a sweep, of at least 16 blocks each (enough work for the threads).
     const std::size_t batch_size = std::max<std::size_t>(16, blocks.size() / 16);
     Image framebuffer(width, height);
+    std::vector<PixelRect> batch;
     std::size_t cursor = 0;             // next block of the permutation
     std::size_t fresh = blocks.size();  // blocks rendered with the current camera
     std::uint64_t version = 0;
-    Scene scene = scene_;
-    std::optional<CompiledScene> compiled;
+    std::optional<Scene> scalar;  // the scalar path's scene, with the current camera
+    if (settings_.path == RenderPath::scalar) scalar = scene_;
+    std::optional<PreparedScene> prepared;
+    RenderOptions options;
+    options.threads = settings_.threads;
     Clock::time_point camera_start;
-    std::optional<tbb::task_arena> arena;
-    if (settings_.threads > 0) arena.emplace(settings_.threads);
 
     std::unique_lock lock(mutex_);
     while (!stop_ && !restart_) {
@@ -265,33 +265,24 @@ void ViewSession::run_frameless() {
         lock.unlock();
         try {
             if (new_camera) {
-                scene.camera = camera;
-                if (settings_.path == RenderPath::simd) compiled.emplace(compile_scene(scene));
+                if (settings_.path == RenderPath::simd) {
+                    if (!prepared)
+                        prepared.emplace(scene_, Accel::automatic, settings_.threads);
+                    prepared->set_camera(camera);
+                } else {
+                    scalar->camera = camera;
+                }
                 fresh = 0;
                 camera_start = Clock::now();
             }
             const std::size_t count = std::min(batch_size, blocks.size() - fresh);
-            std::atomic<std::uint64_t> rays{0};
-            const auto start = Clock::now();
-            const auto render_batch = [&] {
-                tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
-                    const PixelRect& rect = blocks[(cursor + i) % blocks.size()];
-                    RenderOptions options;
-                    options.crop = rect;
-                    const RenderResult result =
-                        compiled ? render_packet(*compiled, options, settings_.isa)
-                                 : render_reference(scene, options);
-                    for (int y = 0; y < rect.height(); ++y)
-                        for (int x = 0; x < rect.width(); ++x)
-                            framebuffer.at(rect.x0 + x, rect.y0 + y) = result.image.at(x, y);
-                    rays += result.rays.total();
-                });
-            };
-            if (arena) {
-                arena->execute(render_batch);
-            } else {
-                render_batch();
-            }
+            batch.clear();
+            for (std::size_t i = 0; i < count; ++i)
+                batch.push_back(blocks[(cursor + i) % blocks.size()]);
+            const RenderResult result =
+                prepared ? render_packet_blocks(*prepared, batch, framebuffer, options,
+                                                settings_.isa)
+                         : render_reference_blocks(*scalar, batch, framebuffer, options);
             cursor = (cursor + count) % blocks.size();
             fresh += count;
             ViewFrame frame;
@@ -300,12 +291,9 @@ void ViewSession::run_frameless() {
             frame.camera = camera;
             frame.spp = scene_.image.spp;
             frame.target_spp = scene_.image.spp;
-            frame.pass_seconds = seconds_since(start);
+            frame.pass_seconds = result.seconds;
             frame.frame_seconds = seconds_since(camera_start);
-            frame.mrays_per_second =
-                frame.pass_seconds > 0.0
-                    ? static_cast<double>(rays.load()) / frame.pass_seconds / 1e6
-                    : 0.0;
+            frame.mrays_per_second = mrays_per_second(result);
             frame.coverage = static_cast<double>(fresh) / static_cast<double>(blocks.size());
             publish(std::move(frame));
         } catch (const std::exception& e) {
