@@ -5,11 +5,13 @@
 #include <fstream>
 #include <string_view>
 
+#include "kernels/dispatch.h"
 #include "render/batch/digest.h"
 #include "render/batch/frame_loop.h"
 #include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/view/http_error.h"
+#include "render/view/view_switches.h"
 #include "scene/load.h"
 
 namespace octray::view {
@@ -132,15 +134,20 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
     result.rays = frame->rays;
     result.seconds = frame->render_seconds;
     const ExrAttributes attributes = batch::render_exr_attributes(
-        identity, posed, 0, result, settings.path_label, posed.image.spp, std::string());
+        identity, posed, 0, result, path_label(frame->path, frame->isa), posed.image.spp,
+        std::string());
     write_exr((directory / name).string(),
               make_exr_image(result, ExrWriteOptions{}, attributes));
 
-    std::string command =
-        "octray render " + shell_word(identity.spec) + " --width " +
-        std::to_string(posed.image.width) + " --height " + std::to_string(posed.image.height) +
-        " --spp " + std::to_string(posed.image.spp) + " --max-depth " +
-        std::to_string(posed.render.max_depth) + settings.render_arguments + " -o " + name;
+    std::string command = "octray render " + shell_word(identity.spec) + " --width " +
+                          std::to_string(posed.image.width) + " --height " +
+                          std::to_string(posed.image.height) + " --spp " +
+                          std::to_string(posed.image.spp) + " --max-depth " +
+                          std::to_string(posed.render.max_depth);
+    if (frame->path == RenderPath::scalar) command += " --path scalar";
+    if (frame->path == RenderPath::simd && frame->isa != Isa::automatic)
+        command += std::string(" --isa ") + isa_name(frame->isa);
+    command += " -o " + name;
     json answer{{"file", name}, {"command", command}, {"camera_moved", moved}};
     answer["scene_file"] = moved ? json(scene_file) : json(nullptr);
     return answer;

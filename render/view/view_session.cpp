@@ -5,9 +5,11 @@
 #include <cmath>
 #include <exception>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
+#include "kernels/dispatch.h"
 #include "render/batch/progressive.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
@@ -29,20 +31,6 @@ double mrays_per_second(const RenderResult& result) {
     return result.seconds > 0.0
                ? static_cast<double>(result.rays.total()) / result.seconds / 1e6
                : 0.0;
-}
-
-// The options of a render of `width` pixels across: the threads asked for, the cancel
-// flag, and for the rows order one tile per row (row-major order).
-RenderOptions render_options(const ViewSettings& settings, int width,
-                             const std::atomic<bool>* cancel) {
-    RenderOptions options;
-    options.threads = settings.threads;
-    options.cancel = cancel;
-    if (settings.order == PixelOrder::rows) {
-        options.tile_width = width;
-        options.tile_height = 1;
-    }
-    return options;
 }
 
 }  // namespace
@@ -80,34 +68,62 @@ Scene ViewSession::scene() const {
 RenderSwitches ViewSession::switches() const {
     std::lock_guard lock(mutex_);
     return RenderSwitches{settings_.threads, scene_.image.spp, scene_.render.max_depth,
-                          settings_.order};
+                          settings_.order,   settings_.path,   settings_.isa};
 }
 
-void ViewSession::reconfigure(const RenderSwitches& switches) {
+RenderOptions ViewSession::render_options(int width) const {
+    RenderOptions options;
+    options.threads = settings_.threads;
+    options.cancel = &cancel_;
+    if (settings_.order == PixelOrder::rows) {
+        options.tile_width = width;
+        options.tile_height = 1;
+    }
+    return options;
+}
+
+// A picture of camera `version` with what the switches say of how it is made.
+ViewFrame ViewSession::frame_of(std::uint64_t version, const Camera& camera) const {
+    ViewFrame frame;
+    frame.camera_version = version;
+    frame.camera = camera;
+    frame.target_spp = scene_.image.spp;
+    frame.max_depth = scene_.render.max_depth;
+    frame.path = settings_.path;
+    frame.isa = settings_.isa;
+    return frame;
+}
+
+std::uint64_t ViewSession::reconfigure(const RenderSwitches& switches) {
     std::lock_guard guard(reconfigure_mutex_);
+    if (switches.path == RenderPath::simd) resolve_isa(switches.isa);  // throws: no change
     Scene next = scene();
     next.image.spp = switches.spp;
     next.render.max_depth = switches.max_depth;
     validate_scene(next);  // throws SceneError: nothing changes
     {
         std::lock_guard lock(mutex_);
-        if (stop_) return;
+        if (stop_) return camera_version_;
         restart_ = true;
         cancel_ = true;
     }
     changed_.notify_all();
     if (thread_.joinable()) thread_.join();
+    std::uint64_t version = 0;
     {
         std::lock_guard lock(mutex_);
         scene_ = std::move(next);
         settings_.threads = switches.threads;
         settings_.order = switches.order;
+        settings_.path = switches.path;
+        settings_.isa = switches.isa;
         restart_ = false;
         cancel_ = false;
-        ++camera_version_;  // the current camera again, under the new switches
+        version = ++camera_version_;  // the current camera again, under the new switches
         moving_ = false;
     }
     thread_ = std::thread([this] { run(); });
+    return version;
 }
 
 void ViewSession::stop() {
@@ -285,12 +301,9 @@ void ViewSession::run_frameless() {
                          : render_reference_blocks(*scalar, batch, framebuffer, options);
             cursor = (cursor + count) % blocks.size();
             fresh += count;
-            ViewFrame frame;
+            ViewFrame frame = frame_of(version, camera);
             frame.image = framebuffer;
-            frame.camera_version = version;
-            frame.camera = camera;
             frame.spp = scene_.image.spp;
-            frame.target_spp = scene_.image.spp;
             frame.pass_seconds = result.seconds;
             frame.frame_seconds = seconds_since(camera_start);
             frame.mrays_per_second = mrays_per_second(result);
@@ -314,18 +327,15 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
     scene.image.width = std::max(1, (scene_.image.width + d - 1) / d);
     scene.image.height = std::max(1, (scene_.image.height + d - 1) / d);
     scene.image.spp = 1;
-    RenderOptions options = render_options(settings_, scene.image.width, &cancel_);
+    const RenderOptions options = render_options(scene.image.width);
     const auto start = Clock::now();
     RenderResult result = settings_.path == RenderPath::simd
                               ? render_packet(scene, options, settings_.isa)
                               : render_reference(scene, options);
-    ViewFrame frame;
+    ViewFrame frame = frame_of(version, camera);
     frame.image = std::move(result.image);
-    frame.camera_version = version;
-    frame.camera = camera;
     frame.preview = true;
     frame.spp = 1;
-    frame.target_spp = scene_.image.spp;
     frame.pass_seconds = result.seconds;
     frame.frame_seconds = seconds_since(start);
     frame.mrays_per_second = mrays_per_second(result);
@@ -335,7 +345,7 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
 bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
     Scene scene = scene_;
     scene.camera = camera;
-    RenderOptions options = render_options(settings_, scene.image.width, &cancel_);
+    const RenderOptions options = render_options(scene.image.width);
     const auto start = Clock::now();
     // The SIMD path compiles the scene once for all passes of this camera.
     std::optional<CompiledScene> compiled;
@@ -349,15 +359,11 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
     const batch::PassCallback on_pass = [&](const RenderResult& so_far, int samples_so_far) {
         rays += so_far.rays;
         render_seconds += so_far.seconds;
-        ViewFrame frame;
+        ViewFrame frame = frame_of(version, camera);
         frame.rays = rays;
         frame.render_seconds = render_seconds;
         frame.image = so_far.image;
-        frame.camera_version = version;
-        frame.camera = camera;
         frame.spp = samples_so_far;
-        frame.target_spp = scene.image.spp;
-        frame.max_depth = scene.render.max_depth;
         frame.pass_seconds = so_far.seconds;
         frame.frame_seconds = seconds_since(start);
         frame.mrays_per_second = mrays_per_second(so_far);

@@ -6,7 +6,8 @@
 Starts `octray view` on a free port, opens the URL it prints, and checks that the page
 shows the refined picture (the canvas has non-black pixels and says spp 4), that a drag
 across the canvas orbits the camera (the server reports a new camera at the same distance
-from the same look-at point, and the canvas changes), that the wheel dollies, that
+from the same look-at point, and the canvas changes), that the wheel dollies, that the
+switches reach the server (spp, path; the ISA selector offers the server's list), that
 the frameless order converges to the same picture as the tiled one, that
 `octray view A.exr B.exr` shows compare's verdict, the heatmap and the value under the
 cursor, that the server refuses the page
@@ -265,6 +266,18 @@ def check_save(browser, octray, WebDriverWait):
                 "document.body.dataset.spp === '2';"))
             if fetch_status(url)["settings"]["spp"] != 2:
                 return fail("the spp switch did not reach the server")
+            # The ISA selector offers what the server says this CPU runs; the path switch
+            # reaches the server.
+            offered = browser.execute_script(
+                "return [...document.getElementById('isa').options].map(o => o.value);")
+            if offered != fetch_status(url)["isas"]:
+                return fail(f"the page offers the ISAs {offered}, the server "
+                            f"{fetch_status(url)['isas']}")
+            browser.execute_script(
+                "const path = document.getElementById('path'); path.value = 'scalar';"
+                "path.dispatchEvent(new Event('change'));")
+            WebDriverWait(browser, WAIT).until(
+                lambda b: fetch_status(url)["settings"]["path"] == "scalar")
         finally:
             process.send_signal(signal.SIGINT)
             process.communicate(timeout=60)
@@ -273,7 +286,8 @@ def check_save(browser, octray, WebDriverWait):
             return fail(f"save showed the command {command!r}")
         if not os.path.exists(os.path.join(folder, "saved.exr")):
             return fail("save did not write saved.exr in the viewer's directory")
-    print(f"PASS: save wrote saved.exr and showed {command}; the spp switch re-rendered")
+    print(f"PASS: save wrote saved.exr and showed {command}; the spp switch re-rendered; "
+          "the page offers the server's ISAs and switches the path")
     return 0
 
 
