@@ -25,7 +25,6 @@
 #include "render/view/view_bench.h"
 #include "render/view/view_server.h"
 #include "render/view/view_session.h"
-#include "scene/animation.h"
 #include "scene/load.h"
 #include "scene/max_depth.h"
 #include "tools/cli_checks.h"
@@ -159,12 +158,8 @@ void run_view(const ViewArguments& args) {
     if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
     const std::string spec = args.inputs.empty() ? std::string("whitted") : args.inputs[0];
     // The digest names the scene in the header of a saved picture, as in `octray render`'s.
+    // An animation is shown at frame 0; the page's slider poses the others.
     auto [scene, sha256] = batch::load_scene_and_digest(spec, args.threads);
-    // An animation shows its first frame; the viewer has no time line yet.
-    if (scene.animation) {
-        scene = scene_at_frame(scene, 0);
-        scene.animation.reset();
-    }
     if (args.width > 0) scene.image.width = args.width;
     if (args.height > 0) scene.image.height = args.height;
     if (args.spp > 0) scene.image.spp = args.spp;
@@ -289,7 +284,7 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
         "(--preview-divisor) until it stops. The mouse shows the linear RGB value under it.\n"
         "The page switches threads, spp, max depth, the order, the path and the ISA\n"
-        "(those this CPU runs) while it runs.\n"
+        "(those this CPU runs) while it runs, and an animated scene's frame (a slider).\n"
         "Save writes the refined picture as octray render writes it, to a file name in the\n"
         "current directory, and shows the octray render command line that makes it.\n"
         "Nothing but the scene (or the two images) named here is served.\n\n"

@@ -52,6 +52,7 @@ json frame_json(const ViewFrame& frame) {
         {"frame_seconds", frame.frame_seconds},
         {"mrays_per_second", frame.mrays_per_second},
         {"coverage", frame.coverage},
+        {"animation_frame", frame.animation_frame},
         {"path", path_label(frame.path, frame.isa)},
         {"camera",
          {{"eye", vec3_json(camera.eye)},
@@ -268,7 +269,11 @@ void ViewServer::Impl::scene_routes() {
                     {"full_width", scene.image.width},
                     {"full_height", scene.image.height},
                     {"settings", switches_json(session.switches())},
-                    {"isas", isa_choices(switch_limits(session))}};
+                    {"isas", isa_choices(switch_limits(session))},
+                    {"animation", nullptr}};
+        if (session.frame_count() > 1)
+            status["animation"] = {{"frames", session.frame_count()},
+                                   {"fps", session.frames_per_second()}};
         if (const auto frame = session.latest()) status["frame"] = frame_json(*frame);
         if (const std::string error = session.error(); !error.empty()) status["error"] = error;
         res.set_content(status.dump(), "application/json");

@@ -14,6 +14,7 @@
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "render/view/frameless.h"
+#include "scene/animation.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 #include "scene/scene_error.h"
@@ -33,10 +34,27 @@ double mrays_per_second(const RenderResult& result) {
                : 0.0;
 }
 
+// `source` posed at `frame` (a still scene is its own pose), with the spp and max depth of
+// the switches.
+Scene posed_scene(const Scene& source, int frame, int spp, int max_depth) {
+    Scene posed = source.animation ? scene_at_frame(source, frame) : source;
+    posed.image.spp = spp;
+    posed.render.max_depth = max_depth;
+    return posed;
+}
+
 }  // namespace
 
 ViewSession::ViewSession(Scene scene, ViewSettings settings)
-    : scene_(std::move(scene)), settings_(settings), camera_(scene_.camera) {
+    : animated_(scene.animation ? std::optional<Scene>(scene) : std::nullopt),
+      frame_count_(scene.animation ? scene.animation->frames : 1),
+      fps_(scene.animation ? scene.animation->fps : kStillFps),
+      scene_(animated_ ? posed_scene(*animated_, settings.frame, scene.image.spp,
+                                     scene.render.max_depth)
+                       : std::move(scene)),
+      settings_(settings),
+      camera_(scene_.camera) {
+    if (!animated_) settings_.frame = 0;
     thread_ = std::thread([this] { run(); });
 }
 
@@ -68,13 +86,15 @@ Scene ViewSession::scene() const {
 RenderSwitches ViewSession::switches() const {
     std::lock_guard lock(mutex_);
     return RenderSwitches{settings_.threads, scene_.image.spp, scene_.render.max_depth,
-                          settings_.order,   settings_.path,   settings_.isa};
+                          settings_.order,   settings_.path,   settings_.isa,
+                          settings_.frame};
 }
 
 RenderOptions ViewSession::render_options(int width) const {
     RenderOptions options;
     options.threads = settings_.threads;
     options.cancel = &cancel_;
+    options.frame = static_cast<std::uint32_t>(settings_.frame);
     if (settings_.order == PixelOrder::rows) {
         options.tile_width = width;
         options.tile_height = 1;
@@ -89,6 +109,7 @@ ViewFrame ViewSession::frame_of(std::uint64_t version, const Camera& camera) con
     frame.camera = camera;
     frame.target_spp = scene_.image.spp;
     frame.max_depth = scene_.render.max_depth;
+    frame.animation_frame = settings_.frame;
     frame.path = settings_.path;
     frame.isa = settings_.isa;
     return frame;
@@ -96,11 +117,19 @@ ViewFrame ViewSession::frame_of(std::uint64_t version, const Camera& camera) con
 
 std::uint64_t ViewSession::reconfigure(const RenderSwitches& switches) {
     std::lock_guard guard(reconfigure_mutex_);
+    if (switches.frame < 0 || switches.frame >= frame_count_)
+        throw std::out_of_range("frame " + std::to_string(switches.frame) +
+                                " is outside the animation's frames 0 to " +
+                                std::to_string(frame_count_ - 1));
     if (switches.path == RenderPath::simd) resolve_isa(switches.isa);  // throws: no change
-    Scene next = scene();
-    next.image.spp = switches.spp;
-    next.render.max_depth = switches.max_depth;
+    // Only this function changes scene_, and only from here on: reading it needs no lock.
+    Scene next = animated_
+                     ? posed_scene(*animated_, switches.frame, switches.spp, switches.max_depth)
+                     : posed_scene(scene_, 0, switches.spp, switches.max_depth);
     validate_scene(next);  // throws SceneError: nothing changes
+    // A new frame of an animated camera shows that frame's camera.
+    const bool frame_camera =
+        animated_ && !animated_->animation->camera.empty() && switches.frame != settings_.frame;
     {
         std::lock_guard lock(mutex_);
         if (stop_) return camera_version_;
@@ -112,11 +141,13 @@ std::uint64_t ViewSession::reconfigure(const RenderSwitches& switches) {
     std::uint64_t version = 0;
     {
         std::lock_guard lock(mutex_);
+        if (frame_camera) camera_ = next.camera;
         scene_ = std::move(next);
         settings_.threads = switches.threads;
         settings_.order = switches.order;
         settings_.path = switches.path;
         settings_.isa = switches.isa;
+        settings_.frame = switches.frame;
         restart_ = false;
         cancel_ = false;
         version = ++camera_version_;  // the current camera again, under the new switches
@@ -266,6 +297,7 @@ void ViewSession::run_frameless() {
     std::optional<PreparedScene> prepared;
     RenderOptions options;
     options.threads = settings_.threads;
+    options.frame = static_cast<std::uint32_t>(settings_.frame);
     Clock::time_point camera_start;
 
     std::unique_lock lock(mutex_);

@@ -45,8 +45,7 @@ Isa isa_from(const json& value, const SwitchLimits& limits) {
 }  // namespace
 
 SwitchLimits switch_limits(const ViewSession& session) {
-    (void)session;  // every session runs on this CPU
-    return SwitchLimits{supported_isas()};
+    return SwitchLimits{supported_isas(), session.frame_count()};
 }
 
 std::vector<std::string> isa_choices(const SwitchLimits& limits) {
@@ -84,10 +83,15 @@ RenderSwitches parse_switches(const std::string& body, RenderSwitches switches,
             switches.path = *path;
         } else if (key == "isa") {
             switches.isa = isa_from(value, limits);
+        } else if (key == "frame") {
+            if (limits.frames <= 1 && value.is_number_integer() && value.get<long long>() != 0)
+                throw BadRequest(400,
+                                 "settings.frame: the scene is not animated (frame 0 only)");
+            switches.frame = integer(value, key, 0, std::max(1, limits.frames) - 1);
         } else {
-            throw BadRequest(400,
-                             "settings: unknown key \"" + key +
-                                 "\" (expected threads, spp, max_depth, order, path, isa)");
+            throw BadRequest(400, "settings: unknown key \"" + key +
+                                      "\" (expected threads, spp, max_depth, order, path, isa, "
+                                      "frame)");
         }
     }
     return switches;
@@ -106,7 +110,8 @@ json switches_json(const RenderSwitches& switches) {
                 {"max_depth", switches.max_depth},
                 {"order", to_string(switches.order)},
                 {"path", render_path_name(switches.path)},
-                {"isa", isa_name(switches.isa)}};
+                {"isa", isa_name(switches.isa)},
+                {"frame", switches.frame}};
 }
 
 }  // namespace octray::view

@@ -1,7 +1,8 @@
-// The page's path and ISA switches (render/view/view_switches.h): the parsing and its
-// refusals on their own (an ISA the CPU lacks, with a CPU that lacks one made up), then
+// The page's path, ISA and frame switches (render/view/view_switches.h): the parsing and
+// its refusals on their own (an ISA the CPU lacks, with a CPU that lacks one made up), then
 // through a real client against a session: the scalar path and a forced ISA render the
-// picture `octray render --path/--isa` makes.
+// picture `octray render --path/--isa` makes, and an animated scene's frame is rendered,
+// shown (tiled and frameless) and saved as `octray render --frames N` renders it.
 
 #include "render/view/view_switches.h"
 
@@ -26,6 +27,7 @@
 #include "render/view/http_error.h"
 #include "render/view/view_server.h"
 #include "render/view/view_session.h"
+#include "scene/animation.h"
 #include "scene/load.h"
 #include "view_fixtures.h"
 
@@ -75,6 +77,22 @@ TEST(ViewSwitches, PathAndIsaAreParsedAndChecked) {
         EXPECT_EQ(refusal(body, limits).first, 400) << body;
 }
 
+TEST(ViewSwitches, TheFrameIsParsedAndChecked) {
+    const SwitchLimits limits{{Isa::sse2}, 48};
+    const RenderSwitches s = parse_switches(R"({"frame": 47})", {}, limits);
+    EXPECT_EQ(s.frame, 47);
+    EXPECT_EQ(parse_switches(R"({"spp": 2})", s, limits).frame, 47)
+        << "an absent key keeps its value";
+    EXPECT_EQ(parse_switches(R"({"frame": 0})", {}, SwitchLimits{{Isa::sse2}, 1}).frame, 0);
+    EXPECT_EQ(refusal(R"({"frame": 48})", limits).second,
+              "settings.frame: expected an integer in [0, 47]");
+    EXPECT_EQ(refusal(R"({"frame": 2})", SwitchLimits{{Isa::sse2}, 1}).second,
+              "settings.frame: the scene is not animated (frame 0 only)");
+    for (const char* body :
+         {R"({"frame": -1})", R"({"frame": 1.5})", R"({"frame": "3"})", R"({"frame": null})"})
+        EXPECT_EQ(refusal(body, limits).first, 400) << body;
+}
+
 // The status's choices are this CPU's: "auto" and every ISA it runs, nothing it lacks.
 TEST(ViewSwitches, TheChoicesAreTheIsasThisCpuRuns) {
     const std::vector<std::string> choices =
@@ -86,6 +104,26 @@ TEST(ViewSwitches, TheChoicesAreTheIsasThisCpuRuns) {
             std::find(choices.begin(), choices.end(), octray::isa_name(isa)) != choices.end();
         EXPECT_EQ(listed, octray::isa_supported(isa)) << octray::isa_name(isa);
     }
+}
+
+// small_whitted animated over 5 frames: the camera moves, and so does the glass sphere.
+Scene animated_whitted() {
+    Scene scene = octray::view::test::small_whitted();
+    octray::Animation animation;
+    animation.frames = 5;
+    animation.fps = 10.0;
+    animation.camera.push_back({0, scene.camera.eye, {}, {}, {}});
+    animation.camera.push_back(
+        {4, scene.camera.eye + octray::Vec3{1.0f, 0.5f, 0.0f}, {}, {}, {}});
+    std::uint32_t sphere = 0;
+    while (scene.objects[sphere].type != octray::ObjectType::sphere) ++sphere;
+    scene.objects[sphere].name = "ball";
+    const octray::Vec3 c = scene.objects[sphere].center;
+    animation.objects.push_back(
+        {"ball", sphere, {{0, c, {}}, {4, c + octray::Vec3{0.6f, 0.4f, 0.0f}, {}}}});
+    scene.animation = animation;
+    octray::validate_scene(scene);
+    return scene;
 }
 
 std::string bytes_of(const octray::Image& image) {
@@ -171,6 +209,8 @@ TEST_F(SwitchesTest, PathAndIsaSwitchesRenderWithThem) {
     EXPECT_EQ(first["settings"]["path"], "simd");
     EXPECT_EQ(first["settings"]["isa"], "auto");
     EXPECT_EQ(first["isas"], json(octray::view::isa_choices({octray::supported_isas()})));
+    EXPECT_TRUE(first["animation"].is_null());
+    EXPECT_EQ(first["settings"]["frame"], 0);
 
     // The simd and scalar paths give the same bits: the picture's path tells them apart.
     const std::string want = bytes_of(octray::render_reference(scene).image);
@@ -201,6 +241,62 @@ TEST_F(SwitchesTest, PathAndIsaSwitchesRenderWithThem) {
         ASSERT_TRUE(result);
         EXPECT_EQ(result->status, 400) << body;
     }
+}
+
+// An animated scene: the status gives the frame range; a frame switch renders that frame
+// as `octray render --frames N` does (the frame's pose and its sample hash), in both
+// orders, and save writes it with --frames N in the command.
+TEST_F(SwitchesTest, TheFrameSwitchRendersAndSavesThatFrame) {
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("octray_view_frame_" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const Scene scene = animated_whitted();
+    start(scene, octray::view::PixelOrder::tiled, dir.string());
+    const json s = status();
+    EXPECT_EQ(s["animation"], (json{{"frames", 5}, {"fps", 10.0}}));
+    EXPECT_EQ(s["settings"]["frame"], 0);
+
+    octray::RenderOptions at3;
+    at3.frame = 3;
+    const Scene posed = octray::scene_at_frame(scene, 3);
+    const std::string want = bytes_of(octray::render_packet(posed, at3).image);
+    EXPECT_FALSE(want == bytes_of(octray::render_packet(posed).image))
+        << "the sample hash of frame 3 must differ from frame 0's";
+    const auto [shown, shown_bytes] = switch_to(R"({"frame": 3})");
+    EXPECT_TRUE(shown_bytes == want);
+    EXPECT_EQ(shown["animation_frame"], 3);
+    EXPECT_EQ(shown["camera"]["eye"][0], posed.camera.eye.x) << "the frame's camera";
+
+    // Saved: the same pixels, and the command line that renders them names the frame.
+    // (The refined picture is in: saving needs no retry.)
+    const auto result = post("/api/save", R"({"name": "f3.exr"})");
+    ASSERT_TRUE(result);
+    ASSERT_EQ(result->status, 200) << result->body;
+    const json answer = json::parse(result->body);
+    EXPECT_EQ(answer["camera_moved"], false);
+    EXPECT_NE(answer["command"].get<std::string>().find(" --frames 3 -o f3.exr"),
+              std::string::npos)
+        << answer["command"];
+    octray::write_exr((dir / "expected.exr").string(),
+                      octray::make_exr_image(octray::render_packet(posed, at3), {}, {}));
+    EXPECT_EQ(octray::read_image((dir / "f3.exr").string()).planes,
+              octray::read_image((dir / "expected.exr").string()).planes);
+
+    // Frameless converges to the same frame; a frame out of range changes nothing.
+    const auto [frameless, frameless_bytes] = switch_to(R"({"order": "frameless"})");
+    EXPECT_EQ(status()["settings"]["frame"], 3);
+    EXPECT_EQ(frameless["animation_frame"], 3);
+    EXPECT_TRUE(frameless_bytes == want);
+    for (const char* body : {R"({"frame": 5})", R"({"frame": -1})", R"({"frame": "2"})"}) {
+        const auto refused = post("/api/settings", body);
+        ASSERT_TRUE(refused);
+        EXPECT_EQ(refused->status, 400) << body;
+    }
+    EXPECT_EQ(status()["settings"]["frame"], 3);
+    server_->stop();
+    fs::remove_all(dir);
 }
 
 }  // namespace
