@@ -14,16 +14,13 @@
 #include <utility>
 #include <vector>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "core/aligned.h"
 #include "core/random.h"
 #include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/crop.h"
 #include "render/parallel.h"
+#include "render/stream_row.h"
 #include "render/tile_layout.h"
 #include "scene/camera.h"
 
@@ -234,49 +231,6 @@ void resolve_into_parents(const kernels::SurfaceColor& c, const kernels::ChildLi
     }
 }
 
-// Writes n pixels (r, g, b) / divisor. A frame's image is far larger than the caches and
-// each pixel is written once: with SSE2 the aligned groups of four pixels go straight to
-// memory (non-temporal stores), so the CPU does not first read every line of the image
-// only to overwrite it. Division is IEEE-exact either way (the same bits as the scalar
-// r / divisor), and skipped for a divisor of 1, where x / 1 == x.
-void stream_row(Rgb* out, const float* r, const float* g, const float* b, int n,
-                float divisor) {
-    const bool divide = divisor != 1.0f;
-    const auto pixel = [&](int x) {
-        const Rgb sum(r[x], g[x], b[x]);
-        return divide ? sum / divisor : sum;
-    };
-    int x = 0;
-#if defined(__SSE2__)
-    // Four pixels are 48 bytes: aligned groups start where the address is 16-aligned.
-    for (; x < n && (reinterpret_cast<std::uintptr_t>(out + x) & 15u) != 0; ++x)
-        out[x] = pixel(x);
-    const __m128 d = _mm_set1_ps(divisor);
-    for (; x + 4 <= n; x += 4) {
-        __m128 vr = _mm_loadu_ps(r + x), vg = _mm_loadu_ps(g + x), vb = _mm_loadu_ps(b + x);
-        if (divide) vr = _mm_div_ps(vr, d), vg = _mm_div_ps(vg, d), vb = _mm_div_ps(vb, d);
-        // (r0 g0 b0 r1) (g1 b1 r2 g2) (b2 r3 g3 b3)
-        const __m128 rg_lo = _mm_unpacklo_ps(vr, vg), rg_hi = _mm_unpackhi_ps(vr, vg);
-        const __m128 b0r1 = _mm_shuffle_ps(vb, vr, _MM_SHUFFLE(1, 1, 0, 0));
-        const __m128 g1b1 = _mm_shuffle_ps(vg, vb, _MM_SHUFFLE(1, 1, 1, 1));
-        const __m128 b2r3 = _mm_shuffle_ps(vb, vr, _MM_SHUFFLE(3, 3, 2, 2));
-        const __m128 g3b3 = _mm_shuffle_ps(vg, vb, _MM_SHUFFLE(3, 3, 3, 3));
-        float* dst = &out[x].r;
-        _mm_stream_ps(dst, _mm_shuffle_ps(rg_lo, b0r1, _MM_SHUFFLE(2, 0, 1, 0)));
-        _mm_stream_ps(dst + 4, _mm_shuffle_ps(g1b1, rg_hi, _MM_SHUFFLE(1, 0, 2, 0)));
-        _mm_stream_ps(dst + 8, _mm_shuffle_ps(b2r3, g3b3, _MM_SHUFFLE(2, 0, 2, 0)));
-    }
-#endif
-    for (; x < n; ++x) out[x] = pixel(x);
-}
-
-// Non-temporal stores are weakly ordered: fence them before the tile counts as written.
-void finish_streaming() {
-#if defined(__SSE2__)
-    _mm_sfence();
-#endif
-}
-
 struct Tile {
     int x0, y0, width, height;  // in pixels of the full image
 };
@@ -485,6 +439,48 @@ class PacketTracer {
     std::vector<float> center_x_, center_y_;
 };
 
+// The per-thread tallies of a render's tiles: the rays traced and the largest scratch.
+struct TileTallies {
+    tbb::enumerable_thread_specific<RayCounts> counts;
+    tbb::enumerable_thread_specific<std::uint64_t> scratch_bytes{std::uint64_t{0}};
+
+    void add_to(RenderResult& result) const {
+        for (const RayCounts& c : counts) result.rays += c;
+        for (std::uint64_t bytes : scratch_bytes)
+            result.scratch_bytes = std::max(result.scratch_bytes, bytes);
+    }
+};
+
+// Traces tiles tile_at(0) .. tile_at(count - 1) with `tracer` into `target`, in parallel in
+// the calling thread's arena, until `control` says to stop.
+template <class TileAt>
+void trace_tiles(const PacketTracer& tracer, const RenderTarget& target, int count,
+                 const TileAt& tile_at, TileControl& control, TileTallies& tallies) {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, count, 1),
+        [&](const tbb::blocked_range<int>& range) {
+            TileScratch& s = scratch_for_thread();
+            RayCounts& c = tallies.counts.local();
+            for (int t = range.begin(); t < range.end(); ++t) {
+                if (!control.proceed()) return;
+                const Tile tile = tile_at(t);
+                tracer.render_tile(tile, s, target, c);
+                control.done(static_cast<std::uint64_t>(tile.width) *
+                             static_cast<std::uint64_t>(tile.height));
+            }
+            std::uint64_t& bytes = tallies.scratch_bytes.local();
+            bytes = std::max(bytes, s.bytes());
+        },
+        tbb::auto_partitioner());
+}
+
+// RenderOptions::ray_chunk as the tracer takes it: whole 16-ray packets, 0 the default.
+std::uint32_t ray_chunk_of(const RenderOptions& options) {
+    return options.ray_chunk == 0
+               ? kDefaultRayChunk
+               : (std::max<std::uint32_t>(options.ray_chunk, 1u) + 15u) / 16u * 16u;
+}
+
 }  // namespace
 
 RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options, Isa isa) {
@@ -515,13 +511,8 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     }
     const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
     const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
-    tbb::enumerable_thread_specific<RayCounts> counts;
-    tbb::enumerable_thread_specific<std::uint64_t> scratch_bytes(std::uint64_t{0});
+    TileTallies tallies;
     TileControl control(options);
-    const std::uint32_t ray_chunk =
-        options.ray_chunk == 0
-            ? kDefaultRayChunk
-            : (std::max<std::uint32_t>(options.ray_chunk, 1u) + 15u) / 16u * 16u;
 
     // The spheres' BVH (options.accel), built on the render's threads and timed with it.
     SphereBvh bvh;
@@ -529,32 +520,19 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     const auto render_tiles = [&] {
         if (use_bvh) bvh = build_sphere_bvh(scene.spheres);
         const PacketTracer tracer(scene, table, options.frame, use_bvh ? &bvh : nullptr,
-                                  ray_chunk);
-        tbb::parallel_for(
-            tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
-            [&](const tbb::blocked_range<int>& range) {
-                TileScratch& s = scratch_for_thread();
-                RayCounts& c = counts.local();
-                for (int t = range.begin(); t < range.end(); ++t) {
-                    if (!control.proceed()) return;
-                    const int x0 = rect.x0 + (t % tiles_x) * tw;
-                    const int y0 = rect.y0 + (t / tiles_x) * th;
-                    const Tile tile{x0, y0, std::min(tw, rect.x1 - x0),
-                                    std::min(th, rect.y1 - y0)};
-                    tracer.render_tile(tile, s, target, c);
-                    control.done(static_cast<std::uint64_t>(tile.width) *
-                                 static_cast<std::uint64_t>(tile.height));
-                }
-                std::uint64_t& bytes = scratch_bytes.local();
-                bytes = std::max(bytes, s.bytes());
+                                  ray_chunk_of(options));
+        trace_tiles(
+            tracer, target, tiles_x * tiles_y,
+            [&](int t) {
+                const int x0 = rect.x0 + (t % tiles_x) * tw;
+                const int y0 = rect.y0 + (t / tiles_x) * th;
+                return Tile{x0, y0, std::min(tw, rect.x1 - x0), std::min(th, rect.y1 - y0)};
             },
-            tbb::auto_partitioner());
+            control, tallies);
     };
     run_with_threads(options.threads, render_tiles);
     control.finish();
-    for (const RayCounts& c : counts) result.rays += c;
-    for (std::uint64_t bytes : scratch_bytes)
-        result.scratch_bytes = std::max(result.scratch_bytes, bytes);
+    tallies.add_to(result);
     result.bvh_seconds = use_bvh ? bvh.build_seconds : 0.0;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -566,6 +544,45 @@ RenderResult render_packet(const Scene& scene, const RenderOptions& options, Isa
     const CompiledScene compiled = compile_scene(scene);
     RenderResult result = render_packet(compiled, options, isa);
     result.compile_seconds = compiled.compile_seconds;
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+PreparedScene::PreparedScene(const Scene& scene, Accel accel, int threads)
+    : compiled_(compile_scene(scene)),
+      use_bvh_(accel_uses_bvh(accel, compiled_.spheres.count)) {
+    if (use_bvh_)
+        run_with_threads(threads, [&] { bvh_ = build_sphere_bvh(compiled_.spheres); });
+}
+
+RenderResult render_packet_blocks(const PreparedScene& prepared,
+                                  std::span<const PixelRect> blocks, Image& target,
+                                  const RenderOptions& options, Isa isa) {
+    const auto start = std::chrono::steady_clock::now();
+    const CompiledScene& scene = prepared.compiled();
+    check_block_render(blocks, target, scene.width, scene.height, options);
+    const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
+    RenderResult result;
+    result.full_width = scene.width;
+    result.full_height = scene.height;
+    const RenderTarget out{target, PixelRect{0, 0, scene.width, scene.height},
+                           SampleRange{0, scene.spp}};
+    TileTallies tallies;
+    TileControl control(options);
+    run_with_threads(options.threads, [&] {
+        const PacketTracer tracer(scene, table, options.frame, prepared.bvh(),
+                                  ray_chunk_of(options));
+        trace_tiles(
+            tracer, out, static_cast<int>(blocks.size()),
+            [&](int t) {
+                const PixelRect& b = blocks[static_cast<std::size_t>(t)];
+                return Tile{b.x0, b.y0, b.width(), b.height()};
+            },
+            control, tallies);
+    });
+    control.finish();
+    tallies.add_to(result);
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

@@ -6,9 +6,13 @@
 // by `octray verify` and tests/render/packet_renderer_test.cpp.
 
 #include <cstdint>
+#include <span>
 
+#include "core/pixel_rect.h"
+#include "kernels/bvh_build.h"
 #include "kernels/isa.h"
 #include "kernels/kernel_table.h"
+#include "render/accel.h"
 #include "render/tile_layout.h"
 #include "render/types.h"
 #include "scene/compile.h"
@@ -34,5 +38,40 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
 // closest_hit and any_hit trace with Embree (bench/embree_frames.h), the rest octray's.
 RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options,
                            const kernels::KernelTable& table);
+
+// A compiled scene with its spheres' BVH (when `accel` asks for one), made once for many
+// renders of parts of the picture (render_packet_blocks): `octray view`'s frameless order
+// renders 8x8 blocks a batch at a time, and a render_packet call per block would compile
+// the scene and build the BVH per block. Neither depends on the camera, so set_camera()
+// keeps both.
+class PreparedScene {
+  public:
+    // Compiles `scene` (which must have passed validate_scene()) and builds the BVH on
+    // `threads` threads (0: every core TBB sees).
+    explicit PreparedScene(const Scene& scene, Accel accel = Accel::automatic, int threads = 0);
+    // The same scene seen through `camera` (valid for it: validate_scene's camera rules).
+    void set_camera(const Camera& camera) { set_compiled_camera(compiled_, camera); }
+    const CompiledScene& compiled() const { return compiled_; }
+    // The spheres' BVH, or nullptr where the scene is traced brute force.
+    const SphereBvh* bvh() const { return use_bvh_ ? &bvh_ : nullptr; }
+
+  private:
+    CompiledScene compiled_;
+    bool use_bvh_ = false;
+    SphereBvh bvh_;
+};
+
+// Renders the pixels of each of `blocks` into `target` (the scene's width x height
+// picture) at their places, every sample of each; the other pixels of `target` keep their
+// values. Each pixel is the same pixel of render_packet's image bit for bit. Each block is
+// one tile; the blocks are spread over options.threads threads (0: all), and must not
+// overlap. options.frame, cancel, pixels_done and ray_chunk apply; the tile size does not
+// (a block is a tile), and crop and samples must be unset. Throws std::invalid_argument
+// for an empty block or one outside the picture, a target of another size, a crop or a
+// sample range; std::runtime_error for a forced ISA the CPU lacks. The result carries the
+// rays and seconds; its image is empty (the pixels are in `target`).
+RenderResult render_packet_blocks(const PreparedScene& scene, std::span<const PixelRect> blocks,
+                                  Image& target, const RenderOptions& options = {},
+                                  Isa isa = Isa::automatic);
 
 }  // namespace octray

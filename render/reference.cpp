@@ -3,6 +3,7 @@
 
 #include "render/reference.h"
 
+#include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/blocked_range2d.h>
 #include <oneapi/tbb/combinable.h>
 #include <oneapi/tbb/parallel_for.h>
@@ -362,6 +363,40 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
             tbb::simple_partitioner());
     };
     run_with_threads(options.threads, render_tiles);
+    control.finish();
+    counts.combine_each([&](const RayCounts& c) { result.rays += c; });
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRect> blocks,
+                                     Image& target, const RenderOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    check_block_render(blocks, target, scene.image.width, scene.image.height, options);
+    const ReferenceTracer tracer(scene);
+    RenderResult result;
+    result.full_width = scene.image.width;
+    result.full_height = scene.image.height;
+    tbb::combinable<RayCounts> counts;
+    TileControl control(options);
+    run_with_threads(options.threads, [&] {
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, blocks.size(), 1),
+            [&](const tbb::blocked_range<std::size_t>& range) {
+                RayCounts& local = counts.local();
+                for (std::size_t b = range.begin(); b < range.end(); ++b) {
+                    if (!control.proceed()) return;
+                    const PixelRect& r = blocks[b];
+                    for (int j = r.y0; j < r.y1; ++j)
+                        for (int i = r.x0; i < r.x1; ++i)
+                            target.at(i, j) = tracer.render_pixel(i, j, options.frame, local);
+                    control.done(static_cast<std::uint64_t>(r.width()) *
+                                 static_cast<std::uint64_t>(r.height()));
+                }
+            },
+            tbb::simple_partitioner());
+    });
     control.finish();
     counts.combine_each([&](const RayCounts& c) { result.rays += c; });
     result.seconds =

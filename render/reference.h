@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "core/ray.h"
@@ -72,5 +73,11 @@ class ReferenceTracer {
 // render/types.h); tiles may run in parallel (TBB), one ray at a time per thread. The image
 // is bit-identical for any thread count, tile size and crop.
 RenderResult render_reference(const Scene& scene, const RenderOptions& options = {});
+
+// Renders the pixels of each of `blocks` into `target` at their places, as
+// render_packet_blocks (render/packet_renderer.h) does, with its checks; each pixel is
+// the same pixel of render_reference's image. One tracer serves every block.
+RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRect> blocks,
+                                     Image& target, const RenderOptions& options = {});
 
 }  // namespace octray

@@ -47,15 +47,18 @@ float pow_zero_below(float n) {
 
 }  // namespace
 
+void set_compiled_camera(CompiledScene& scene, const Camera& camera) {
+    scene.camera = make_camera_frame(camera, scene.width, scene.height);
+    scene.background_up = normalize(camera.up);
+}
+
 CompiledScene compile_scene(const Scene& scene) {
     const auto start = std::chrono::steady_clock::now();
     if (scene.objects.size() > (1u << 24))
         throw std::invalid_argument("more than 2^24 objects cannot be compiled");
 
     CompiledScene out;
-    out.camera = make_camera_frame(scene.camera, scene.image.width, scene.image.height);
     out.background = scene.background;
-    out.background_up = normalize(scene.camera.up);
     out.ambient = scene.ambient;
     out.epsilon = self_intersection_epsilon(scene);
     out.max_depth = scene.render.max_depth;
@@ -63,6 +66,7 @@ CompiledScene compile_scene(const Scene& scene) {
     out.seed = scene.render.seed;
     out.width = scene.image.width;
     out.height = scene.image.height;
+    set_compiled_camera(out, scene.camera);
 
     // Geometry: spheres and planes each in file order, and the per-object table. Every
     // array is sized (and padded, with its filler) up front, then filled by index in

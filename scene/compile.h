@@ -104,4 +104,10 @@ struct CompiledScene {
 // the kernels cannot represent (more than 2^24 objects: hit ids travel as exact floats).
 CompiledScene compile_scene(const Scene& scene);
 
+// Sets what compile_scene takes from the camera (its frame for the image's size, and the
+// gradient background's axis) from `camera`: nothing else of a compiled scene depends on
+// it, so another view of the same scene needs no new compile (octray view). The camera
+// must pass validate_scene's camera rules for the compiled scene's image size.
+void set_compiled_camera(CompiledScene& scene, const Camera& camera);
+
 }  // namespace octray

@@ -25,7 +25,6 @@
 #include "render/view/view_bench.h"
 #include "render/view/view_server.h"
 #include "render/view/view_session.h"
-#include "scene/animation.h"
 #include "scene/load.h"
 #include "scene/max_depth.h"
 #include "tools/cli_checks.h"
@@ -159,12 +158,8 @@ void run_view(const ViewArguments& args) {
     if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
     const std::string spec = args.inputs.empty() ? std::string("whitted") : args.inputs[0];
     // The digest names the scene in the header of a saved picture, as in `octray render`'s.
+    // An animation is shown at frame 0; the page's slider poses the others.
     auto [scene, sha256] = batch::load_scene_and_digest(spec, args.threads);
-    // An animation shows its first frame; the viewer has no time line yet.
-    if (scene.animation) {
-        scene = scene_at_frame(scene, 0);
-        scene.animation.reset();
-    }
     if (args.width > 0) scene.image.width = args.width;
     if (args.height > 0) scene.image.height = args.height;
     if (args.spp > 0) scene.image.spp = args.spp;
@@ -173,8 +168,9 @@ void run_view(const ViewArguments& args) {
 
     view::ViewSettings settings;
     settings.path = *parse_render_path(args.path);
+    settings.isa = parse_isa(args.isa).value_or(Isa::automatic);
     try {
-        settings.isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
+        resolve_isa(settings.isa);  // each render resolves "auto" again
     } catch (const std::runtime_error& e) {
         throw UsageError(std::string("--isa: ") + e.what());
     }
@@ -191,12 +187,6 @@ void run_view(const ViewArguments& args) {
     view::SaveSettings save;
     save.spec = spec;
     save.sha256 = sha256;
-    batch::BatchSettings batch_settings;
-    batch_settings.path = settings.path;
-    batch_settings.isa = settings.isa;
-    save.path_label = batch::render_path_label(batch_settings);
-    if (args.path != "simd") save.render_arguments += " --path " + args.path;
-    if (args.isa != "auto") save.render_arguments += " --isa " + args.isa;
     const auto server = make_server(args, session, save);
     serve(*server, *stop_on_signal,
           scene.source + " (" + std::to_string(scene.image.width) + "x" +
@@ -293,7 +283,8 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "pixel) with spp, Mrays/s and frame time; drag orbits the camera about its look-at\n"
         "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
         "(--preview-divisor) until it stops. The mouse shows the linear RGB value under it.\n"
-        "The page switches threads, spp, max depth and the order while it runs.\n"
+        "The page switches threads, spp, max depth, the order, the path and the ISA\n"
+        "(those this CPU runs) while it runs, and an animated scene's frame (a slider).\n"
         "Save writes the refined picture as octray render writes it, to a file name in the\n"
         "current directory, and shows the octray render command line that makes it.\n"
         "Nothing but the scene (or the two images) named here is served.\n\n"

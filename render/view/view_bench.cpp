@@ -52,7 +52,7 @@ ViewBenchResult bench_orbit(const Scene& scene, const ViewSettings& settings, in
     result.first_height = first->image.height();
     result.first_spp = first->spp;
 
-    const Camera initial = scene.camera;
+    const Camera initial = session.camera();  // an animation's: its first frame's
     double rays = 0.0, render_seconds = 0.0, png_bytes = 0.0;
     const auto orbit_start = Clock::now();
     for (int i = 1; i <= updates; ++i) {

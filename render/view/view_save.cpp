@@ -5,11 +5,13 @@
 #include <fstream>
 #include <string_view>
 
+#include "kernels/dispatch.h"
 #include "render/batch/digest.h"
 #include "render/batch/frame_loop.h"
 #include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/view/http_error.h"
+#include "render/view/view_switches.h"
 #include "scene/load.h"
 
 namespace octray::view {
@@ -86,8 +88,10 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
     check_save_name(name);
     const auto frame = session.latest();
     Scene posed = session.scene();
+    const int animation_frame = session.switches().frame;
     if (!frame || frame->preview || frame->spp < frame->target_spp ||
-        frame->target_spp != posed.image.spp || frame->max_depth != posed.render.max_depth)
+        frame->target_spp != posed.image.spp || frame->max_depth != posed.render.max_depth ||
+        frame->animation_frame != animation_frame)
         throw BadRequest(409, "save: the picture is still refining; save once it has all " +
                                   std::to_string(posed.image.spp) + " spp");
     if (frame->rays.total() == 0)
@@ -107,6 +111,13 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
     identity.spec = settings.spec;
     identity.sha256 = settings.sha256;
     identity.scene = posed;
+    // The header's time and frame rate are the animation's (render_exr_attributes reads
+    // only its frame count and fps from the scene it identifies).
+    if (session.frame_count() > 1) {
+        identity.scene.animation.emplace();
+        identity.scene.animation->frames = session.frame_count();
+        identity.scene.animation->fps = session.frames_per_second();
+    }
     // A moved camera is a new scene: written beside the image as JSON (`octray scene`'s
     // writer), named in the header and the command line instead of the original.
     const bool moved = !same_camera(frame->camera, scene_camera);
@@ -132,15 +143,21 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
     result.rays = frame->rays;
     result.seconds = frame->render_seconds;
     const ExrAttributes attributes = batch::render_exr_attributes(
-        identity, posed, 0, result, settings.path_label, posed.image.spp, std::string());
+        identity, posed, animation_frame, result, path_label(frame->path, frame->isa),
+        posed.image.spp, std::string());
     write_exr((directory / name).string(),
               make_exr_image(result, ExrWriteOptions{}, attributes));
 
-    std::string command =
-        "octray render " + shell_word(identity.spec) + " --width " +
-        std::to_string(posed.image.width) + " --height " + std::to_string(posed.image.height) +
-        " --spp " + std::to_string(posed.image.spp) + " --max-depth " +
-        std::to_string(posed.render.max_depth) + settings.render_arguments + " -o " + name;
+    std::string command = "octray render " + shell_word(identity.spec) + " --width " +
+                          std::to_string(posed.image.width) + " --height " +
+                          std::to_string(posed.image.height) + " --spp " +
+                          std::to_string(posed.image.spp) + " --max-depth " +
+                          std::to_string(posed.render.max_depth);
+    if (frame->path == RenderPath::scalar) command += " --path scalar";
+    if (frame->path == RenderPath::simd && frame->isa != Isa::automatic)
+        command += std::string(" --isa ") + isa_name(frame->isa);
+    if (session.frame_count() > 1) command += " --frames " + std::to_string(animation_frame);
+    command += " -o " + name;
     json answer{{"file", name}, {"command", command}, {"camera_moved", moved}};
     answer["scene_file"] = moved ? json(scene_file) : json(nullptr);
     return answer;

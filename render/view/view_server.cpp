@@ -23,8 +23,8 @@
 #include "render/view/token.h"
 #include "render/view/tone_map.h"
 #include "render/view/view_save.h"
+#include "render/view/view_switches.h"
 #include "scene/load.h"
-#include "scene/max_depth.h"
 #include "scene/scene_error.h"
 
 namespace octray::view {
@@ -52,6 +52,8 @@ json frame_json(const ViewFrame& frame) {
         {"frame_seconds", frame.frame_seconds},
         {"mrays_per_second", frame.mrays_per_second},
         {"coverage", frame.coverage},
+        {"animation_frame", frame.animation_frame},
+        {"path", path_label(frame.path, frame.isa)},
         {"camera",
          {{"eye", vec3_json(camera.eye)},
           {"lookat", vec3_json(camera.lookat)},
@@ -262,16 +264,16 @@ void ViewServer::Impl::scene_routes() {
     ViewSession& session = *session_ptr;
     server.Get("/api/status", [&session](const httplib::Request&, httplib::Response& res) {
         const Scene scene = session.scene();
-        const RenderSwitches switches = session.switches();
         json status{{"mode", "scene"},
                     {"scene", scene.source},
                     {"full_width", scene.image.width},
                     {"full_height", scene.image.height},
-                    {"settings",
-                     {{"threads", switches.threads},
-                      {"spp", switches.spp},
-                      {"max_depth", switches.max_depth},
-                      {"order", to_string(switches.order)}}}};
+                    {"settings", switches_json(session.switches())},
+                    {"isas", isa_choices(switch_limits(session))},
+                    {"animation", nullptr}};
+        if (session.frame_count() > 1)
+            status["animation"] = {{"frames", session.frame_count()},
+                                   {"fps", session.frames_per_second()}};
         if (const auto frame = session.latest()) status["frame"] = frame_json(*frame);
         if (const std::string error = session.error(); !error.empty()) status["error"] = error;
         res.set_content(status.dump(), "application/json");
@@ -350,43 +352,15 @@ void ViewServer::Impl::scene_routes() {
                     });
     }
 
-    // The page's switches: {"threads": N, "spp": N, "max_depth": N, "order": "tiled" |
-    // "rows" | "frameless"}, every key optional; a change re-renders the current camera.
-    server.Post("/api/settings", [&session](const httplib::Request& req,
-                                            httplib::Response& res) {
-        const json request = json::parse(req.body, nullptr, /*allow_exceptions=*/false);
-        if (request.is_discarded() || !request.is_object())
-            throw BadRequest(400, "settings: expected a JSON object such as {\"spp\": 16}");
-        RenderSwitches switches = session.switches();
-        const auto integer = [](const json& value, const std::string& what, int lo, int hi) {
-            if (!value.is_number_integer() || value.get<long long>() < lo ||
-                value.get<long long>() > hi)
-                throw BadRequest(400, "settings." + what + ": expected an integer in [" +
-                                          std::to_string(lo) + ", " + std::to_string(hi) + "]");
-            return static_cast<int>(value.get<long long>());
-        };
-        for (const auto& [key, value] : request.items()) {
-            if (key == "threads") {
-                switches.threads = integer(value, key, 0, kMaxRenderThreads);
-            } else if (key == "spp") {
-                switches.spp = integer(value, key, 1, kMaxSamplesPerPixel);
-            } else if (key == "max_depth") {
-                switches.max_depth = integer(value, key, 1, kMaxDepthLimit);
-            } else if (key == "order") {
-                const auto order = value.is_string()
-                                       ? parse_pixel_order(value.get<std::string>())
-                                       : std::nullopt;
-                if (!order)
-                    throw BadRequest(400, "settings.order: expected tiled, rows or frameless");
-                switches.order = *order;
-            } else {
-                throw BadRequest(400, "settings: unknown key \"" + key +
-                                          "\" (expected threads, spp, max_depth, order)");
-            }
-        }
-        session.reconfigure(switches);
-        res.set_content(json{{"ok", true}}.dump(), "application/json");
-    });
+    // The page's switches (view_switches.h); a change re-renders the current camera, as a
+    // new camera version: the pictures made with the new switches carry it.
+    server.Post("/api/settings",
+                [&session](const httplib::Request& req, httplib::Response& res) {
+                    const std::uint64_t version = session.reconfigure(
+                        parse_switches(req.body, session.switches(), switch_limits(session)));
+                    res.set_content(json{{"ok", true}, {"camera_version", version}}.dump(),
+                                    "application/json");
+                });
 
     server.Post("/api/camera", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto [camera, moving] = parse_camera_request(req.body, session.camera());

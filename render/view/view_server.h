@@ -13,13 +13,11 @@
 namespace octray::view {
 
 // What POST /api/save needs to write the current picture as `octray render` would: the
-// scene's identity for the EXR header and the command line that renders it again.
+// scene's identity for the EXR header and for the command line that renders it again (the
+// picture itself says which path and ISA made it, the session which frame it is).
 struct SaveSettings {
-    std::string spec;        // the scene as given on the command line (octray.scene)
-    std::string sha256;      // its digest (octray.sceneSha256)
-    std::string path_label;  // octray.path: "simd (avx2)", "scalar"
-    // Options of the render command line beyond the size, spp and depth ("--path scalar").
-    std::string render_arguments;
+    std::string spec;             // the scene as given on the command line (octray.scene)
+    std::string sha256;           // its digest (octray.sceneSha256)
     std::string directory = ".";  // where files are written: the working directory
 };
 

@@ -1,20 +1,20 @@
 #include "render/view/view_session.h"
 
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <exception>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
+#include "kernels/dispatch.h"
 #include "render/batch/progressive.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "render/view/frameless.h"
+#include "scene/animation.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 #include "scene/scene_error.h"
@@ -34,24 +34,27 @@ double mrays_per_second(const RenderResult& result) {
                : 0.0;
 }
 
-// The options of a render of `width` pixels across: the threads asked for, the cancel
-// flag, and for the rows order one tile per row (row-major order).
-RenderOptions render_options(const ViewSettings& settings, int width,
-                             const std::atomic<bool>* cancel) {
-    RenderOptions options;
-    options.threads = settings.threads;
-    options.cancel = cancel;
-    if (settings.order == PixelOrder::rows) {
-        options.tile_width = width;
-        options.tile_height = 1;
-    }
-    return options;
+// `source` posed at `frame` (a still scene is its own pose), with the spp and max depth of
+// the switches.
+Scene posed_scene(const Scene& source, int frame, int spp, int max_depth) {
+    Scene posed = source.animation ? scene_at_frame(source, frame) : source;
+    posed.image.spp = spp;
+    posed.render.max_depth = max_depth;
+    return posed;
 }
 
 }  // namespace
 
 ViewSession::ViewSession(Scene scene, ViewSettings settings)
-    : scene_(std::move(scene)), settings_(settings), camera_(scene_.camera) {
+    : animated_(scene.animation ? std::optional<Scene>(scene) : std::nullopt),
+      frame_count_(scene.animation ? scene.animation->frames : 1),
+      fps_(scene.animation ? scene.animation->fps : kStillFps),
+      scene_(animated_ ? posed_scene(*animated_, settings.frame, scene.image.spp,
+                                     scene.render.max_depth)
+                       : std::move(scene)),
+      settings_(settings),
+      camera_(scene_.camera) {
+    if (!animated_) settings_.frame = 0;
     thread_ = std::thread([this] { run(); });
 }
 
@@ -83,34 +86,75 @@ Scene ViewSession::scene() const {
 RenderSwitches ViewSession::switches() const {
     std::lock_guard lock(mutex_);
     return RenderSwitches{settings_.threads, scene_.image.spp, scene_.render.max_depth,
-                          settings_.order};
+                          settings_.order,   settings_.path,   settings_.isa,
+                          settings_.frame};
 }
 
-void ViewSession::reconfigure(const RenderSwitches& switches) {
+RenderOptions ViewSession::render_options(int width) const {
+    RenderOptions options;
+    options.threads = settings_.threads;
+    options.cancel = &cancel_;
+    options.frame = static_cast<std::uint32_t>(settings_.frame);
+    if (settings_.order == PixelOrder::rows) {
+        options.tile_width = width;
+        options.tile_height = 1;
+    }
+    return options;
+}
+
+// A picture of camera `version` with what the switches say of how it is made.
+ViewFrame ViewSession::frame_of(std::uint64_t version, const Camera& camera) const {
+    ViewFrame frame;
+    frame.camera_version = version;
+    frame.camera = camera;
+    frame.target_spp = scene_.image.spp;
+    frame.max_depth = scene_.render.max_depth;
+    frame.animation_frame = settings_.frame;
+    frame.path = settings_.path;
+    frame.isa = settings_.isa;
+    return frame;
+}
+
+std::uint64_t ViewSession::reconfigure(const RenderSwitches& switches) {
     std::lock_guard guard(reconfigure_mutex_);
-    Scene next = scene();
-    next.image.spp = switches.spp;
-    next.render.max_depth = switches.max_depth;
+    if (switches.frame < 0 || switches.frame >= frame_count_)
+        throw std::out_of_range("frame " + std::to_string(switches.frame) +
+                                " is outside the animation's frames 0 to " +
+                                std::to_string(frame_count_ - 1));
+    if (switches.path == RenderPath::simd) resolve_isa(switches.isa);  // throws: no change
+    // Only this function changes scene_, and only from here on: reading it needs no lock.
+    Scene next = animated_
+                     ? posed_scene(*animated_, switches.frame, switches.spp, switches.max_depth)
+                     : posed_scene(scene_, 0, switches.spp, switches.max_depth);
     validate_scene(next);  // throws SceneError: nothing changes
+    // A new frame of an animated camera shows that frame's camera.
+    const bool frame_camera =
+        animated_ && !animated_->animation->camera.empty() && switches.frame != settings_.frame;
     {
         std::lock_guard lock(mutex_);
-        if (stop_) return;
+        if (stop_) return camera_version_;
         restart_ = true;
         cancel_ = true;
     }
     changed_.notify_all();
     if (thread_.joinable()) thread_.join();
+    std::uint64_t version = 0;
     {
         std::lock_guard lock(mutex_);
+        if (frame_camera) camera_ = next.camera;
         scene_ = std::move(next);
         settings_.threads = switches.threads;
         settings_.order = switches.order;
+        settings_.path = switches.path;
+        settings_.isa = switches.isa;
+        settings_.frame = switches.frame;
         restart_ = false;
         cancel_ = false;
-        ++camera_version_;  // the current camera again, under the new switches
+        version = ++camera_version_;  // the current camera again, under the new switches
         moving_ = false;
     }
     thread_ = std::thread([this] { run(); });
+    return version;
 }
 
 void ViewSession::stop() {
@@ -235,7 +279,8 @@ void ViewSession::run() {
 // Frameless: one framebuffer, re-rendered a batch of blocks at a time in the permutation
 // of frameless_blocks, continuing where the last camera left off (the oldest pixels are
 // renewed first); each batch is published at once. A camera that stays still is rendered
-// once over (a full sweep), which is then exactly the tiled order's picture.
+// once over (a full sweep), which is then exactly the tiled order's picture. The SIMD path
+// compiles the scene and builds its BVH once (PreparedScene); a new camera only re-aims it.
 void ViewSession::run_frameless() {
     const int width = scene_.image.width, height = scene_.image.height;
     const std::vector<PixelRect> blocks =
@@ -243,14 +288,17 @@ void ViewSession::run_frameless() {
     // About 16 pictures a sweep, of at least 16 blocks each (enough work for the threads).
     const std::size_t batch_size = std::max<std::size_t>(16, blocks.size() / 16);
     Image framebuffer(width, height);
+    std::vector<PixelRect> batch;
     std::size_t cursor = 0;             // next block of the permutation
     std::size_t fresh = blocks.size();  // blocks rendered with the current camera
     std::uint64_t version = 0;
-    Scene scene = scene_;
-    std::optional<CompiledScene> compiled;
+    std::optional<Scene> scalar;  // the scalar path's scene, with the current camera
+    if (settings_.path == RenderPath::scalar) scalar = scene_;
+    std::optional<PreparedScene> prepared;
+    RenderOptions options;
+    options.threads = settings_.threads;
+    options.frame = static_cast<std::uint32_t>(settings_.frame);
     Clock::time_point camera_start;
-    std::optional<tbb::task_arena> arena;
-    if (settings_.threads > 0) arena.emplace(settings_.threads);
 
     std::unique_lock lock(mutex_);
     while (!stop_ && !restart_) {
@@ -265,47 +313,32 @@ void ViewSession::run_frameless() {
         lock.unlock();
         try {
             if (new_camera) {
-                scene.camera = camera;
-                if (settings_.path == RenderPath::simd) compiled.emplace(compile_scene(scene));
+                if (settings_.path == RenderPath::simd) {
+                    if (!prepared)
+                        prepared.emplace(scene_, Accel::automatic, settings_.threads);
+                    prepared->set_camera(camera);
+                } else {
+                    scalar->camera = camera;
+                }
                 fresh = 0;
                 camera_start = Clock::now();
             }
             const std::size_t count = std::min(batch_size, blocks.size() - fresh);
-            std::atomic<std::uint64_t> rays{0};
-            const auto start = Clock::now();
-            const auto render_batch = [&] {
-                tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
-                    const PixelRect& rect = blocks[(cursor + i) % blocks.size()];
-                    RenderOptions options;
-                    options.crop = rect;
-                    const RenderResult result =
-                        compiled ? render_packet(*compiled, options, settings_.isa)
-                                 : render_reference(scene, options);
-                    for (int y = 0; y < rect.height(); ++y)
-                        for (int x = 0; x < rect.width(); ++x)
-                            framebuffer.at(rect.x0 + x, rect.y0 + y) = result.image.at(x, y);
-                    rays += result.rays.total();
-                });
-            };
-            if (arena) {
-                arena->execute(render_batch);
-            } else {
-                render_batch();
-            }
+            batch.clear();
+            for (std::size_t i = 0; i < count; ++i)
+                batch.push_back(blocks[(cursor + i) % blocks.size()]);
+            const RenderResult result =
+                prepared ? render_packet_blocks(*prepared, batch, framebuffer, options,
+                                                settings_.isa)
+                         : render_reference_blocks(*scalar, batch, framebuffer, options);
             cursor = (cursor + count) % blocks.size();
             fresh += count;
-            ViewFrame frame;
+            ViewFrame frame = frame_of(version, camera);
             frame.image = framebuffer;
-            frame.camera_version = version;
-            frame.camera = camera;
             frame.spp = scene_.image.spp;
-            frame.target_spp = scene_.image.spp;
-            frame.pass_seconds = seconds_since(start);
+            frame.pass_seconds = result.seconds;
             frame.frame_seconds = seconds_since(camera_start);
-            frame.mrays_per_second =
-                frame.pass_seconds > 0.0
-                    ? static_cast<double>(rays.load()) / frame.pass_seconds / 1e6
-                    : 0.0;
+            frame.mrays_per_second = mrays_per_second(result);
             frame.coverage = static_cast<double>(fresh) / static_cast<double>(blocks.size());
             publish(std::move(frame));
         } catch (const std::exception& e) {
@@ -326,18 +359,15 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
     scene.image.width = std::max(1, (scene_.image.width + d - 1) / d);
     scene.image.height = std::max(1, (scene_.image.height + d - 1) / d);
     scene.image.spp = 1;
-    RenderOptions options = render_options(settings_, scene.image.width, &cancel_);
+    const RenderOptions options = render_options(scene.image.width);
     const auto start = Clock::now();
     RenderResult result = settings_.path == RenderPath::simd
                               ? render_packet(scene, options, settings_.isa)
                               : render_reference(scene, options);
-    ViewFrame frame;
+    ViewFrame frame = frame_of(version, camera);
     frame.image = std::move(result.image);
-    frame.camera_version = version;
-    frame.camera = camera;
     frame.preview = true;
     frame.spp = 1;
-    frame.target_spp = scene_.image.spp;
     frame.pass_seconds = result.seconds;
     frame.frame_seconds = seconds_since(start);
     frame.mrays_per_second = mrays_per_second(result);
@@ -347,7 +377,7 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
 bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
     Scene scene = scene_;
     scene.camera = camera;
-    RenderOptions options = render_options(settings_, scene.image.width, &cancel_);
+    const RenderOptions options = render_options(scene.image.width);
     const auto start = Clock::now();
     // The SIMD path compiles the scene once for all passes of this camera.
     std::optional<CompiledScene> compiled;
@@ -361,15 +391,11 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
     const batch::PassCallback on_pass = [&](const RenderResult& so_far, int samples_so_far) {
         rays += so_far.rays;
         render_seconds += so_far.seconds;
-        ViewFrame frame;
+        ViewFrame frame = frame_of(version, camera);
         frame.rays = rays;
         frame.render_seconds = render_seconds;
         frame.image = so_far.image;
-        frame.camera_version = version;
-        frame.camera = camera;
         frame.spp = samples_so_far;
-        frame.target_spp = scene.image.spp;
-        frame.max_depth = scene.render.max_depth;
         frame.pass_seconds = so_far.seconds;
         frame.frame_seconds = seconds_since(start);
         frame.mrays_per_second = mrays_per_second(so_far);

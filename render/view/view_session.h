@@ -32,9 +32,10 @@ struct ViewSettings {
     PixelOrder order = PixelOrder::tiled;
     int frameless_block = 8;  // frameless: block side in pixels
     RenderPath path = RenderPath::simd;
-    Isa isa = Isa::automatic;
-    int threads = 0;          // 0: every core TBB sees
-    int preview_divisor = 4;  // a moving camera renders (width / d) x (height / d) at 1 spp
+    Isa isa = Isa::automatic;  // as asked: automatic is resolved by each render
+    int threads = 0;           // 0: every core TBB sees
+    int frame = 0;             // an animated scene's frame shown first
+    int preview_divisor = 4;   // a moving camera renders (width / d) x (height / d) at 1 spp
     // After a preview, the passes at full resolution start once the camera has not moved
     // for this long (a page that sends no final "stopped" still gets a sharp picture).
     std::chrono::milliseconds settle{300};
@@ -46,6 +47,9 @@ struct RenderSwitches {
     int spp = 1;
     int max_depth = 1;
     PixelOrder order = PixelOrder::tiled;
+    RenderPath path = RenderPath::simd;
+    Isa isa = Isa::automatic;
+    int frame = 0;  // the animation's frame (0 for a still scene)
 };
 
 // "tiled", "rows", "frameless"; and the order a name stands for.
@@ -58,13 +62,16 @@ struct ViewFrame {
     std::uint64_t generation = 0;      // 1, 2, 3, ... in publishing order
     std::uint64_t camera_version = 0;  // which set_camera() call it shows (1: the scene's)
     Camera camera;
-    bool preview = false;           // reduced resolution while the camera moves
-    int spp = 0;                    // samples per pixel so far
-    int target_spp = 0;             // the scene's spp: the last pass
-    int max_depth = 0;              // the scene's max depth when it was rendered
-    double pass_seconds = 0.0;      // this pass
-    double frame_seconds = 0.0;     // every pass so far of this camera
-    double mrays_per_second = 0.0;  // this pass: rays traced / pass_seconds
+    bool preview = false;                // reduced resolution while the camera moves
+    int spp = 0;                         // samples per pixel so far
+    int target_spp = 0;                  // the scene's spp: the last pass
+    int max_depth = 0;                   // the scene's max depth when it was rendered
+    int animation_frame = 0;             // the animation's frame (0 for a still scene)
+    RenderPath path = RenderPath::simd;  // the renderer that made it,
+    Isa isa = Isa::automatic;            // and the ISA asked of the simd path
+    double pass_seconds = 0.0;           // this pass
+    double frame_seconds = 0.0;          // every pass so far of this camera
+    double mrays_per_second = 0.0;       // this pass: rays traced / pass_seconds
     // Frameless: the part of the picture rendered with this camera so far (1: all of it,
     // at the scene's spp; the rest still shows earlier cameras). Tiled: always 1.
     double coverage = 1.0;
@@ -76,19 +83,30 @@ struct ViewFrame {
 
 class ViewSession {
   public:
-    // `scene` must be a still scene that passed validate_scene(). Starts rendering at once.
+    // `scene` must have passed validate_scene(). An animated scene is shown at frame
+    // settings.frame (in range), posed as scene_at_frame() poses it; the page's frame
+    // switch poses another. Starts rendering at once.
     ViewSession(Scene scene, ViewSettings settings);
     ~ViewSession();  // stop()
     ViewSession(const ViewSession&) = delete;
     ViewSession& operator=(const ViewSession&) = delete;
 
-    // The scene as loaded (its camera is the initial one), with the switches applied.
+    // The scene as loaded (an animation posed at the current frame; its camera is the
+    // initial one, not the page's), with the switches applied.
     Scene scene() const;
     RenderSwitches switches() const;
+    // The animation's frame count (1 for a still scene) and frames per second (its fps,
+    // kStillFps for a still scene). They never change.
+    int frame_count() const { return frame_count_; }
+    double frames_per_second() const { return fps_; }
     // Applies new switches: the render in flight is abandoned, the render thread restarts
-    // with them and renders the current camera again (a new camera version). Throws
-    // SceneError for values the scene rules refuse (spp, max depth out of range).
-    void reconfigure(const RenderSwitches& switches);
+    // with them and renders the current camera again (a new camera version). A new frame
+    // of an animation whose camera is animated takes that frame's camera. Throws
+    // SceneError for values the scene rules refuse (spp, max depth out of range, a pose
+    // that cannot be rendered), std::out_of_range for a frame outside the animation and
+    // std::runtime_error for an ISA this CPU lacks; nothing changes then. Returns the
+    // camera version of the pictures made with the new switches.
+    std::uint64_t reconfigure(const RenderSwitches& switches);
 
     // The latest picture, nullptr before the first one.
     std::shared_ptr<const ViewFrame> latest() const;
@@ -119,6 +137,15 @@ class ViewSession {
     bool render_passes(const Camera& camera, std::uint64_t version);
     void publish(ViewFrame frame);
 
+    // Options of every render of the current switches: threads, the cancel flag, the
+    // frame counter of the sample hash, and for the rows order one tile per row.
+    RenderOptions render_options(int width) const;
+    ViewFrame frame_of(std::uint64_t version, const Camera& camera) const;
+
+    // An animated scene as loaded (its poses come from it), absent for a still one.
+    const std::optional<Scene> animated_;
+    const int frame_count_;
+    const double fps_;
     // Changed only by reconfigure(), while the render thread is stopped; read by other
     // threads under mutex_ (scene(), switches()).
     Scene scene_;

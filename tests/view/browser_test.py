@@ -6,7 +6,9 @@
 Starts `octray view` on a free port, opens the URL it prints, and checks that the page
 shows the refined picture (the canvas has non-black pixels and says spp 4), that a drag
 across the canvas orbits the camera (the server reports a new camera at the same distance
-from the same look-at point, and the canvas changes), that the wheel dollies, that
+from the same look-at point, and the canvas changes), that the wheel dollies, that the
+switches reach the server (spp, path; the ISA selector offers the server's list), that an
+animated scene's frame slider renders and saves another frame, that
 the frameless order converges to the same picture as the tiled one, that
 `octray view A.exr B.exr` shows compare's verdict, the heatmap and the value under the
 cursor, that the server refuses the page
@@ -118,6 +120,8 @@ def run(octray, artifacts):
                     status = check_frameless(browser, octray, artifacts, WebDriverWait)
                 if status == 0:
                     status = check_save(browser, octray, WebDriverWait)
+                if status == 0:
+                    status = check_frame(browser, octray, WebDriverWait)
                 if status == 0:
                     status = check_compare(browser, octray, artifacts, ActionChains,
                                            WebDriverWait)
@@ -265,6 +269,18 @@ def check_save(browser, octray, WebDriverWait):
                 "document.body.dataset.spp === '2';"))
             if fetch_status(url)["settings"]["spp"] != 2:
                 return fail("the spp switch did not reach the server")
+            # The ISA selector offers what the server says this CPU runs; the path switch
+            # reaches the server.
+            offered = browser.execute_script(
+                "return [...document.getElementById('isa').options].map(o => o.value);")
+            if offered != fetch_status(url)["isas"]:
+                return fail(f"the page offers the ISAs {offered}, the server "
+                            f"{fetch_status(url)['isas']}")
+            browser.execute_script(
+                "const path = document.getElementById('path'); path.value = 'scalar';"
+                "path.dispatchEvent(new Event('change'));")
+            WebDriverWait(browser, WAIT).until(
+                lambda b: fetch_status(url)["settings"]["path"] == "scalar")
         finally:
             process.send_signal(signal.SIGINT)
             process.communicate(timeout=60)
@@ -273,7 +289,48 @@ def check_save(browser, octray, WebDriverWait):
             return fail(f"save showed the command {command!r}")
         if not os.path.exists(os.path.join(folder, "saved.exr")):
             return fail("save did not write saved.exr in the viewer's directory")
-    print(f"PASS: save wrote saved.exr and showed {command}; the spp switch re-rendered")
+    print(f"PASS: save wrote saved.exr and showed {command}; the spp switch re-rendered; "
+          "the page offers the server's ISAs and switches the path")
+    return 0
+
+
+def check_frame(browser, octray, WebDriverWait):
+    """An animated scene (scene/examples/bounce.json, 48 frames) shows the frame slider;
+    moving it re-renders that frame, and save's command line names it (--frames N)."""
+    scene = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scene",
+                         "examples", "bounce.json")
+    with tempfile.TemporaryDirectory() as folder:
+        process, url = start_command(
+            [octray, "view", scene, "--port", "0", "--width", "160", "--height", "90",
+             "--spp", "2", "--threads", "2"], folder)
+        try:
+            browser.get(url)
+            WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return !document.getElementById('frame-controls').hidden && "
+                "document.body.dataset.spp === '2';"))
+            browser.execute_script(
+                "const frame = document.getElementById('frame'); frame.value = '10';"
+                "frame.dispatchEvent(new Event('input'));"
+                "frame.dispatchEvent(new Event('change'));")
+            WebDriverWait(browser, WAIT).until(
+                lambda b: fetch_status(url).get("frame", {}).get("animation_frame") == 10
+                and fetch_status(url)["frame"]["spp"] == 2)
+            label = browser.execute_script(
+                "return document.getElementById('frame-value').textContent;")
+            if not label.startswith("10 / 47"):
+                return fail(f"the frame slider's label says {label!r}")
+            name = browser.find_element("id", "save-name")
+            name.clear()
+            name.send_keys("frame10.exr")
+            browser.find_element("id", "save").click()
+            command = WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                "return document.getElementById('save-result').dataset.command;"))
+        finally:
+            process.send_signal(signal.SIGINT)
+            process.communicate(timeout=60)
+        if not command.endswith(" --frames 10 -o frame10.exr"):
+            return fail(f"save showed the command {command!r} for frame 10")
+    print(f"PASS: the frame slider rendered frame 10 ({label}); save showed {command}")
     return 0
 
 
