@@ -29,15 +29,18 @@ class Image {
           height_(height),
           pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {}
 
-    // A width x height image with undefined pixels in the storage of `spare` (left empty),
-    // where it holds exactly that many pixels: a frame loop hands back the frame it has
-    // written, and the next frame then touches no freshly mapped pages. Fresh storage
-    // otherwise.
+    // A width x height image with undefined pixels in the storage of `spare`, where it
+    // holds exactly that many pixels: a frame loop hands back the frame it has written,
+    // and the next frame then touches no freshly mapped pages. Fresh storage otherwise,
+    // after `spare`'s is freed (never two frames at once). `spare` is left empty.
     static Image reuse(Image&& spare, int width, int height) {
         Image image;
         const std::size_t n =
             static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-        if (spare.pixels_.size() != n) return Image(width, height, Uninitialized{});
+        if (spare.pixels_.size() != n) {
+            spare = Image();
+            return Image(width, height, Uninitialized{});
+        }
         image.width_ = width, image.height_ = height;
         image.pixels_ = std::move(spare.pixels_);
         spare = Image();

@@ -250,6 +250,16 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         options.cancel = cancel_;
         options.pixels_done = observer_.pixel_counter();
         options.crop = scene.crop;
+        // A spare frame and channels of another size would only add to this frame's
+        // memory (the estimate counts one frame): they go before it renders.
+        const std::uint64_t pixels = scene.crop
+                                         ? scene.crop->pixel_count()
+                                         : static_cast<std::uint64_t>(posed.image.width) *
+                                               static_cast<std::uint64_t>(posed.image.height);
+        if (spare_frame_.pixel_count() != pixels) {
+            spare_frame_ = Image();
+            spare_channels_.clear();
+        }
         options.spare_image = &spare_frame_;
         // Writing (EXR and PNG encoding) is timed apart from tracing: the frame line and
         // the summary report each, and the rate is rays over trace time alone.

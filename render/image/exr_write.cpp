@@ -289,6 +289,8 @@ ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* va
                             std::vector<unsigned char> storage) {
     if (type == ExrPixelType::uint32)
         throw std::invalid_argument("make_exr_channel: floats make half or float channels");
+    // Storage of another size is not kept: its capacity would outlast this channel.
+    if (storage.size() != count * sample_size(type)) storage = {};
     storage.resize(count * sample_size(type));  // every byte is written below
     ExrChannel c{std::move(name), type, std::move(storage)};
     unsigned char* out = c.samples.data();

@@ -115,8 +115,8 @@ struct ExrChannel {
 
 // A half or float32 channel from `count` floats at `values`, `stride` floats apart
 // (half rounds to nearest even, as OpenEXR's half does). Its samples go into `storage`
-// (a written frame's, handed on): storage of the right size is neither zeroed nor mapped
-// afresh.
+// (a written frame's, handed on) where it is of the right size, which is then neither
+// zeroed nor mapped afresh; storage of another size is freed first.
 ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* values,
                             std::size_t count, std::size_t stride = 1,
                             std::vector<unsigned char> storage = {});

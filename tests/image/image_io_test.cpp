@@ -167,7 +167,7 @@ TEST(ExrChannels, SpareStorageIsTakenAndFullyOverwritten) {
             EXPECT_EQ(reused.channels[k].samples, fresh.channels[k].samples);
         }
     }
-    // Spare channels of another size are resized: the values are still the image's.
+    // Spare channels of another size are not kept: the values are still the image's.
     const ExrImage small =
         make_exr_image(gradient_image(2, 2), PixelRect{0, 0, 2, 2}, 2, 2, {});
     const ExrImage big = make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}, {},
