@@ -64,6 +64,8 @@ octray::Isa to_internal(Isa isa) {
             return octray::Isa::sse4_1;
         case Isa::avx2:
             return octray::Isa::avx2;
+        case Isa::avx512:
+            return octray::Isa::avx512;
         case Isa::automatic:
             break;
     }
@@ -78,6 +80,8 @@ Isa from_internal(octray::Isa isa) {
             return Isa::sse4_1;
         case octray::Isa::avx2:
             return Isa::avx2;
+        case octray::Isa::avx512:
+            return Isa::avx512;
         case octray::Isa::automatic:
             break;
     }

@@ -285,6 +285,12 @@ void set_up_scene(BenchRun& run, BenchScene& bs) {
 
 // ---- Rows ----
 
+// The packets octray's kernels trace in: 8 rays, and 16 through the BVH with AVX-512
+// (kernels/bvh_packet.h).
+const char* octray_mode(Isa isa, bool bvh) {
+    return isa == Isa::avx512 && bvh ? "packet16" : "packet8";
+}
+
 BenchRow base_row(const BenchRun& run, const std::string& spec, Workload w, const Variant& v) {
     BenchRow row;
     row.scene = spec;
@@ -371,7 +377,7 @@ void measure_octray_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun
             for (const SimdConfig& config : bs.simd_configs) {
                 BenchRow row = base_row(run, bs.spec, rs.workload, v);
                 row.system = "octray";
-                row.mode = "packet8";
+                row.mode = octray_mode(isa, config.bvh);
                 row.isa = isa_name(isa);
                 row.accel = config.bvh ? "bvh" : "none";
                 // The lanes rule the rays were traced under (secondary rays: their own).
@@ -453,7 +459,8 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile,
                 BenchRow row =
                     base_row(run, bs.spec, Workload::whitted, Variant{PixelOrder::tiled, tile});
                 row.system = "octray";
-                row.mode = path == RenderPath::simd ? "packet8" : "single";
+                row.mode = path == RenderPath::simd ? octray_mode(isa, config && config->bvh)
+                                                    : "single";
                 row.isa = path == RenderPath::simd ? isa_name(isa) : "scalar";
                 if (config) row.accel = config->bvh ? "bvh" : "none";
                 if (path == RenderPath::simd) {

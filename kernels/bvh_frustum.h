@@ -55,11 +55,14 @@ __m256 lane_mask8(std::uint32_t bits) {
         _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), lane_bit), lane_bit));
 }
 
-// The largest / smallest of v[i] over the lanes i in `bits` (not empty). Exact: min and
-// max do not round, so the order of the reduction does not matter.
+// The largest / smallest of v[i] over the lanes i in `bits` (not empty) of a traversal
+// packet (F: its registers). Exact: min and max do not round, so the order of the
+// reduction does not matter.
 template <class F>
 float masked_max(const float* v, std::uint32_t bits) {
-    if constexpr (F::size == 8) {
+    if constexpr (F::size == 16) {
+        return _mm512_mask_reduce_max_ps(static_cast<__mmask16>(bits), _mm512_load_ps(v));
+    } else if constexpr (F::size == 8) {
         const __m256 x =
             _mm256_blendv_ps(_mm256_set1_ps(-kInf), _mm256_load_ps(v), lane_mask8<F>(bits));
         __m128 m = _mm_max_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1));
@@ -76,7 +79,9 @@ float masked_max(const float* v, std::uint32_t bits) {
 }
 template <class F>
 float masked_min(const float* v, std::uint32_t bits) {
-    if constexpr (F::size == 8) {
+    if constexpr (F::size == 16) {
+        return _mm512_mask_reduce_min_ps(static_cast<__mmask16>(bits), _mm512_load_ps(v));
+    } else if constexpr (F::size == 8) {
         const __m256 x =
             _mm256_blendv_ps(_mm256_set1_ps(kInf), _mm256_load_ps(v), lane_mask8<F>(bits));
         __m128 m = _mm_min_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1));
@@ -95,7 +100,11 @@ float masked_min(const float* v, std::uint32_t bits) {
 template <class F>
 bool masked_all_equal(const float* v, std::uint32_t bits) {
     const float v0 = v[__builtin_ctz(bits)];
-    if constexpr (F::size == 8) {
+    if constexpr (F::size == 16) {
+        const __mmask16 eq =
+            _mm512_cmp_ps_mask(_mm512_load_ps(v), _mm512_set1_ps(v0), _CMP_EQ_OQ);
+        return (static_cast<std::uint32_t>(eq) & bits) == bits;
+    } else if constexpr (F::size == 8) {
         const __m256 eq = _mm256_cmp_ps(_mm256_load_ps(v), _mm256_set1_ps(v0), _CMP_EQ_OQ);
         const auto eq_bits = static_cast<std::uint32_t>(_mm256_movemask_ps(eq));
         return (eq_bits & bits) == bits;
@@ -106,8 +115,8 @@ bool masked_all_equal(const float* v, std::uint32_t bits) {
     }
 }
 
-// `live`: not empty.
-template <class F>
+// `live`: not empty. F: the node tests' registers (8 children); FR: the packet's.
+template <class F, class FR = F>
 PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
     using Plane = typename PacketFrustum<F>::Plane;
     const float* const inv[3] = {p.inv_x, p.inv_y, p.inv_z};
@@ -117,19 +126,19 @@ PacketFrustum<F> packet_frustum(const BvhPacket& p, std::uint32_t live) {
     const Plane maxs[3] = {&BvhNode8::max_x, &BvhNode8::max_y, &BvhNode8::max_z};
     PacketFrustum<F> f;
     for (int a = 0; a < 3; ++a) {
-        const float lo = masked_min<F>(inv[a], live), hi = masked_max<F>(inv[a], live);
+        const float lo = masked_min<FR>(inv[a], live), hi = masked_max<FR>(inv[a], live);
         const bool positive = lo > 0.0f;
         if (!positive && !(hi < 0.0f)) return f;  // mixed signs (or NaN): no bundle
-        const float near_max = masked_max<F>(positive ? lo_off[a] : hi_off[a], live);
-        const float far_min = masked_min<F>(positive ? hi_off[a] : lo_off[a], live);
+        const float near_max = masked_max<FR>(positive ? lo_off[a] : hi_off[a], live);
+        const float far_min = masked_min<FR>(positive ? hi_off[a] : lo_off[a], live);
         f.near[a] = positive ? mins[a] : maxs[a];
         f.far[a] = positive ? maxs[a] : mins[a];
         f.inv_lo[a] = F(lo), f.inv_hi[a] = F(hi);
         f.near_off[a] = F(near_max), f.far_off[a] = F(far_min);
     }
     f.valid = true;
-    f.one_origin = masked_all_equal<F>(p.ox, live) && masked_all_equal<F>(p.oy, live) &&
-                   masked_all_equal<F>(p.oz, live);
+    f.one_origin = masked_all_equal<FR>(p.ox, live) && masked_all_equal<FR>(p.oy, live) &&
+                   masked_all_equal<FR>(p.oz, live);
     return f;
 }
 

@@ -50,6 +50,23 @@
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
+// Rays per traversal packet. A translation unit that defines OCTRAY_TRAVERSAL_ARCH (the
+// AVX-512 one: xsimd::avx512f) traverses 16 rays at a time, one register per packet: two
+// of the stream's 8-ray packets, adjacent pixels, share every node visit and leaf load,
+// as embree's 16-wide packets do. Its node tests stay 8 lanes wide (the node's 8
+// children, in the kernel's Arch), as do its camera and shading kernels. Without it a
+// traversal packet is the stream's packet, in registers of the kernel's Arch.
+#ifdef OCTRAY_TRAVERSAL_ARCH
+template <class Arch>
+using RayArch = OCTRAY_TRAVERSAL_ARCH;
+constexpr std::uint32_t kTraversalWidth = 16;
+#else
+template <class Arch>
+using RayArch = Arch;
+constexpr std::uint32_t kTraversalWidth = kPacketWidth;
+#endif
+static_assert(kTraversalWidth % kPacketWidth == 0 && kTraversalWidth <= 16);
+
 // Entries of a traversal stack: a node pushes at most 8 children, and the builder keeps
 // the tree below 48 + 28 levels (kernels/bvh_sah.cpp, kMaxSahDepth).
 constexpr std::uint32_t kBvhStackSize = 1024;
@@ -63,21 +80,22 @@ constexpr float kBvhTinyDirection = 1e-18f;
 // One packet's rays as the traversal reads them, lane by lane in memory: the single-ray
 // traversal picks its lane's scalars from here.
 struct BvhPacket {
-    alignas(64) float ox[kPacketWidth], oy[kPacketWidth], oz[kPacketWidth];
-    alignas(64) float dx[kPacketWidth], dy[kPacketWidth], dz[kPacketWidth];
-    alignas(64) float a[kPacketWidth];  // V·V, as the sphere test computes it
-    alignas(64) float inv_x[kPacketWidth], inv_y[kPacketWidth], inv_z[kPacketWidth];
+    static constexpr std::uint32_t N = kTraversalWidth;
+    alignas(64) float ox[N], oy[N], oz[N];
+    alignas(64) float dx[N], dy[N], dz[N];
+    alignas(64) float a[N];  // V·V, as the sphere test computes it
+    alignas(64) float inv_x[N], inv_y[N], inv_z[N];
     // (O + margin) * inv and (O - margin) * inv: a widened slab [min - m, max + m] is
     // entered at min * inv - lo_off (positive direction) or max * inv - hi_off (negative).
-    alignas(64) float lo_off_x[kPacketWidth], lo_off_y[kPacketWidth], lo_off_z[kPacketWidth];
-    alignas(64) float hi_off_x[kPacketWidth], hi_off_y[kPacketWidth], hi_off_z[kPacketWidth];
+    alignas(64) float lo_off_x[N], lo_off_y[N], lo_off_z[N];
+    alignas(64) float hi_off_x[N], hi_off_y[N], hi_off_z[N];
     // Closest hit: the nearest hit so far (t, file index). Any hit: t_max.
-    alignas(64) float best_t[kPacketWidth], best_id[kPacketWidth];
+    alignas(64) float best_t[N], best_id[N];
 };
 
 struct BvhStacks {
     std::uint32_t packet_node[kBvhStackSize];
-    std::uint8_t packet_mask[kBvhStackSize];
+    std::uint16_t packet_mask[kBvhStackSize];  // lanes, one bit each
     std::uint32_t ray_node[kBvhStackSize];
 };
 
@@ -106,13 +124,26 @@ F safe_reciprocal(const F& d) {
 // coordinates past ~1e19, or an overflowing margin) a packet falls back to brute force.
 constexpr float kBvhFiniteLimit = 1e37f;
 
-// Loads a packet's rays into `p`; best_t starts at `t_far` (+inf or t_max), best_id at -1.
-// Returns the lanes whose box tests stay finite (kBvhFiniteLimit).
+// v[at ... at + size) of a stream `left` values long from v. Streams hold whole 8-ray
+// packets (kernel_types.h), so a 16-lane register whose upper half lies past them repeats
+// its lower half: finite rays, never read back.
+template <class F>
+F load_stream(const float* v, std::uint32_t at, std::uint32_t left) {
+    if constexpr (F::size == 16) {
+        if (left <= at + kPacketWidth) return _mm512_broadcast_f32x8(_mm256_load_ps(v + at));
+    }
+    (void)left;
+    return F::load_aligned(v + at);
+}
+
+// Loads a packet's rays (of a stream holding `count` rays) into `p`; best_t starts at
+// `t_far` (+inf or t_max), best_id at -1. Returns the lanes whose box tests stay finite
+// (kBvhFiniteLimit).
 template <class F>
 std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* oy,
                               const float* oz, const float* dx, const float* dy,
                               const float* dz, const float* t_far, std::uint32_t base,
-                              BvhPacket& p) {
+                              std::uint32_t count, BvhPacket& p) {
     constexpr std::uint32_t W = F::size;
     float box_max = 0.0f;  // no fmaxf: it is a libm call, not an instruction
     for (int a = 0; a < 3; ++a) {
@@ -121,9 +152,13 @@ std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* 
         box_max = box_max > hi ? box_max : hi;
     }
     std::uint32_t finite = 0;
-    for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
-        const V3<F> o = load3<F>(ox, oy, oz, base + at);
-        const V3<F> d = load3<F>(dx, dy, dz, base + at);
+    const std::uint32_t left = count - base;
+    const auto load = [&](const float* v, std::uint32_t at) {
+        return load_stream<F>(v + base, at, left);
+    };
+    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
+        const V3<F> o{load(ox, at), load(oy, at), load(oz, at)};
+        const V3<F> d{load(dx, at), load(dy, at), load(dz, at)};
         store3(o, p.ox, p.oy, p.oz, at);
         store3(d, p.dx, p.dy, p.dz, at);
         dot(d, d).store_aligned(p.a + at);
@@ -138,7 +173,7 @@ std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* 
         const V3<F> lo{o.x + m, o.y + m, o.z + m}, hi{o.x - m, o.y - m, o.z - m};
         store3(hadamard(lo, inv), p.lo_off_x, p.lo_off_y, p.lo_off_z, at);
         store3(hadamard(hi, inv), p.hi_off_x, p.hi_off_y, p.hi_off_z, at);
-        (t_far ? F::load_aligned(t_far + base + at) : F(kInf)).store_aligned(p.best_t + at);
+        (t_far ? load(t_far, at) : F(kInf)).store_aligned(p.best_t + at);
         F(-1.0f).store_aligned(p.best_id + at);
     }
     return finite;

@@ -19,9 +19,10 @@
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
-// Packets: the 8 rays against one child box at a time.
+// Packets: the packet's rays (kTraversalWidth) against one child box at a time.
 
 // Lanes of the packet whose widened box of child j meets the ray on [t_near, t_far[lane]].
+// F: the packet's registers.
 // Always inlined: a node runs it for each of its 8 children, and as a call (which GCC
 // chose) each one also paid for the call and a vzeroupper.
 template <class F>
@@ -34,16 +35,16 @@ template <class F>
     const F min_x(n.min_x[j]), max_x(n.max_x[j]), min_y(n.min_y[j]), max_y(n.max_y[j]);
     const F min_z(n.min_z[j]), max_z(n.max_z[j]);
     std::uint32_t bits = 0;
-    for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
+    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
         const F ix = F::load_aligned(p.inv_x + at), iy = F::load_aligned(p.inv_y + at),
                 iz = F::load_aligned(p.inv_z + at);
         // Either slab plane may be the near one (lanes differ in sign): sort per lane.
-        const F ax = xsimd::fms(min_x, ix, F::load_aligned(p.lo_off_x + at));
-        const F bx = xsimd::fms(max_x, ix, F::load_aligned(p.hi_off_x + at));
-        const F ay = xsimd::fms(min_y, iy, F::load_aligned(p.lo_off_y + at));
-        const F by = xsimd::fms(max_y, iy, F::load_aligned(p.hi_off_y + at));
-        const F az = xsimd::fms(min_z, iz, F::load_aligned(p.lo_off_z + at));
-        const F bz = xsimd::fms(max_z, iz, F::load_aligned(p.hi_off_z + at));
+        const F ax = fused_ms(min_x, ix, F::load_aligned(p.lo_off_x + at));
+        const F bx = fused_ms(max_x, ix, F::load_aligned(p.hi_off_x + at));
+        const F ay = fused_ms(min_y, iy, F::load_aligned(p.lo_off_y + at));
+        const F by = fused_ms(max_y, iy, F::load_aligned(p.hi_off_y + at));
+        const F az = fused_ms(min_z, iz, F::load_aligned(p.lo_off_z + at));
+        const F bz = fused_ms(max_z, iz, F::load_aligned(p.hi_off_z + at));
         const F tn = xsimd::max(xsimd::max(xsimd::min(ax, bx), xsimd::min(ay, by)),
                                 xsimd::max(xsimd::min(az, bz), t_near));
         const F tf = xsimd::min(xsimd::min(xsimd::max(ax, bx), xsimd::max(ay, by)),
@@ -81,16 +82,18 @@ void packet_child_keys(const BvhNode8& n, const BvhPacket& p, std::uint32_t rep,
 // origin: each child takes all of `mask`); these are independent (no branch between them,
 // so the CPU overlaps them), and the entered children are then placed by rank, without a
 // data-dependent branch: child j goes below every entered child nearer than it (ties: the
-// lower index nearer). The leaves among them start loading (prefetch_leaf).
+// lower index nearer). The leaves among them start loading (prefetch_leaf). F: the node
+// tests' registers; the packet's are FR.
 template <class F, bool kNearestFirst = true>
 void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket& p,
-                          const PacketFrustum<F>& fr, std::uint32_t mask, const F& t_near,
+                          const PacketFrustum<F>& fr, std::uint32_t mask, float t_near,
                           const float* t_far, BvhStacks& st, std::uint32_t& sp) {
+    using FR = xsimd::batch<float, RayArch<typename F::arch_type>>;
     constexpr std::uint32_t W = F::size;
     std::uint32_t lanes[kBvhWidth] = {}, entered = 0;
     alignas(64) float key[kBvhWidth];
     const std::uint32_t candidates =
-        fr.valid ? frustum_children<F>(n, fr, t_near, F(masked_max<F>(t_far, mask)), key)
+        fr.valid ? frustum_children<F>(n, fr, F(t_near), F(masked_max<FR>(t_far, mask)), key)
                  : used_children(n);
     if (fr.one_origin) {
         for (std::uint32_t j = 0; j < kBvhWidth; ++j) lanes[j] = mask;
@@ -98,7 +101,7 @@ void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket
     } else {
         for (std::uint32_t bits = candidates; bits != 0; bits &= bits - 1) {
             const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
-            lanes[j] = packet_child_lanes(n, j, p, t_near, t_far) & mask;
+            lanes[j] = packet_child_lanes(n, j, p, FR(t_near), t_far) & mask;
             entered |= static_cast<std::uint32_t>(lanes[j] != 0) << j;
         }
     }
@@ -114,7 +117,7 @@ void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket
         for (std::uint32_t bits = entered, slot = sp + count; bits != 0; bits &= bits - 1) {
             const auto j = static_cast<std::uint32_t>(__builtin_ctz(bits));
             st.packet_node[--slot] = n.child[j];
-            st.packet_mask[slot] = static_cast<std::uint8_t>(lanes[j]);
+            st.packet_mask[slot] = static_cast<std::uint16_t>(lanes[j]);
         }
         sp += count;
         return;
@@ -133,7 +136,7 @@ void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket
         const std::uint32_t slot =
             sp + count - 1 - static_cast<std::uint32_t>(__builtin_popcount(nearer & entered));
         st.packet_node[slot] = n.child[j];
-        st.packet_mask[slot] = static_cast<std::uint8_t>(lanes[j]);
+        st.packet_mask[slot] = static_cast<std::uint16_t>(lanes[j]);
     }
     sp += count;
 }
@@ -143,13 +146,14 @@ void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket
 template <class Arch>
 void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, float t_min,
                         BvhStacks& st) {
-    using F = xsimd::batch<float, Arch>;
+    using FN = xsimd::batch<float, Arch>;          // a node's children
+    using F = xsimd::batch<float, RayArch<Arch>>;  // the packet's rays
     constexpr std::uint32_t W = F::size;
-    constexpr std::uint32_t K = kPacketWidth / W;
+    constexpr std::uint32_t K = kTraversalWidth / W;
     const F tmin(t_min), zero(0.0f);
-    const PacketFrustum<F> fr = packet_frustum<F>(p, live);
+    const PacketFrustum<FN> fr = packet_frustum<FN, F>(p, live);
     std::uint32_t sp = 0;
-    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
+    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint16_t>(live);
     while (sp > 0) {
         --sp;
         const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp];
@@ -160,7 +164,7 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
             continue;
         }
         if ((node & kBvhLeafBit) == 0) {
-            push_packet_children(s, s.bvh_nodes[node], p, fr, mask, tmin, p.best_t, st, sp);
+            push_packet_children(s, s.bvh_nodes[node], p, fr, mask, t_min, p.best_t, st, sp);
             continue;
         }
         // A leaf: each sphere broadcast against the packet, as the brute-force kernel does,
@@ -208,13 +212,14 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
 template <class Arch>
 std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::uint32_t live,
                                   BvhStacks& st) {
-    using F = xsimd::batch<float, Arch>;
+    using FN = xsimd::batch<float, Arch>;          // a node's children
+    using F = xsimd::batch<float, RayArch<Arch>>;  // the packet's rays
     constexpr std::uint32_t W = F::size;
-    constexpr std::uint32_t K = kPacketWidth / W;
+    constexpr std::uint32_t K = kTraversalWidth / W;
     const F zero(0.0f);
-    const PacketFrustum<F> fr = packet_frustum<F>(p, live);
+    const PacketFrustum<FN> fr = packet_frustum<FN, F>(p, live);
     std::uint32_t done = 0, sp = 0;
-    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint8_t>(live);
+    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint16_t>(live);
     while (sp > 0 && done != live) {
         --sp;
         const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp] & ~done;
@@ -227,8 +232,8 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
             continue;
         }
         if ((node & kBvhLeafBit) == 0) {
-            push_packet_children<F, false>(s, s.bvh_nodes[node], p, fr, mask, zero, p.best_t,
-                                           st, sp);
+            push_packet_children<FN, false>(s, s.bvh_nodes[node], p, fr, mask, 0.0f, p.best_t,
+                                            st, sp);
             continue;
         }
         V3<F> o[K], d[K];

@@ -17,12 +17,14 @@ const char* isa_name(Isa isa) {
             return "sse4.1";
         case Isa::avx2:
             return "avx2";
+        case Isa::avx512:
+            return "avx512";
     }
     return "?";
 }
 
 std::optional<Isa> parse_isa(std::string_view name) {
-    for (Isa isa : {Isa::automatic, Isa::sse2, Isa::sse4_1, Isa::avx2})
+    for (Isa isa : {Isa::automatic, Isa::sse2, Isa::sse4_1, Isa::avx2, Isa::avx512})
         if (name == isa_name(isa)) return isa;
     return std::nullopt;
 }
@@ -34,6 +36,9 @@ CpuSupport cpu_support() {
     s.sse4_1 = arch.sse4_1;
     s.avx2 = arch.avx2;
     s.fma = arch.fma3_avx2;  // xsimd: AVX2 and the FMA3 CPUID bit
+    // libgcc's CPU model counts AVX-512 only where the OS saves the ZMM state (XCR0).
+    s.avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+               __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
     return s;
 }
 
@@ -48,11 +53,13 @@ bool isa_supported(Isa isa) {
             return s.sse4_1;
         case Isa::avx2:
             return s.avx2 && s.fma;
+        case Isa::avx512:
+            return s.avx2 && s.fma && s.avx512;
     }
     return false;
 }
 
-std::vector<Isa> compiled_isas() { return {Isa::sse2, Isa::sse4_1, Isa::avx2}; }
+std::vector<Isa> compiled_isas() { return {Isa::sse2, Isa::sse4_1, Isa::avx2, Isa::avx512}; }
 
 std::vector<Isa> supported_isas() {
     std::vector<Isa> out;
@@ -81,6 +88,8 @@ const kernels::KernelTable& kernel_table(Isa isa) {
             return kernels::kKernelsSse41;
         case Isa::avx2:
             return kernels::kKernelsAvx2;
+        case Isa::avx512:
+            return kernels::kKernelsAvx512;
         case Isa::automatic:
             break;
     }

@@ -16,7 +16,7 @@
 
 namespace octray {
 
-// "auto", "sse2", "sse4.1" or "avx2".
+// "auto", "sse2", "sse4.1", "avx2" or "avx512".
 const char* isa_name(Isa isa);
 std::optional<Isa> parse_isa(std::string_view name);
 
@@ -26,10 +26,12 @@ struct CpuSupport {
     bool sse4_1 = false;
     bool avx2 = false;
     bool fma = false;
+    bool avx512 = false;  // F, VL, BW and DQ, with the OS saving the ZMM state
 };
 CpuSupport cpu_support();
 
-// Whether the kernels for `isa` can run here (avx2 needs AVX2 and FMA).
+// Whether the kernels for `isa` can run here (avx2 needs AVX2 and FMA; avx512 those and
+// AVX-512 F, VL, BW and DQ).
 bool isa_supported(Isa isa);
 
 // Every ISA compiled into this binary, best last.

@@ -19,10 +19,16 @@
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
-// Lanes [base, base + 8) below count, as bits.
+// Lanes [base, base + kTraversalWidth) below count, as bits.
 inline std::uint32_t live_bits(std::uint32_t base, std::uint32_t count) {
     const std::uint32_t left = count - base;
-    return left >= kPacketWidth ? (1u << kPacketWidth) - 1u : (1u << left) - 1u;
+    return left >= kTraversalWidth ? (1u << kTraversalWidth) - 1u : (1u << left) - 1u;
+}
+
+// The packet-lane thresholds of a scene view in a traversal of kTraversalWidth rays: a
+// threshold above kPacketWidth means "single rays only" (SceneView) whatever the width.
+inline std::uint32_t traversal_min_lanes(std::uint32_t min_lanes) {
+    return min_lanes > kPacketWidth ? kTraversalWidth + 1 : min_lanes;
 }
 
 template <class Arch>
@@ -32,63 +38,73 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
         return closest_hit_all<Arch>(scene, rays, count, t_min, hits);
     // Secondary rays switch to single rays by their own rule (SceneView).
     SceneView s = scene;
-    if (t_min == 0.0f) s.bvh_packet_min_lanes = s.bvh_secondary_min_lanes;
-    using F = xsimd::batch<float, Arch>;
+    s.bvh_packet_min_lanes =
+        traversal_min_lanes(t_min == 0.0f ? s.bvh_secondary_min_lanes : s.bvh_packet_min_lanes);
+    using F = xsimd::batch<float, RayArch<Arch>>;  // the packet's rays
+    using FN = xsimd::batch<float, Arch>;          // the stream's
     constexpr std::uint32_t W = F::size;
     BvhPacket p;
     BvhStacks st;
     const F tmin(t_min);
-    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+    for (std::uint32_t base = 0; base < count; base += kTraversalWidth) {
         const std::uint32_t live = live_bits(base, count);
         if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
-                                nullptr, base, p) &
+                                nullptr, base, count, p) &
              live) != live) {
             // Box tests would overflow: this packet against every sphere.
             const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
                                 rays.dx + base,   rays.dy + base, rays.dz + base,
                                 rays.wr + base,   rays.wg + base, rays.wb + base,
                                 rays.pixel + base};
-            closest_hit_all<Arch>(s, one,
-                                  count - base < kPacketWidth ? count - base : kPacketWidth,
-                                  t_min, HitStream{hits.t + base, hits.object + base});
+            closest_hit_all<Arch>(
+                s, one, count - base < kTraversalWidth ? count - base : kTraversalWidth, t_min,
+                HitStream{hits.t + base, hits.object + base});
             continue;
         }
         bvh_closest_packet<Arch>(s, p, live, t_min, st);
         // Planes stay outside the tree.
-        for (std::uint32_t at = 0; at < kPacketWidth; at += W) {
+        for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
             F best_t = F::load_aligned(p.best_t + at),
               best_id = F::load_aligned(p.best_id + at);
             closest_planes(s, load3<F>(p.ox, p.oy, p.oz, at), load3<F>(p.dx, p.dy, p.dz, at),
                            tmin, best_t, best_id);
-            best_t.store_aligned(hits.t + base + at);
-            xsimd::to_int(best_id).store_aligned(hits.object + base + at);  // ids < 2^24
+            best_t.store_aligned(p.best_t + at);
+            best_id.store_aligned(p.best_id + at);
+        }
+        // Back to the stream by its own packets, none past its end.
+        for (std::uint32_t at = 0; at < kTraversalWidth && base + at < count; at += FN::size) {
+            FN::load_aligned(p.best_t + at).store_aligned(hits.t + base + at);
+            xsimd::to_int(FN::load_aligned(p.best_id + at))  // ids < 2^24
+                .store_aligned(hits.object + base + at);
         }
     }
 }
 
-// Whether each live lane of the 8 rays from `base` of `rays` is occluded, as bits.
+// Whether each live lane of the kTraversalWidth rays from `base` of `rays` (a stream of
+// `count`) is occluded, as bits.
 template <class Arch>
 std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std::uint32_t base,
-                              std::uint32_t live, BvhPacket& p, BvhStacks& st) {
-    using F = xsimd::batch<float, Arch>;
+                              std::uint32_t count, std::uint32_t live, BvhPacket& p,
+                              BvhStacks& st) {
+    using F = xsimd::batch<float, RayArch<Arch>>;
     constexpr std::uint32_t W = F::size;
     if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t_max,
-                            base, p) &
+                            base, count, p) &
          live) != live) {
         // Box tests would overflow: this packet against every sphere.
         const ShadowStream one{rays.ox + base,     rays.oy + base,     rays.oz + base,
                                rays.dx + base,     rays.dy + base,     rays.dz + base,
                                rays.t_max + base,  rays.term_r + base, rays.term_g + base,
                                rays.term_b + base, rays.parent + base};
-        std::uint32_t flags[kPacketWidth] = {};
+        std::uint32_t flags[kTraversalWidth] = {};
         any_hit_all<Arch>(s, one, static_cast<std::uint32_t>(32 - __builtin_clz(live)), flags);
         std::uint32_t bits = 0;
-        for (std::uint32_t i = 0; i < kPacketWidth; ++i) bits |= (flags[i] & 1u) << i;
+        for (std::uint32_t i = 0; i < kTraversalWidth; ++i) bits |= (flags[i] & 1u) << i;
         return bits & live;
     }
     // Planes first: a lane they occlude needs no traversal.
     std::uint32_t done = 0;
-    for (std::uint32_t at = 0; at < kPacketWidth; at += W)
+    for (std::uint32_t at = 0; at < kTraversalWidth; at += W)
         done |= mask_bits<F>(any_plane(s, load3<F>(p.ox, p.oy, p.oz, at),
                                        load3<F>(p.dx, p.dy, p.dz, at),
                                        F::load_aligned(p.best_t + at)))
@@ -133,16 +149,19 @@ void shadow_keys(const SceneView& s, const ShadowStream& rays, std::uint32_t at,
 }
 
 template <class Arch>
-void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
+void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t count,
              std::uint32_t* occluded) {
-    if (s.bvh_nodes == nullptr) return any_hit_all<Arch>(s, rays, count, occluded);
+    if (scene.bvh_nodes == nullptr) return any_hit_all<Arch>(scene, rays, count, occluded);
+    SceneView s = scene;
+    s.bvh_packet_min_lanes = traversal_min_lanes(s.bvh_packet_min_lanes);
     BvhPacket p;
     BvhStacks st;
     if (count < kShadowSortMin || s.sphere_count < s.bvh_shadow_sort_min_spheres) {
-        for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+        for (std::uint32_t base = 0; base < count; base += kTraversalWidth) {
             const std::uint32_t live = live_bits(base, count);
-            const std::uint32_t bits = occluded_packet<Arch>(s, rays, base, live, p, st);
-            for (std::uint32_t i = 0; i < kPacketWidth; ++i)
+            const std::uint32_t bits = occluded_packet<Arch>(s, rays, base, count, live, p, st);
+            // Whole stream packets (kernel_types.h), none past the stream's end.
+            for (std::uint32_t i = 0; i < kTraversalWidth && base + i < count; ++i)
                 occluded[base + i] = (bits >> i) & 1u;
         }
         return;
@@ -156,11 +175,12 @@ void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
     // (18 bits) above the ray's index in the batch (12 bits), two passes of 9 bits.
     static_assert(kShadowBatch <= 4096);
     alignas(64) std::uint32_t order[kShadowBatch], sorted[kShadowBatch];
+    constexpr std::uint32_t N = kTraversalWidth;
     struct Gathered {
-        alignas(64) float ox[kPacketWidth], oy[kPacketWidth], oz[kPacketWidth];
-        alignas(64) float dx[kPacketWidth], dy[kPacketWidth], dz[kPacketWidth];
-        alignas(64) float t_max[kPacketWidth], term[kPacketWidth];
-        std::uint32_t parent[kPacketWidth];
+        alignas(64) float ox[N], oy[N], oz[N];
+        alignas(64) float dx[N], dy[N], dz[N];
+        alignas(64) float t_max[N], term[N];
+        std::uint32_t parent[N];
     } g;
     const ShadowStream packet{g.ox,    g.oy,   g.oz,   g.dx,   g.dy,    g.dz,
                               g.t_max, g.term, g.term, g.term, g.parent};
@@ -180,17 +200,17 @@ void any_hit(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
                 to[start[(from[i] >> shift) & 511u]++] = from[i];
         }
         for (std::uint32_t i = 0; i < n; ++i) order[i] = from[i] & 4095u;  // from == order
-        for (std::uint32_t k = 0; k < n; k += kPacketWidth) {
+        for (std::uint32_t k = 0; k < n; k += N) {
             const std::uint32_t live = live_bits(k, n);
-            for (std::uint32_t l = 0; l < kPacketWidth; ++l) {
+            for (std::uint32_t l = 0; l < N; ++l) {
                 // Dead lanes repeat the first ray: finite values, never read back.
                 const std::uint32_t r = first + order[(live >> l & 1u) != 0 ? k + l : k];
                 g.ox[l] = rays.ox[r], g.oy[l] = rays.oy[r], g.oz[l] = rays.oz[r];
                 g.dx[l] = rays.dx[r], g.dy[l] = rays.dy[r], g.dz[l] = rays.dz[r];
                 g.t_max[l] = rays.t_max[r], g.term[l] = 0.0f, g.parent[l] = 0;
             }
-            const std::uint32_t bits = occluded_packet<Arch>(s, packet, 0, live, p, st);
-            for (std::uint32_t l = 0; l < kPacketWidth && k + l < n; ++l)
+            const std::uint32_t bits = occluded_packet<Arch>(s, packet, 0, N, live, p, st);
+            for (std::uint32_t l = 0; l < N && k + l < n; ++l)
                 occluded[first + order[k + l]] = (bits >> l) & 1u;
         }
     }

@@ -9,6 +9,7 @@ enum class Isa {
     sse2,       // baseline x86-64: two 4-wide registers per 8-wide packet
     sse4_1,     // two 4-wide registers per packet, hardware floor and blend
     avx2,       // AVX2 + FMA: one 8-wide register per packet
+    avx512,     // AVX-512 F/VL/BW/DQ: AVX2's kernels, BVH traversal 16 rays at a time
 };
 
 }  // namespace octray

@@ -1,7 +1,7 @@
 #pragma once
 // One table of kernel entry points per ISA, each defined in its own translation unit
-// (kernels_avx2.cpp, kernels_sse41.cpp, kernels_sse2.cpp) and picked at run time by
-// kernels/dispatch.h. Plain data only (see kernels/README.md, "the ODR rule").
+// (kernels_avx512.cpp, kernels_avx2.cpp, kernels_sse41.cpp, kernels_sse2.cpp) and picked at run
+// time by kernels/dispatch.h. Plain data only (see kernels/README.md, "the ODR rule").
 
 #include <cstdint>
 
@@ -13,7 +13,8 @@ namespace octray::kernels {
 struct KernelTable {
     Isa isa;
     const char* name;
-    std::uint32_t lanes_per_register;  // 8 (AVX2) or 4 (SSE): registers per packet = 8 / this
+    std::uint32_t
+        lanes_per_register;  // 8 (AVX2, AVX-512) or 4 (SSE): registers per packet = 8 / this
 
     // Primary rays for `count` camera samples; returns how many rays it wrote (the
     // fisheye drops samples outside its image circle). Weights are 1.
@@ -37,5 +38,6 @@ struct KernelTable {
 extern const KernelTable kKernelsSse2;
 extern const KernelTable kKernelsSse41;
 extern const KernelTable kKernelsAvx2;
+extern const KernelTable kKernelsAvx512;
 
 }  // namespace octray::kernels

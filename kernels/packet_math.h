@@ -19,7 +19,9 @@
 // as in the reference: xsimd's own versions differ by ulps.
 //
 // Packets are 8 rays (kPacketWidth). A kernel walks a stream in packets; a packet is
-// K = 8 / batch::size registers (one on AVX2, two on SSE).
+// K = 8 / batch::size registers (one on AVX2, two on SSE). The AVX-512 translation unit
+// runs these kernels 8 lanes wide too, and only its BVH traversal 16 rays at a time
+// (bvh_packet.h, kTraversalWidth).
 
 #ifndef OCTRAY_KERNEL_NAMESPACE
 #error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"
@@ -104,6 +106,16 @@ void store3(const V3<F>& v, float* x, float* y, float* z, std::uint32_t i) {
     v.z.store_aligned(z + i);
 }
 
+// a * b - c, fused. xsimd 8.1 fuses only on its FMA3 architectures; AVX-512 has the
+// instruction too.
+template <class F>
+F fused_ms(const F& a, const F& b, const F& c) {
+    if constexpr (F::size == 16)
+        return _mm512_fmsub_ps(a, b, c);
+    else
+        return xsimd::fms(a, b, c);
+}
+
 // Lanes [base, base + size) that lie below `count`.
 template <class F>
 auto live_lanes(std::uint32_t base, std::uint32_t count) {
@@ -148,10 +160,12 @@ F gather(const T* base, const LaneIndex& ix) {
     }
 }
 
-// Bit i set when lane i of the mask is (movmskps).
+// Bit i set when lane i of the mask is (movmskps; AVX-512 masks are bits already).
 template <class F, class M>
 std::uint32_t mask_bits(const M& m) {
-    if constexpr (F::size == 8) {
+    if constexpr (F::size == 16) {
+        return static_cast<std::uint32_t>(static_cast<__mmask16>(m));
+    } else if constexpr (F::size == 8) {
         return static_cast<std::uint32_t>(_mm256_movemask_ps(static_cast<__m256>(m)));
     } else {
         return static_cast<std::uint32_t>(_mm_movemask_ps(static_cast<__m128>(m)));

@@ -262,7 +262,7 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         ->delimiter(',')
         ->type_name("LIST");
     cmd->add_option("--isa", a->isas,
-                    "octray kernel ISAs: auto, sse2, sse4.1, avx2 [default: auto]")
+                    "octray kernel ISAs: auto, sse2, sse4.1, avx2, avx512 [default: auto]")
         ->delimiter(',')
         ->type_name("LIST");
     cmd->add_option(

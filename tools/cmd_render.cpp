@@ -432,10 +432,10 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->capture_default_str();
     cmd->add_option(
            "--isa", args->isa,
-           "Instruction set of the simd path: auto (the best this CPU has), avx2,\n"
-           "sse4.1 or sse2 (`octray info` lists them; the image does not depend on it)")
+           "Instruction set of the simd path: auto (the best this CPU has), avx512,\n"
+           "avx2, sse4.1 or sse2 (`octray info` lists them; the image does not depend on it)")
         ->type_name("ISA")
-        ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
+        ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
     cmd->add_option(
            "--accel", args->accel,

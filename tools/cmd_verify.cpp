@@ -180,9 +180,10 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
                     "Frames of an animated scene to verify, as render takes them: 5, 1-100,\n"
                     "1-100:2,150 [default: frame 0]")
         ->type_name("SPEC");
-    cmd->add_option("--isa", args->isa, "ISA of the simd path: auto, avx2, sse4.1, sse2")
+    cmd->add_option("--isa", args->isa,
+                    "ISA of the simd path: auto, avx512, avx2, sse4.1, sse2")
         ->type_name("ISA")
-        ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
+        ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
     cmd->add_option("--fail", args->fail,
                     "A pixel fails when any channel differs by more than X (" +

@@ -272,9 +272,9 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->check(quiet(CLI::IsMember({"scalar", "simd"})))
         ->capture_default_str();
     cmd->add_option("--isa", args->isa,
-                    "Instruction set of the simd path: auto, avx2, sse4.1 or sse2")
+                    "Instruction set of the simd path: auto, avx512, avx2, sse4.1 or sse2")
         ->type_name("ISA")
-        ->check(quiet(CLI::IsMember({"auto", "avx2", "sse4.1", "sse2"})))
+        ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
     cmd->footer(
         "The command prints a URL such as http://127.0.0.1:8090/?token=3f9c...: open it in a\n"

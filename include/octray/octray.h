@@ -149,9 +149,10 @@ enum class Isa {
     sse2,
     sse4_1,
     avx2,
+    avx512,  // AVX-512 F/VL/BW/DQ
 };
 
-// "auto", "sse2", "sse4.1", "avx2".
+// "auto", "sse2", "sse4.1", "avx2", "avx512".
 const char* isa_name(Isa isa);
 // The ISAs this CPU can run, best last (never Isa::automatic).
 std::vector<Isa> supported_isas();

@@ -27,7 +27,8 @@ template <Isa I>
 struct IsaTag {
     static constexpr Isa isa = I;
 };
-using Isas = ::testing::Types<IsaTag<Isa::sse2>, IsaTag<Isa::sse4_1>, IsaTag<Isa::avx2>>;
+using Isas = ::testing::Types<IsaTag<Isa::sse2>, IsaTag<Isa::sse4_1>, IsaTag<Isa::avx2>,
+                              IsaTag<Isa::avx512>>;
 
 std::size_t padded(std::size_t n) {
     return (n + kPacketWidth - 1) / kPacketWidth * kPacketWidth;
@@ -388,16 +389,19 @@ TYPED_TEST(KernelTest, ShadingNeverProducesNaN) {
 }
 
 TEST(KernelDispatch, ParsesAndResolvesIsas) {
+    EXPECT_EQ(parse_isa("avx512"), Isa::avx512);
     EXPECT_EQ(parse_isa("avx2"), Isa::avx2);
     EXPECT_EQ(parse_isa("sse4.1"), Isa::sse4_1);
     EXPECT_EQ(parse_isa("sse2"), Isa::sse2);
     EXPECT_EQ(parse_isa("auto"), Isa::automatic);
-    EXPECT_FALSE(parse_isa("avx512"));
+    EXPECT_FALSE(parse_isa("AVX2"));
+    EXPECT_FALSE(parse_isa("neon"));
     const Isa best = resolve_isa(Isa::automatic);
     EXPECT_NE(best, Isa::automatic);
     EXPECT_EQ(best, supported_isas().back());
     EXPECT_EQ(kernel_table(best).isa, best);
     for (Isa isa : compiled_isas()) EXPECT_STREQ(kernel_table(isa).name, isa_name(isa));
+    EXPECT_EQ(kernel_table(Isa::avx512).lanes_per_register, 8u);
     EXPECT_EQ(kernel_table(Isa::avx2).lanes_per_register, 8u);
     EXPECT_EQ(kernel_table(Isa::sse2).lanes_per_register, 4u);
 }

@@ -22,7 +22,7 @@ it), and so does `assemble`, which joins them. `--shard auto` reads the environm
 task 0 of a two-task Slurm array (SLURM_ARRAY_TASK_ID=0, SLURM_ARRAY_TASK_COUNT=2).
 
 "Numbers aside": every number in a sample line matches any number, and an instruction
-set name (avx2, sse4.1, sse2) any of them, since both depend on the machine.
+set name (avx512, avx2, sse4.1, sse2) any of them, since both depend on the machine.
 """
 
 import os
@@ -34,7 +34,7 @@ import tempfile
 
 SMALL = {"--width": "64", "--height": "36"}
 ENV = {"SLURM_ARRAY_TASK_ID": "0", "SLURM_ARRAY_TASK_COUNT": "2"}
-ISAS = ("avx2", "sse4.1", "sse2")
+ISAS = ("avx512", "avx2", "sse4.1", "sse2")
 
 
 def marked_blocks(readme_path):

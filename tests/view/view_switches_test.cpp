@@ -68,7 +68,9 @@ TEST(ViewSwitches, PathAndIsaAreParsedAndChecked) {
     EXPECT_EQ(status, 400);
     EXPECT_EQ(message, "settings.isa: this CPU cannot run avx2 (it runs auto, sse2, sse4.1)");
     EXPECT_EQ(refusal(R"({"isa": "avx512"})", limits).second,
-              "settings.isa: expected one of auto, sse2, sse4.1, found \"avx512\"");
+              "settings.isa: this CPU cannot run avx512 (it runs auto, sse2, sse4.1)");
+    EXPECT_EQ(refusal(R"({"isa": "neon"})", limits).second,
+              "settings.isa: expected one of auto, sse2, sse4.1, found \"neon\"");
     EXPECT_EQ(refusal(R"({"path": "gpu"})", limits).second,
               "settings.path: expected simd (8-ray packets) or scalar (the reference "
               "renderer), found \"gpu\"");
@@ -236,7 +238,7 @@ TEST_F(SwitchesTest, PathAndIsaSwitchesRenderWithThem) {
             << name;
         ASSERT_EQ(post("/api/settings", R"({"path": "scalar", "isa": "auto"})")->status, 200);
     }
-    for (const char* body : {R"({"isa": "avx512"})", R"({"path": "gpu"})", R"({"isa": 1})"}) {
+    for (const char* body : {R"({"isa": "neon"})", R"({"path": "gpu"})", R"({"isa": 1})"}) {
         const auto result = post("/api/settings", body);
         ASSERT_TRUE(result);
         EXPECT_EQ(result->status, 400) << body;
