@@ -223,7 +223,7 @@ def isa_chart(plt, rows):
     threads = max(r["threads"] for r in octray)
     at = [r for r in octray if r["threads"] == threads]
     top = best(at, lambda r: (r["scene"], r["ray_kind"], r["isa"]))
-    isas = ordered((r["isa"] for r in at), ("scalar", "sse2", "sse4.1", "avx2"))
+    isas = ordered((r["isa"] for r in at), ("scalar", "sse2", "sse4.1", "avx2", "avx512"))
     groups = groups_of(at)
     fig, axis = plt.subplots(figsize=(max(6.0, 0.9 * len(groups) + 2), 4.2))
     width = 0.8 / len(isas)
