@@ -222,7 +222,7 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
         return bvh;
     }
 
-    // The builder's buffers (references twice, binary nodes) on huge pages: core/aligned.h.
+    // The builder's buffers (references, binary nodes) on huge pages: core/aligned.h.
     using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef, Pages::huge>>;
     PrimRefs refs(n);
     // Each sphere's box c ± sqrt(r2), rounded outwards: it holds every point of the sphere
@@ -258,11 +258,7 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
     // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
     std::vector<BinaryNode, UninitializedAllocator<BinaryNode, Pages::huge>> binary(
         2 * static_cast<std::size_t>(n) - 1);
-    {
-        PrimRefs scratch(n);
-        build_binary_tree(refs.data(), scratch.data(), binary.data(),
-                          range_bounds(refs.data(), 0, n), n);
-    }
+    build_binary_tree(refs.data(), binary.data(), range_bounds(refs.data(), 0, n), n);
     const Box root{_mm_setr_ps(binary[0].lo[0], binary[0].lo[1], binary[0].lo[2], 0.0f),
                    _mm_setr_ps(binary[0].hi[0], binary[0].hi[1], binary[0].hi[2], 0.0f)};
 

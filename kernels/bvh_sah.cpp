@@ -7,7 +7,8 @@
 // so any TBB split gives the same bins); a partition is one serial pass over its range; each
 // binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
 // preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
-// depends on which thread got there first.
+// depends on which thread got there first. Partitions reorder a node's own range in place,
+// which no other task touches meanwhile.
 
 #include "kernels/bvh_sah.h"
 
@@ -203,32 +204,35 @@ Split best_split(const Bins& bins, const BinMapping& m) {
     return best;
 }
 
-// Copies the spheres of [b, e) from `src` to `dst`, those whose center lies in bins
-// [0, bin] of `Axis` first, and returns where the rest begin; the two sides' center
-// bounds come out on the way. Branch-free (which side a sphere goes to is a coin toss
-// the CPU cannot predict): each sphere goes to the next free slot at the front or at the
-// back of [b, e) (the right side comes out reversed). The axis is a template argument so
-// that its lane is picked by a shuffle, not by a round trip through memory.
+// Reorders the spheres of [b, e) in place, those whose center lies in bins [0, bin] of
+// `Axis` first, and returns where the rest begin; the two sides' center bounds come out on
+// the way. In place, so the build needs no second array of references (its pages cost a
+// fault each, the time to clear them, and cache space). Branch-free (which side a sphere
+// goes to is a coin toss the CPU cannot predict): [b, l) holds the left spheres found so
+// far and [l, i) the right ones; each sphere is swapped with the first right one at l, and
+// l moves on only past a left one (a right sphere swaps with a right one: the right side
+// comes out permuted, the same way for any thread count). The axis is a template argument
+// so that its lane is picked by a shuffle, not by a round trip through memory.
 template <int Axis>
-std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
+std::uint32_t partition_on(PrimRef* refs, std::uint32_t b, std::uint32_t e,
                            const BinMapping& m, int bin, Box& left_centers,
                            Box& right_centers) {
     constexpr int kBroadcast = Axis * 0x55;  // _MM_SHUFFLE(Axis, Axis, Axis, Axis)
     const __m128i last_left = _mm_set1_epi32(bin);
     const __m128 all_ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
     Box lc, rc;
-    PrimRef* front = dst + b;
-    PrimRef* back = dst + e;
-    for (std::uint32_t i = b; i < e; ++i) {
-        const PrimRef p = src[i];
+    PrimRef* l = refs + b;
+    for (PrimRef *i = refs + b, *end = refs + e; i < end; ++i) {
+        const PrimRef p = *i;
         const __m128 c = p.center();
         // All ones in every lane where the bin on `Axis` lies right of `bin`.
         const __m128i right_mask =
             _mm_shuffle_epi32(_mm_cmpgt_epi32(m.bins(c), last_left), kBroadcast);
         const std::int32_t right = _mm_cvtsi128_si32(right_mask);  // 0 or -1
-        *(right ? back - 1 : front) = p;
-        front += 1 + right;
-        back += right;
+        const PrimRef q = *l;
+        *i = q;
+        *l = p;
+        l += 1 + right;
         // The side's bounds grow by the center, the other side's by NaN, which min and
         // max pass over: minps and maxps return their second operand where either is
         // NaN, and all ones (the mask) is a NaN.
@@ -240,55 +244,46 @@ std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, st
     }
     left_centers = lc;
     right_centers = rc;
-    return static_cast<std::uint32_t>(front - dst);
+    return static_cast<std::uint32_t>(l - refs);
 }
 
-std::uint32_t partition(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
-                        const BinMapping& m, int axis, int bin, Box& left_centers,
-                        Box& right_centers) {
+std::uint32_t partition(PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+                        int axis, int bin, Box& left_centers, Box& right_centers) {
     switch (axis) {
         case 0:
-            return partition_on<0>(src, dst, b, e, m, bin, left_centers, right_centers);
+            return partition_on<0>(refs, b, e, m, bin, left_centers, right_centers);
         case 1:
-            return partition_on<1>(src, dst, b, e, m, bin, left_centers, right_centers);
+            return partition_on<1>(refs, b, e, m, bin, left_centers, right_centers);
         default:
-            return partition_on<2>(src, dst, b, e, m, bin, left_centers, right_centers);
+            return partition_on<2>(refs, b, e, m, bin, left_centers, right_centers);
     }
 }
 
 class Builder {
   public:
-    // The spheres start in `refs` and end there in leaf order; the partitions move them
-    // back and forth between `refs` and `scratch` (as many spheres), level by level.
-    Builder(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes)
-        : refs_(refs), scratch_(scratch), nodes_(nodes) {}
+    // The spheres are reordered in `refs`, node by node, into leaf order.
+    Builder(PrimRef* refs, BinaryNode* nodes) : refs_(refs), nodes_(nodes) {}
 
-    void build(const RangeBounds& rb, std::uint32_t n) { build(0, 0, n, rb, 0, refs_); }
+    void build(const RangeBounds& rb, std::uint32_t n) { build(0, 0, n, rb, 0); }
 
   private:
-    // Builds the subtree of spheres [b, e), which lie in `src` (refs_ or scratch_), into
-    // slots [slot, slot + 2(e - b) - 1).
+    // Builds the subtree of spheres [b, e) into slots [slot, slot + 2(e - b) - 1).
     void build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
-               std::uint32_t depth, PrimRef* src) {
+               std::uint32_t depth) {
         BinaryNode& node = nodes_[slot];
         for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
         node.mid = 0;
         const std::uint32_t n = e - b;
-        const auto leaf = [&] {
-            if (src != refs_) std::copy(src + b, src + e, refs_ + b);
-        };
         // A split costs at least one traversal step, more than testing this many spheres:
         // the SAH would choose the leaf, so the binning is skipped.
-        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return leaf();
+        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return;
 
-        PrimRef* const other = src == refs_ ? scratch_ : refs_;
-        PrimRef* children_src = src;
         std::uint32_t mid = 0;
         RangeBounds left, right;
         if (depth < kMaxSahDepth) {
             const BinMapping m(rb.centers, n);
             Bins bins(m.count);
-            bin_range(src, b, e, m, bins);
+            bin_range(refs_, b, e, m, bins);
             const Split split = best_split(bins, m);
             const float area = rb.box.half_area();
             const float leaf_cost = kIntersectionCost * static_cast<float>(n);
@@ -296,37 +291,34 @@ class Builder {
                 split.axis < 0 ? kInf
                 : area > 0.0f  ? kTraversalCost + kIntersectionCost * split.cost / area
                                : kTraversalCost + kIntersectionCost * static_cast<float>(n);
-            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return leaf();
+            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return;
             if (split.axis >= 0) {
-                mid = partition(src, other, b, e, m, split.axis, split.bin, left.centers,
+                mid = partition(refs_, b, e, m, split.axis, split.bin, left.centers,
                                 right.centers);
-                children_src = other;
                 left.box = split.left;
                 right.box = split.right;
             }
         } else if (n <= kMaxLeafSize) {
-            return leaf();
+            return;
         }
         // Every center in one bin (coincident spheres) or too deep: the middle index.
         if (mid <= b || mid >= e) {
             mid = b + n / 2;
-            left = range_bounds(src, b, mid);
-            right = range_bounds(src, mid, e);
+            left = range_bounds(refs_, b, mid);
+            right = range_bounds(refs_, mid, e);
         }
         node.mid = mid;
         const std::uint32_t left_slot = slot + 1, right_slot = slot + 2 * (mid - b);
         if (n >= kParallelSubtree) {
-            tbb::parallel_invoke(
-                [&] { build(left_slot, b, mid, left, depth + 1, children_src); },
-                [&] { build(right_slot, mid, e, right, depth + 1, children_src); });
+            tbb::parallel_invoke([&] { build(left_slot, b, mid, left, depth + 1); },
+                                 [&] { build(right_slot, mid, e, right, depth + 1); });
         } else {
-            build(left_slot, b, mid, left, depth + 1, children_src);
-            build(right_slot, mid, e, right, depth + 1, children_src);
+            build(left_slot, b, mid, left, depth + 1);
+            build(right_slot, mid, e, right, depth + 1);
         }
     }
 
     PrimRef* refs_;
-    PrimRef* scratch_;
     BinaryNode* nodes_;
 };
 
@@ -349,9 +341,9 @@ RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e) 
         });
 }
 
-void build_binary_tree(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes,
-                       const RangeBounds& rb, std::uint32_t n) {
-    Builder(refs, scratch, nodes).build(rb, n);
+void build_binary_tree(PrimRef* refs, BinaryNode* nodes, const RangeBounds& rb,
+                       std::uint32_t n) {
+    Builder(refs, nodes).build(rb, n);
 }
 
 }  // namespace octray::bvh_sah

@@ -95,9 +95,9 @@ RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e);
 
 // Builds the binary tree over the n spheres of `refs` (bounds `rb`) into nodes[0, 2n - 1):
 // node 0 the root, a left child right after its parent. The spheres end in `refs` in leaf
-// order; `scratch` (n references) is the partitions' other buffer. In parallel with TBB
-// over subtrees; every node and every byte of `refs` the same for any thread count.
-void build_binary_tree(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes,
-                       const RangeBounds& rb, std::uint32_t n);
+// order (the partitions reorder them in place). In parallel with TBB over subtrees; every
+// node and every byte of `refs` the same for any thread count.
+void build_binary_tree(PrimRef* refs, BinaryNode* nodes, const RangeBounds& rb,
+                       std::uint32_t n);
 
 }  // namespace octray::bvh_sah
