@@ -5,10 +5,10 @@
 // Determinism: every decision depends only on the spheres of a subtree and its place in
 // the tree. Binning reduces boxes with min/max and counts with integer sums (both exact,
 // so any TBB split gives the same bins); a partition is one serial pass over its range; each
-// binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
-// preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
-// depends on which thread got there first. Partitions reorder a node's own range in place,
-// which no other task touches meanwhile.
+// binary subtree over primitives [b, e) writes the node slots [s, s + (e - b) - 1) of a
+// preallocated array (inner nodes only; left child at s + 1, right child at s + mid - b),
+// so no slot depends on which thread got there first. Partitions reorder a node's own range in
+// place, which no other task touches meanwhile.
 
 #include "kernels/bvh_sah.h"
 
@@ -214,9 +214,8 @@ Split best_split(const Bins& bins, const BinMapping& m) {
 // comes out permuted, the same way for any thread count). The axis is a template argument
 // so that its lane is picked by a shuffle, not by a round trip through memory.
 template <int Axis>
-std::uint32_t partition_on(PrimRef* refs, std::uint32_t b, std::uint32_t e,
-                           const BinMapping& m, int bin, Box& left_centers,
-                           Box& right_centers) {
+std::uint32_t partition_on(PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+                           int bin, Box& left_centers, Box& right_centers) {
     constexpr int kBroadcast = Axis * 0x55;  // _MM_SHUFFLE(Axis, Axis, Axis, Axis)
     const __m128i last_left = _mm_set1_epi32(bin);
     const __m128 all_ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
@@ -264,19 +263,17 @@ class Builder {
     // The spheres are reordered in `refs`, node by node, into leaf order.
     Builder(PrimRef* refs, BinaryNode* nodes) : refs_(refs), nodes_(nodes) {}
 
-    void build(const RangeBounds& rb, std::uint32_t n) { build(0, 0, n, rb, 0); }
+    bool build(const RangeBounds& rb, std::uint32_t n) { return !build(0, 0, n, rb, 0); }
 
   private:
-    // Builds the subtree of spheres [b, e) into slots [slot, slot + 2(e - b) - 1).
-    void build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
+    // Builds the subtree of spheres [b, e) into slots [slot, slot + (e - b) - 1); returns
+    // whether it is a leaf (and then writes no node).
+    bool build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
                std::uint32_t depth) {
-        BinaryNode& node = nodes_[slot];
-        for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
-        node.mid = 0;
         const std::uint32_t n = e - b;
         // A split costs at least one traversal step, more than testing this many spheres:
         // the SAH would choose the leaf, so the binning is skipped.
-        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return;
+        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return true;
 
         std::uint32_t mid = 0;
         RangeBounds left, right;
@@ -291,7 +288,7 @@ class Builder {
                 split.axis < 0 ? kInf
                 : area > 0.0f  ? kTraversalCost + kIntersectionCost * split.cost / area
                                : kTraversalCost + kIntersectionCost * static_cast<float>(n);
-            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return;
+            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return true;
             if (split.axis >= 0) {
                 mid = partition(refs_, b, e, m, split.axis, split.bin, left.centers,
                                 right.centers);
@@ -299,7 +296,7 @@ class Builder {
                 right.box = split.right;
             }
         } else if (n <= kMaxLeafSize) {
-            return;
+            return true;
         }
         // Every center in one bin (coincident spheres) or too deep: the middle index.
         if (mid <= b || mid >= e) {
@@ -307,15 +304,21 @@ class Builder {
             left = range_bounds(refs_, b, mid);
             right = range_bounds(refs_, mid, e);
         }
-        node.mid = mid;
-        const std::uint32_t left_slot = slot + 1, right_slot = slot + 2 * (mid - b);
+        const std::uint32_t left_slot = slot + 1, right_slot = slot + (mid - b);
+        bool left_leaf, right_leaf;
         if (n >= kParallelSubtree) {
-            tbb::parallel_invoke([&] { build(left_slot, b, mid, left, depth + 1); },
-                                 [&] { build(right_slot, mid, e, right, depth + 1); });
+            tbb::parallel_invoke(
+                [&] { left_leaf = build(left_slot, b, mid, left, depth + 1); },
+                [&] { right_leaf = build(right_slot, mid, e, right, depth + 1); });
         } else {
-            build(left_slot, b, mid, left, depth + 1);
-            build(right_slot, mid, e, right, depth + 1);
+            left_leaf = build(left_slot, b, mid, left, depth + 1);
+            right_leaf = build(right_slot, mid, e, right, depth + 1);
         }
+        BinaryNode& node = nodes_[slot];
+        for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
+        node.mid =
+            mid | (left_leaf ? kBinaryLeftLeaf : 0u) | (right_leaf ? kBinaryRightLeaf : 0u);
+        return false;
     }
 
     PrimRef* refs_;
@@ -341,9 +344,9 @@ RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e) 
         });
 }
 
-void build_binary_tree(PrimRef* refs, BinaryNode* nodes, const RangeBounds& rb,
+bool build_binary_tree(PrimRef* refs, BinaryNode* nodes, const RangeBounds& rb,
                        std::uint32_t n) {
-    Builder(refs, nodes).build(rb, n);
+    return Builder(refs, nodes).build(rb, n);
 }
 
 }  // namespace octray::bvh_sah
