@@ -35,16 +35,18 @@ struct BinMapping {
 
     BinMapping(const Box& centers, std::uint32_t n) {
         count = static_cast<int>(std::min<std::uint32_t>(8 + n / 20, kBins));
-        alignas(16) float s[4] = {0, 0, 0, 0};
-        for (int a = 0; a < 3; ++a) {
-            const float extent = centers.hi_at(a) - centers.lo_at(a);
-            // Slightly fewer than `count` bins per extent, so the top center maps to the
-            // last bin rather than past it (clamped anyway).
-            s[a] = extent > 0.0f ? (static_cast<float>(count) * 0.99999f) / extent : 0.0f;
-            if (!(s[a] < kInf)) s[a] = 0.0f;  // denormal extent
-        }
+        // Slightly fewer than `count` bins per extent, so the top center maps to the last
+        // bin rather than past it (clamped anyway). 0 where the extent is 0 (or NaN), where
+        // the quotient overflows (a denormal extent), and in w. All three axes at once:
+        // each node makes one mapping, and lanes written one by one and read back as a
+        // vector would wait on a failed store forwarding.
+        const __m128 extent = _mm_sub_ps(centers.hi, centers.lo);
+        const __m128 s = _mm_div_ps(_mm_set1_ps(static_cast<float>(count) * 0.99999f), extent);
+        const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+        const __m128 valid = _mm_and_ps(xyz, _mm_and_ps(_mm_cmpgt_ps(extent, _mm_setzero_ps()),
+                                                        _mm_cmplt_ps(s, _mm_set1_ps(kInf))));
         lo = centers.lo;
-        scale = _mm_load_ps(s);
+        scale = _mm_and_ps(valid, s);
         extent_mask = _mm_cmpgt_ps(scale, _mm_setzero_ps());
     }
     __m128i bins(__m128 center) const {
