@@ -72,10 +72,26 @@ __m128i select(__m128 mask, __m128i a, __m128i b) {
 // Per axis and bin: the spheres' boxes and their count (the children's center bounds come
 // out of the partition, which visits every sphere anyway). Counts are kept per bin with
 // the three axes in lanes, as the sweep reads them.
+// A bin's box: a Box without initialisers, so that a node's Bins clear only the bins it
+// uses (8 + n/20 per axis; Box's initialisers would write all kBins of them every time).
+struct BinBox {
+    __m128 lo, hi;
+    BinBox& operator=(const Box& b) {
+        lo = b.lo, hi = b.hi;
+        return *this;
+    }
+    operator Box() const { return Box{lo, hi}; }
+    void grow(const Box& b) {
+        lo = _mm_min_ps(lo, b.lo);
+        hi = _mm_max_ps(hi, b.hi);
+    }
+};
+
 struct Bins {
-    Box box[3][kBins];
+    BinBox box[3][kBins];
     alignas(16) std::int32_t count[kBins][4];
 
+    Bins() = default;  // nothing written: BinsAvx::store_to() fills it
     explicit Bins(int bins) {
         for (int k = 0; k < bins; ++k) {
             for (int a = 0; a < 3; ++a) box[a][k] = Box{};
@@ -142,21 +158,30 @@ struct BinsAvx {
             for (int a = 0; a < 3; ++a) count[k][a] += o.count[k][a];
         }
     }
+    __attribute__((target("avx2"))) Box at(int a, int k) const {
+        return Box{_mm256_castps256_ps128(box[a][k]),
+                   _mm_xor_ps(_mm256_extractf128_ps(box[a][k], 1), _mm_set1_ps(-0.0f))};
+    }
     // Into `bins` (grown: as Bins::merge).
     __attribute__((target("avx2"))) void merge_into(Bins& bins, int nb) const {
-        const __m128 sign = _mm_set1_ps(-0.0f);
         for (int k = 0; k < nb; ++k) {
-            for (int a = 0; a < 3; ++a)
-                bins.box[a][k].grow(Box{_mm256_castps256_ps128(box[a][k]),
-                                        _mm_xor_ps(_mm256_extractf128_ps(box[a][k], 1), sign)});
+            for (int a = 0; a < 3; ++a) bins.box[a][k].grow(at(a, k));
             for (int a = 0; a < 3; ++a) bins.count[k][a] += count[k][a];
+        }
+    }
+    // Into `bins`, whatever it held (the same as merge_into() on cleared bins).
+    __attribute__((target("avx2"))) void store_to(Bins& bins, int nb) const {
+        for (int k = 0; k < nb; ++k) {
+            for (int a = 0; a < 3; ++a) bins.box[a][k] = at(a, k);
+            _mm_store_si128(bins.counts_at(k),
+                            _mm_load_si128(reinterpret_cast<const __m128i*>(count[k])));
         }
     }
 };
 
 __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::uint32_t b,
                                                     std::uint32_t e, const BinMapping& m,
-                                                    Bins& bins) {
+                                                    Bins& bins, bool fresh) {
     BinsAvx even(m.count), odd(m.count);
     std::uint32_t i = b;
     for (; i + 1 < e; i += 2) {
@@ -165,7 +190,10 @@ __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::ui
     }
     even.merge(odd, m.count);
     for (; i < e; ++i) even.add(refs[i], m);
-    even.merge_into(bins, m.count);
+    if (fresh)
+        even.store_to(bins, m.count);
+    else
+        even.merge_into(bins, m.count);
 }
 
 // Bins spheres [b, e) one after the other. Neighbouring spheres tend to fall into the same
@@ -175,7 +203,7 @@ __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::ui
 void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                 Bins& bins) {
     static const bool avx2 = isa_supported(Isa::avx2);
-    if (e - b >= kTwoWayBinning && avx2) return bin_serial_avx(refs, b, e, m, bins);
+    if (e - b >= kTwoWayBinning && avx2) return bin_serial_avx(refs, b, e, m, bins, false);
     std::uint32_t i = b;
     if (e - b >= kTwoWayBinning) {
         Bins odd(m.count);
@@ -188,9 +216,13 @@ void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const Bin
     for (; i < e; ++i) bins.add(refs[i], m);
 }
 
+// Into `bins`, whatever they held.
 void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                Bins& bins) {
     if (e - b < kParallelBinning) {
+        static const bool avx2 = isa_supported(Isa::avx2);
+        if (e - b >= kTwoWayBinning && avx2) return bin_serial_avx(refs, b, e, m, bins, true);
+        bins = Bins(m.count);
         bin_serial(refs, b, e, m, bins);
         return;
     }
@@ -345,7 +377,7 @@ class Builder {
         RangeBounds left, right;
         if (depth < kMaxSahDepth) {
             const BinMapping m(rb.centers, n);
-            Bins bins(m.count);
+            Bins bins;
             bin_range(refs_, b, e, m, bins);
             const Split split = best_split(bins, m);
             const float area = rb.box.half_area();
