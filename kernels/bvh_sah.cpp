@@ -182,13 +182,16 @@ struct BinsAvx {
 __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::uint32_t b,
                                                     std::uint32_t e, const BinMapping& m,
                                                     Bins& bins, bool fresh) {
-    BinsAvx even(m.count), odd(m.count);
+    BinsAvx even(m.count);
     std::uint32_t i = b;
-    for (; i + 1 < e; i += 2) {
-        even.add(refs[i], m);
-        odd.add(refs[i + 1], m);
+    if (e - b >= kTwoWayBinning) {
+        BinsAvx odd(m.count);
+        for (; i + 1 < e; i += 2) {
+            even.add(refs[i], m);
+            odd.add(refs[i + 1], m);
+        }
+        even.merge(odd, m.count);
     }
-    even.merge(odd, m.count);
     for (; i < e; ++i) even.add(refs[i], m);
     if (fresh)
         even.store_to(bins, m.count);
@@ -199,11 +202,11 @@ __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::ui
 // Bins spheres [b, e) one after the other. Neighbouring spheres tend to fall into the same
 // bins (sphereflakes are generated child by child), and then each update waits for the
 // previous one's store; two sets of bins, merged at the end (exactly: min, max and integer
-// sums), make two independent chains.
+// sums), make two independent chains. With AVX: bin_serial_avx, for every range.
 void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                 Bins& bins) {
     static const bool avx2 = isa_supported(Isa::avx2);
-    if (e - b >= kTwoWayBinning && avx2) return bin_serial_avx(refs, b, e, m, bins, false);
+    if (avx2) return bin_serial_avx(refs, b, e, m, bins, false);
     std::uint32_t i = b;
     if (e - b >= kTwoWayBinning) {
         Bins odd(m.count);
@@ -221,7 +224,7 @@ void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinM
                Bins& bins) {
     if (e - b < kParallelBinning) {
         static const bool avx2 = isa_supported(Isa::avx2);
-        if (e - b >= kTwoWayBinning && avx2) return bin_serial_avx(refs, b, e, m, bins, true);
+        if (avx2) return bin_serial_avx(refs, b, e, m, bins, true);
         bins = Bins(m.count);
         bin_serial(refs, b, e, m, bins);
         return;
