@@ -86,21 +86,21 @@ struct Collapsed {
 
 class Collapser {
   public:
-    explicit Collapser(const BinaryNode* binary) : binary_(binary) {}
+    Collapser(const BinaryNode* binary, const PrimRef* refs) : binary_(binary), refs_(refs) {}
 
-    // Collapses the binary subtree at `slot` (spheres [b, e), at 8-wide level `depth`) into
-    // `out`, its root at out.nodes[0]. Subtrees of kParallelCollapse spheres or more are
-    // collapsed by tasks of their own into out.parts.
-    void collapse(std::uint32_t slot, std::uint32_t b, std::uint32_t e, std::uint32_t depth,
-                  Collapsed& out) const {
+    // Collapses the binary subtree at `slot` (spheres [b, e), at 8-wide level `depth`; a
+    // leaf, without a node, where `leaf`) into `out`, its root at out.nodes[0]. Subtrees of
+    // kParallelCollapse spheres or more are collapsed by tasks of their own into out.parts.
+    void collapse(std::uint32_t slot, std::uint32_t b, std::uint32_t e, bool leaf,
+                  std::uint32_t depth, Collapsed& out) const {
         std::vector<Deferred> deferred;
-        emit(slot, b, e, depth, out, deferred);
+        emit(slot, b, e, leaf, depth, out, deferred);
         out.total = out.nodes.size();
         if (deferred.empty()) return;
         out.parts.resize(deferred.size());
         tbb::parallel_for(std::size_t{0}, deferred.size(), [&](std::size_t i) {
             const Deferred& d = deferred[i];
-            collapse(d.slot, d.b, d.e, d.depth, out.parts[i]);
+            collapse(d.slot, d.b, d.e, false, d.depth, out.parts[i]);
         });
         for (const Collapsed& part : out.parts) {
             out.total += part.total;
@@ -115,32 +115,48 @@ class Collapser {
         std::uint32_t slot, b, e, depth;
     };
 
-    std::uint32_t emit(std::uint32_t slot, std::uint32_t b, std::uint32_t e,
+    std::uint32_t emit(std::uint32_t slot, std::uint32_t b, std::uint32_t e, bool leaf,
                        std::uint32_t depth, Collapsed& out,
                        std::vector<Deferred>& deferred) const {
         out.depth = std::max(out.depth, depth);
-        // A binary node to become a child: its spheres, its split (0: a leaf), its area.
+        // A binary subtree to become a child: its spheres, its split (0: a leaf) and which
+        // of its children are leaves, its box and area.
         struct Child {
-            std::uint32_t slot, b, e, mid;
+            std::uint32_t slot, b, e, mid, leaves;
+            float lo[3], hi[3];
             float area;
-            std::uint32_t right_slot() const { return slot + 2 * (mid - b); }
+            std::uint32_t right_slot() const { return slot + (mid - b); }
         };
-        const auto child = [&](std::uint32_t s, std::uint32_t cb, std::uint32_t ce) {
-            const Child c{s, cb, ce, binary_[s].mid, half_area(s)};
-            // An inner node's right child lies past its left subtree, far away in memory
-            // for a large one: fetched now, it is there when the node is opened.
-            if (c.mid != 0)
-                _mm_prefetch(reinterpret_cast<const char*>(&binary_[c.right_slot()]),
-                             _MM_HINT_T0);
+        const auto child = [&](std::uint32_t s, std::uint32_t cb, std::uint32_t ce,
+                               bool is_leaf) {
+            Child c{s, cb, ce, 0, 0, {}, {}, 0.0f};
+            if (is_leaf) {
+                // A leaf's box: its spheres' (as the builder bounded the range).
+                Box box;
+                for (std::uint32_t i = cb; i < ce; ++i) box.grow(refs_[i].box);
+                for (int a = 0; a < 3; ++a) c.lo[a] = box.lo_at(a), c.hi[a] = box.hi_at(a);
+            } else {
+                const BinaryNode& bn = binary_[s];
+                c.mid = bn.mid & kBinaryMidMask;
+                c.leaves = bn.mid & (kBinaryLeftLeaf | kBinaryRightLeaf);
+                for (int a = 0; a < 3; ++a) c.lo[a] = bn.lo[a], c.hi[a] = bn.hi[a];
+                // An inner node's right child lies past its left subtree, far away in
+                // memory for a large one: fetched now, it is there when the node is opened.
+                if ((c.leaves & kBinaryRightLeaf) == 0)
+                    _mm_prefetch(reinterpret_cast<const char*>(&binary_[c.right_slot()]),
+                                 _MM_HINT_T0);
+            }
+            const float dx = c.hi[0] - c.lo[0], dy = c.hi[1] - c.lo[1], dz = c.hi[2] - c.lo[2];
+            c.area = dx * dy + dy * dz + dz * dx;
             return c;
         };
         Child children[kBvhWidth];
         std::uint32_t count = 0;
         const auto open = [&](const Child& c, Child& first, Child& second) {
-            first = child(c.slot + 1, c.b, c.mid);
-            second = child(c.right_slot(), c.mid, c.e);
+            first = child(c.slot + 1, c.b, c.mid, (c.leaves & kBinaryLeftLeaf) != 0);
+            second = child(c.right_slot(), c.mid, c.e, (c.leaves & kBinaryRightLeaf) != 0);
         };
-        children[count++] = child(slot, b, e);
+        children[count++] = child(slot, b, e, leaf);
         // Open the inner child with the largest surface area (the root first) until there
         // are 8.
         while (count < kBvhWidth) {
@@ -182,28 +198,23 @@ class Collapser {
                 out.links.push_back({index, i});
                 refs[i] = kBvhEmpty;  // set by Collapsed::flatten()
             } else {
-                refs[i] = emit(c.slot, c.b, c.e, depth + 1, out, deferred);
+                refs[i] = emit(c.slot, c.b, c.e, false, depth + 1, out, deferred);
             }
         }
         BvhNode8& node = out.nodes[index];  // after the recursion: emplace_back moves nodes
         for (std::uint32_t i = 0; i < kBvhWidth; ++i) {
             const bool used = i < count;
-            const BinaryNode* bn = used ? &binary_[children[i].slot] : nullptr;
-            node.min_x[i] = used ? bn->lo[0] : kInf, node.max_x[i] = used ? bn->hi[0] : -kInf;
-            node.min_y[i] = used ? bn->lo[1] : kInf, node.max_y[i] = used ? bn->hi[1] : -kInf;
-            node.min_z[i] = used ? bn->lo[2] : kInf, node.max_z[i] = used ? bn->hi[2] : -kInf;
+            const Child* c = used ? &children[i] : nullptr;
+            node.min_x[i] = used ? c->lo[0] : kInf, node.max_x[i] = used ? c->hi[0] : -kInf;
+            node.min_y[i] = used ? c->lo[1] : kInf, node.max_y[i] = used ? c->hi[1] : -kInf;
+            node.min_z[i] = used ? c->lo[2] : kInf, node.max_z[i] = used ? c->hi[2] : -kInf;
             node.child[i] = used ? refs[i] : kBvhEmpty;
         }
         return index;
     }
 
-    float half_area(std::uint32_t slot) const {
-        const BinaryNode& b = binary_[slot];
-        const float dx = b.hi[0] - b.lo[0], dy = b.hi[1] - b.lo[1], dz = b.hi[2] - b.lo[2];
-        return dx * dy + dy * dz + dz * dx;
-    }
-
     const BinaryNode* binary_;
+    const PrimRef* refs_;
 };
 
 }  // namespace
@@ -222,7 +233,7 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
         return bvh;
     }
 
-    // The builder's buffers (references twice, binary nodes) on huge pages: core/aligned.h.
+    // The builder's buffers (references, binary nodes) on huge pages: core/aligned.h.
     using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef, Pages::huge>>;
     PrimRefs refs(n);
     // Each sphere's box c ± sqrt(r2), rounded outwards: it holds every point of the sphere
@@ -255,20 +266,15 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
             }
         });
 
-    // The binary tree: 2n - 1 slots (a leaf holds at least one sphere).
-    std::vector<BinaryNode, UninitializedAllocator<BinaryNode, Pages::huge>> binary(
-        2 * static_cast<std::size_t>(n) - 1);
-    {
-        PrimRefs scratch(n);
-        build_binary_tree(refs.data(), scratch.data(), binary.data(),
-                          range_bounds(refs.data(), 0, n), n);
-    }
-    const Box root{_mm_setr_ps(binary[0].lo[0], binary[0].lo[1], binary[0].lo[2], 0.0f),
-                   _mm_setr_ps(binary[0].hi[0], binary[0].hi[1], binary[0].hi[2], 0.0f)};
+    // The binary tree: n - 1 slots for its inner nodes (leaves have none).
+    std::vector<BinaryNode, UninitializedAllocator<BinaryNode, Pages::huge>> binary(n - 1);
+    const RangeBounds bounds = range_bounds(refs.data(), 0, n);
+    const bool root_inner = build_binary_tree(refs.data(), binary.data(), bounds, n);
+    const Box root = bounds.box;
 
     // 8-wide nodes: preorder, but for the subtrees collapsed by tasks of their own.
     Collapsed collapsed;
-    Collapser(binary.data()).collapse(0, 0, n, 1, collapsed);
+    Collapser(binary.data(), refs.data()).collapse(0, 0, n, !root_inner, 1, collapsed);
     bvh.nodes.resize(collapsed.total);
     collapsed.flatten(bvh.nodes.data(), 0);
     bvh.leaf_count = collapsed.leaf_count;

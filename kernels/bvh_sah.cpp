@@ -5,12 +5,14 @@
 // Determinism: every decision depends only on the spheres of a subtree and its place in
 // the tree. Binning reduces boxes with min/max and counts with integer sums (both exact,
 // so any TBB split gives the same bins); a partition is one serial pass over its range; each
-// binary subtree over primitives [b, e) writes the node slots [s, s + 2(e - b) - 1) of a
-// preallocated array (left child at s + 1, right child at s + 2(mid - b)), so no slot
-// depends on which thread got there first.
+// binary subtree over primitives [b, e) writes the node slots [s, s + (e - b) - 1) of a
+// preallocated array (inner nodes only; left child at s + 1, right child at s + mid - b),
+// so no slot depends on which thread got there first. Partitions reorder a node's own range in
+// place, which no other task touches meanwhile.
 
 #include "kernels/bvh_sah.h"
 
+#include <immintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -18,6 +20,8 @@
 
 #include <algorithm>
 #include <vector>
+
+#include "kernels/dispatch.h"
 
 namespace octray::bvh_sah {
 namespace {
@@ -34,16 +38,18 @@ struct BinMapping {
 
     BinMapping(const Box& centers, std::uint32_t n) {
         count = static_cast<int>(std::min<std::uint32_t>(8 + n / 20, kBins));
-        alignas(16) float s[4] = {0, 0, 0, 0};
-        for (int a = 0; a < 3; ++a) {
-            const float extent = centers.hi_at(a) - centers.lo_at(a);
-            // Slightly fewer than `count` bins per extent, so the top center maps to the
-            // last bin rather than past it (clamped anyway).
-            s[a] = extent > 0.0f ? (static_cast<float>(count) * 0.99999f) / extent : 0.0f;
-            if (!(s[a] < kInf)) s[a] = 0.0f;  // denormal extent
-        }
+        // Slightly fewer than `count` bins per extent, so the top center maps to the last
+        // bin rather than past it (clamped anyway). 0 where the extent is 0 (or NaN), where
+        // the quotient overflows (a denormal extent), and in w. All three axes at once:
+        // each node makes one mapping, and lanes written one by one and read back as a
+        // vector would wait on a failed store forwarding.
+        const __m128 extent = _mm_sub_ps(centers.hi, centers.lo);
+        const __m128 s = _mm_div_ps(_mm_set1_ps(static_cast<float>(count) * 0.99999f), extent);
+        const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+        const __m128 valid = _mm_and_ps(xyz, _mm_and_ps(_mm_cmpgt_ps(extent, _mm_setzero_ps()),
+                                                        _mm_cmplt_ps(s, _mm_set1_ps(kInf))));
         lo = centers.lo;
-        scale = _mm_load_ps(s);
+        scale = _mm_and_ps(valid, s);
         extent_mask = _mm_cmpgt_ps(scale, _mm_setzero_ps());
     }
     __m128i bins(__m128 center) const {
@@ -66,10 +72,26 @@ __m128i select(__m128 mask, __m128i a, __m128i b) {
 // Per axis and bin: the spheres' boxes and their count (the children's center bounds come
 // out of the partition, which visits every sphere anyway). Counts are kept per bin with
 // the three axes in lanes, as the sweep reads them.
+// A bin's box: a Box without initialisers, so that a node's Bins clear only the bins it
+// uses (8 + n/20 per axis; Box's initialisers would write all kBins of them every time).
+struct BinBox {
+    __m128 lo, hi;
+    BinBox& operator=(const Box& b) {
+        lo = b.lo, hi = b.hi;
+        return *this;
+    }
+    operator Box() const { return Box{lo, hi}; }
+    void grow(const Box& b) {
+        lo = _mm_min_ps(lo, b.lo);
+        hi = _mm_max_ps(hi, b.hi);
+    }
+};
+
 struct Bins {
-    Box box[3][kBins];
+    BinBox box[3][kBins];
     alignas(16) std::int32_t count[kBins][4];
 
+    Bins() = default;  // nothing written: BinsAvx::store_to() fills it
     explicit Bins(int bins) {
         for (int k = 0; k < bins; ++k) {
             for (int a = 0; a < 3; ++a) box[a][k] = Box{};
@@ -103,12 +125,88 @@ struct Bins {
 // spheres apart, merged at the end.
 constexpr std::uint32_t kTwoWayBinning = 32;
 
+// The same binning with AVX where the CPU has it (this file is otherwise baseline SSE2):
+// a bin's box is held as (lo, -hi) in one 8-wide register, so that growing it by a sphere
+// is one min, one load and one store instead of two each (max(a, b) = -min(-a, -b), and
+// on equal operands both minps and maxps return the second, so the boxes come out the
+// same bit for bit, and so does the tree). Counts as in Bins.
+struct BinsAvx {
+    __m256 box[3][kBins];  // (lo, -hi)
+    alignas(16) std::int32_t count[kBins][4];
+
+    __attribute__((target("avx2"))) explicit BinsAvx(int bins) {
+        for (int k = 0; k < bins; ++k) {
+            for (int a = 0; a < 3; ++a) box[a][k] = _mm256_set1_ps(kInf);
+            _mm_store_si128(reinterpret_cast<__m128i*>(count[k]), _mm_setzero_si128());
+        }
+    }
+    __attribute__((target("avx2"))) void add(const PrimRef& p, const BinMapping& m) {
+        const __m256 v = _mm256_loadu_ps(reinterpret_cast<const float*>(&p));
+        const __m256 g =
+            _mm256_xor_ps(v, _mm256_setr_ps(0, 0, 0, 0, -0.0f, -0.0f, -0.0f, -0.0f));
+        const __m128i k = m.bins(p.center());
+        const int kx = _mm_cvtsi128_si32(k);
+        const int ky = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0x55));
+        const int kz = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0xaa));
+        box[0][kx] = _mm256_min_ps(box[0][kx], g), ++count[kx][0];
+        box[1][ky] = _mm256_min_ps(box[1][ky], g), ++count[ky][1];
+        box[2][kz] = _mm256_min_ps(box[2][kz], g), ++count[kz][2];
+    }
+    __attribute__((target("avx2"))) void merge(const BinsAvx& o, int bins) {
+        for (int k = 0; k < bins; ++k) {
+            for (int a = 0; a < 3; ++a) box[a][k] = _mm256_min_ps(box[a][k], o.box[a][k]);
+            for (int a = 0; a < 3; ++a) count[k][a] += o.count[k][a];
+        }
+    }
+    __attribute__((target("avx2"))) Box at(int a, int k) const {
+        return Box{_mm256_castps256_ps128(box[a][k]),
+                   _mm_xor_ps(_mm256_extractf128_ps(box[a][k], 1), _mm_set1_ps(-0.0f))};
+    }
+    // Into `bins` (grown: as Bins::merge).
+    __attribute__((target("avx2"))) void merge_into(Bins& bins, int nb) const {
+        for (int k = 0; k < nb; ++k) {
+            for (int a = 0; a < 3; ++a) bins.box[a][k].grow(at(a, k));
+            for (int a = 0; a < 3; ++a) bins.count[k][a] += count[k][a];
+        }
+    }
+    // Into `bins`, whatever it held (the same as merge_into() on cleared bins).
+    __attribute__((target("avx2"))) void store_to(Bins& bins, int nb) const {
+        for (int k = 0; k < nb; ++k) {
+            for (int a = 0; a < 3; ++a) bins.box[a][k] = at(a, k);
+            _mm_store_si128(bins.counts_at(k),
+                            _mm_load_si128(reinterpret_cast<const __m128i*>(count[k])));
+        }
+    }
+};
+
+__attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::uint32_t b,
+                                                    std::uint32_t e, const BinMapping& m,
+                                                    Bins& bins, bool fresh) {
+    BinsAvx even(m.count);
+    std::uint32_t i = b;
+    if (e - b >= kTwoWayBinning) {
+        BinsAvx odd(m.count);
+        for (; i + 1 < e; i += 2) {
+            even.add(refs[i], m);
+            odd.add(refs[i + 1], m);
+        }
+        even.merge(odd, m.count);
+    }
+    for (; i < e; ++i) even.add(refs[i], m);
+    if (fresh)
+        even.store_to(bins, m.count);
+    else
+        even.merge_into(bins, m.count);
+}
+
 // Bins spheres [b, e) one after the other. Neighbouring spheres tend to fall into the same
 // bins (sphereflakes are generated child by child), and then each update waits for the
 // previous one's store; two sets of bins, merged at the end (exactly: min, max and integer
-// sums), make two independent chains.
+// sums), make two independent chains. With AVX: bin_serial_avx, for every range.
 void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                 Bins& bins) {
+    static const bool avx2 = isa_supported(Isa::avx2);
+    if (avx2) return bin_serial_avx(refs, b, e, m, bins, false);
     std::uint32_t i = b;
     if (e - b >= kTwoWayBinning) {
         Bins odd(m.count);
@@ -121,9 +219,13 @@ void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const Bin
     for (; i < e; ++i) bins.add(refs[i], m);
 }
 
+// Into `bins`, whatever they held.
 void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                Bins& bins) {
     if (e - b < kParallelBinning) {
+        static const bool avx2 = isa_supported(Isa::avx2);
+        if (avx2) return bin_serial_avx(refs, b, e, m, bins, true);
+        bins = Bins(m.count);
         bin_serial(refs, b, e, m, bins);
         return;
     }
@@ -203,32 +305,34 @@ Split best_split(const Bins& bins, const BinMapping& m) {
     return best;
 }
 
-// Copies the spheres of [b, e) from `src` to `dst`, those whose center lies in bins
-// [0, bin] of `Axis` first, and returns where the rest begin; the two sides' center
-// bounds come out on the way. Branch-free (which side a sphere goes to is a coin toss
-// the CPU cannot predict): each sphere goes to the next free slot at the front or at the
-// back of [b, e) (the right side comes out reversed). The axis is a template argument so
-// that its lane is picked by a shuffle, not by a round trip through memory.
+// Reorders the spheres of [b, e) in place, those whose center lies in bins [0, bin] of
+// `Axis` first, and returns where the rest begin; the two sides' center bounds come out on
+// the way. In place, so the build needs no second array of references (its pages cost a
+// fault each, the time to clear them, and cache space). Branch-free (which side a sphere
+// goes to is a coin toss the CPU cannot predict): [b, l) holds the left spheres found so
+// far and [l, i) the right ones; each sphere is swapped with the first right one at l, and
+// l moves on only past a left one (a right sphere swaps with a right one: the right side
+// comes out permuted, the same way for any thread count). The axis is a template argument
+// so that its lane is picked by a shuffle, not by a round trip through memory.
 template <int Axis>
-std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
-                           const BinMapping& m, int bin, Box& left_centers,
-                           Box& right_centers) {
+std::uint32_t partition_on(PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+                           int bin, Box& left_centers, Box& right_centers) {
     constexpr int kBroadcast = Axis * 0x55;  // _MM_SHUFFLE(Axis, Axis, Axis, Axis)
     const __m128i last_left = _mm_set1_epi32(bin);
     const __m128 all_ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
     Box lc, rc;
-    PrimRef* front = dst + b;
-    PrimRef* back = dst + e;
-    for (std::uint32_t i = b; i < e; ++i) {
-        const PrimRef p = src[i];
+    PrimRef* l = refs + b;
+    for (PrimRef *i = refs + b, *end = refs + e; i < end; ++i) {
+        const PrimRef p = *i;
         const __m128 c = p.center();
         // All ones in every lane where the bin on `Axis` lies right of `bin`.
         const __m128i right_mask =
             _mm_shuffle_epi32(_mm_cmpgt_epi32(m.bins(c), last_left), kBroadcast);
         const std::int32_t right = _mm_cvtsi128_si32(right_mask);  // 0 or -1
-        *(right ? back - 1 : front) = p;
-        front += 1 + right;
-        back += right;
+        const PrimRef q = *l;
+        *i = q;
+        *l = p;
+        l += 1 + right;
         // The side's bounds grow by the center, the other side's by NaN, which min and
         // max pass over: minps and maxps return their second operand where either is
         // NaN, and all ones (the mask) is a NaN.
@@ -240,55 +344,44 @@ std::uint32_t partition_on(const PrimRef* src, PrimRef* dst, std::uint32_t b, st
     }
     left_centers = lc;
     right_centers = rc;
-    return static_cast<std::uint32_t>(front - dst);
+    return static_cast<std::uint32_t>(l - refs);
 }
 
-std::uint32_t partition(const PrimRef* src, PrimRef* dst, std::uint32_t b, std::uint32_t e,
-                        const BinMapping& m, int axis, int bin, Box& left_centers,
-                        Box& right_centers) {
+std::uint32_t partition(PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
+                        int axis, int bin, Box& left_centers, Box& right_centers) {
     switch (axis) {
         case 0:
-            return partition_on<0>(src, dst, b, e, m, bin, left_centers, right_centers);
+            return partition_on<0>(refs, b, e, m, bin, left_centers, right_centers);
         case 1:
-            return partition_on<1>(src, dst, b, e, m, bin, left_centers, right_centers);
+            return partition_on<1>(refs, b, e, m, bin, left_centers, right_centers);
         default:
-            return partition_on<2>(src, dst, b, e, m, bin, left_centers, right_centers);
+            return partition_on<2>(refs, b, e, m, bin, left_centers, right_centers);
     }
 }
 
 class Builder {
   public:
-    // The spheres start in `refs` and end there in leaf order; the partitions move them
-    // back and forth between `refs` and `scratch` (as many spheres), level by level.
-    Builder(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes)
-        : refs_(refs), scratch_(scratch), nodes_(nodes) {}
+    // The spheres are reordered in `refs`, node by node, into leaf order.
+    Builder(PrimRef* refs, BinaryNode* nodes) : refs_(refs), nodes_(nodes) {}
 
-    void build(const RangeBounds& rb, std::uint32_t n) { build(0, 0, n, rb, 0, refs_); }
+    bool build(const RangeBounds& rb, std::uint32_t n) { return !build(0, 0, n, rb, 0); }
 
   private:
-    // Builds the subtree of spheres [b, e), which lie in `src` (refs_ or scratch_), into
-    // slots [slot, slot + 2(e - b) - 1).
-    void build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
-               std::uint32_t depth, PrimRef* src) {
-        BinaryNode& node = nodes_[slot];
-        for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
-        node.mid = 0;
+    // Builds the subtree of spheres [b, e) into slots [slot, slot + (e - b) - 1); returns
+    // whether it is a leaf (and then writes no node).
+    bool build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
+               std::uint32_t depth) {
         const std::uint32_t n = e - b;
-        const auto leaf = [&] {
-            if (src != refs_) std::copy(src + b, src + e, refs_ + b);
-        };
         // A split costs at least one traversal step, more than testing this many spheres:
         // the SAH would choose the leaf, so the binning is skipped.
-        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return leaf();
+        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return true;
 
-        PrimRef* const other = src == refs_ ? scratch_ : refs_;
-        PrimRef* children_src = src;
         std::uint32_t mid = 0;
         RangeBounds left, right;
         if (depth < kMaxSahDepth) {
             const BinMapping m(rb.centers, n);
-            Bins bins(m.count);
-            bin_range(src, b, e, m, bins);
+            Bins bins;
+            bin_range(refs_, b, e, m, bins);
             const Split split = best_split(bins, m);
             const float area = rb.box.half_area();
             const float leaf_cost = kIntersectionCost * static_cast<float>(n);
@@ -296,37 +389,40 @@ class Builder {
                 split.axis < 0 ? kInf
                 : area > 0.0f  ? kTraversalCost + kIntersectionCost * split.cost / area
                                : kTraversalCost + kIntersectionCost * static_cast<float>(n);
-            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return leaf();
+            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return true;
             if (split.axis >= 0) {
-                mid = partition(src, other, b, e, m, split.axis, split.bin, left.centers,
+                mid = partition(refs_, b, e, m, split.axis, split.bin, left.centers,
                                 right.centers);
-                children_src = other;
                 left.box = split.left;
                 right.box = split.right;
             }
         } else if (n <= kMaxLeafSize) {
-            return leaf();
+            return true;
         }
         // Every center in one bin (coincident spheres) or too deep: the middle index.
         if (mid <= b || mid >= e) {
             mid = b + n / 2;
-            left = range_bounds(src, b, mid);
-            right = range_bounds(src, mid, e);
+            left = range_bounds(refs_, b, mid);
+            right = range_bounds(refs_, mid, e);
         }
-        node.mid = mid;
-        const std::uint32_t left_slot = slot + 1, right_slot = slot + 2 * (mid - b);
+        const std::uint32_t left_slot = slot + 1, right_slot = slot + (mid - b);
+        bool left_leaf, right_leaf;
         if (n >= kParallelSubtree) {
             tbb::parallel_invoke(
-                [&] { build(left_slot, b, mid, left, depth + 1, children_src); },
-                [&] { build(right_slot, mid, e, right, depth + 1, children_src); });
+                [&] { left_leaf = build(left_slot, b, mid, left, depth + 1); },
+                [&] { right_leaf = build(right_slot, mid, e, right, depth + 1); });
         } else {
-            build(left_slot, b, mid, left, depth + 1, children_src);
-            build(right_slot, mid, e, right, depth + 1, children_src);
+            left_leaf = build(left_slot, b, mid, left, depth + 1);
+            right_leaf = build(right_slot, mid, e, right, depth + 1);
         }
+        BinaryNode& node = nodes_[slot];
+        for (int a = 0; a < 3; ++a) node.lo[a] = rb.box.lo_at(a), node.hi[a] = rb.box.hi_at(a);
+        node.mid =
+            mid | (left_leaf ? kBinaryLeftLeaf : 0u) | (right_leaf ? kBinaryRightLeaf : 0u);
+        return false;
     }
 
     PrimRef* refs_;
-    PrimRef* scratch_;
     BinaryNode* nodes_;
 };
 
@@ -349,9 +445,9 @@ RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e) 
         });
 }
 
-void build_binary_tree(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes,
-                       const RangeBounds& rb, std::uint32_t n) {
-    Builder(refs, scratch, nodes).build(rb, n);
+bool build_binary_tree(PrimRef* refs, BinaryNode* nodes, const RangeBounds& rb,
+                       std::uint32_t n) {
+    return Builder(refs, nodes).build(rb, n);
 }
 
 }  // namespace octray::bvh_sah

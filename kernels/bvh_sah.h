@@ -83,21 +83,30 @@ struct RangeBounds {
     }
 };
 
-// A binary node. mid == 0 marks a leaf (an inner node's mid lies above its begin >= 0).
+// An inner node of the binary tree: its box and where its right child's spheres begin
+// (mid, in the low bits), with a bit for each child that is a leaf. Leaves have no node:
+// a leaf's box is its spheres' (at most kMaxLeafSize of them, in leaf order in `refs`), so
+// the collapse makes it from them, and a subtree of n spheres needs n - 1 slots, not
+// 2n - 1 (half the memory to fault in and clear).
 // No initialisers: the slot array is allocated untouched and filled by the build tasks.
 struct BinaryNode {
     float lo[3], hi[3];
     std::uint32_t mid;
 };
+inline constexpr std::uint32_t kBinaryLeftLeaf = 1u << 31;
+inline constexpr std::uint32_t kBinaryRightLeaf = 1u << 30;
+inline constexpr std::uint32_t kBinaryMidMask = kBinaryRightLeaf - 1;  // 2^24 spheres at most
 
 // Bounds of spheres [b, e) of `refs`.
 RangeBounds range_bounds(const PrimRef* refs, std::uint32_t b, std::uint32_t e);
 
-// Builds the binary tree over the n spheres of `refs` (bounds `rb`) into nodes[0, 2n - 1):
-// node 0 the root, a left child right after its parent. The spheres end in `refs` in leaf
-// order; `scratch` (n references) is the partitions' other buffer. In parallel with TBB
-// over subtrees; every node and every byte of `refs` the same for any thread count.
-void build_binary_tree(PrimRef* refs, PrimRef* scratch, BinaryNode* nodes,
-                       const RangeBounds& rb, std::uint32_t n);
+// Builds the binary tree over the n spheres of `refs` (bounds `rb`) into nodes[0, n - 1):
+// node 0 the root, a left child right after its parent, the right child of a node over
+// spheres [b, e) split at mid at mid - b slots after it. Returns false where the root is a
+// leaf (no node written). The spheres end in `refs` in leaf order (the partitions reorder
+// them in place). In parallel with TBB over subtrees; every node and every byte of `refs`
+// the same for any thread count.
+bool build_binary_tree(PrimRef* refs, BinaryNode* nodes, const RangeBounds& rb,
+                       std::uint32_t n);
 
 }  // namespace octray::bvh_sah
