@@ -285,10 +285,11 @@ void set_up_scene(BenchRun& run, BenchScene& bs) {
 
 // ---- Rows ----
 
-// The packets octray's kernels trace in: 8 rays, and 16 through the BVH with AVX-512
-// (kernels/bvh_packet.h).
-const char* octray_mode(Isa isa, bool bvh) {
-    return isa == Isa::avx512 && bvh ? "packet16" : "packet8";
+// The packets octray's kernels trace in: 8 rays, and through the BVH the ISA's traversal
+// packets (16 rays with AVX-512, kernels/bvh_packet.h).
+std::string octray_mode(Isa isa, bool bvh) {
+    return "packet" +
+           std::to_string(bvh ? kernel_table(isa).traversal_width : kernels::kPacketWidth);
 }
 
 BenchRow base_row(const BenchRun& run, const std::string& spec, Workload w, const Variant& v) {

@@ -68,7 +68,7 @@ struct BenchRow {
     std::string scene;
     Workload workload = Workload::primary;
     std::string system;  // "octray" or "embree"
-    std::string mode;    // "packet8" (octray simd, rtcIntersect8) or "single"
+    std::string mode;    // "packet8", "packet16" (a simd packet) or "single"
     std::string isa;     // octray: the kernels' ISA or "scalar"; embree: "embree"
     std::string order;   // pixel order of the rays
     std::string tile;    // tile size (tiled order, whole renders), "-" where it plays no part

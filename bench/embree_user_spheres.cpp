@@ -83,12 +83,10 @@ const EmbreeSphereCallbacks& embree_sphere_callbacks() {
                                                   avx2::occlude_spheres, "avx2"};
     static const EmbreeSphereCallbacks avx512_build{avx512::intersect_spheres,
                                                     avx512::occlude_spheres, "avx512"};
-    // libgcc's CPU model counts AVX-512 only where the OS saves the ZMM state (XCR0).
-    const bool avx512 = isa_supported(Isa::avx2) && __builtin_cpu_supports("avx512f") &&
-                        __builtin_cpu_supports("avx512vl") &&
-                        __builtin_cpu_supports("avx512bw") &&
-                        __builtin_cpu_supports("avx512dq");
-    return avx512 ? avx512_build : isa_supported(Isa::avx2) ? avx2_build : scalar_build;
+    // The builds' flags are the kernels' (F, VL, BW and DQ), so is the check.
+    return isa_supported(Isa::avx512) ? avx512_build
+           : isa_supported(Isa::avx2) ? avx2_build
+                                      : scalar_build;
 }
 
 }  // namespace octray::bench

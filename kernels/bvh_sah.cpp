@@ -179,6 +179,12 @@ struct BinsAvx {
     }
 };
 
+// Whether this CPU bins with AVX (asked once).
+bool avx_binning() {
+    static const bool avx = isa_supported(Isa::avx2);
+    return avx;
+}
+
 __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::uint32_t b,
                                                     std::uint32_t e, const BinMapping& m,
                                                     Bins& bins, bool fresh) {
@@ -205,8 +211,7 @@ __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::ui
 // sums), make two independent chains. With AVX: bin_serial_avx, for every range.
 void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                 Bins& bins) {
-    static const bool avx2 = isa_supported(Isa::avx2);
-    if (avx2) return bin_serial_avx(refs, b, e, m, bins, false);
+    if (avx_binning()) return bin_serial_avx(refs, b, e, m, bins, false);
     std::uint32_t i = b;
     if (e - b >= kTwoWayBinning) {
         Bins odd(m.count);
@@ -223,8 +228,7 @@ void bin_serial(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const Bin
 void bin_range(const PrimRef* refs, std::uint32_t b, std::uint32_t e, const BinMapping& m,
                Bins& bins) {
     if (e - b < kParallelBinning) {
-        static const bool avx2 = isa_supported(Isa::avx2);
-        if (avx2) return bin_serial_avx(refs, b, e, m, bins, true);
+        if (avx_binning()) return bin_serial_avx(refs, b, e, m, bins, true);
         bins = Bins(m.count);
         bin_serial(refs, b, e, m, bins);
         return;

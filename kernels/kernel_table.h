@@ -13,8 +13,10 @@ namespace octray::kernels {
 struct KernelTable {
     Isa isa;
     const char* name;
-    std::uint32_t
-        lanes_per_register;  // 8 (AVX2, AVX-512) or 4 (SSE): registers per packet = 8 / this
+    // 8 (AVX2, AVX-512) or 4 (SSE): registers per packet = 8 / this.
+    std::uint32_t lanes_per_register;
+    // Rays per BVH traversal packet: 8, or 16 with AVX-512 (kernels/bvh_packet.h).
+    std::uint32_t traversal_width;
 
     // Primary rays for `count` camera samples; returns how many rays it wrote (the
     // fisheye drops samples outside its image circle). Weights are 1.

@@ -17,6 +17,7 @@ constexpr KernelTable make_table_avx2_fma() {
     return KernelTable{Isa::avx2,
                        "avx2",
                        8,
+                       avx2_fma::kTraversalWidth,
                        &avx2_fma::camera_rays<Arch>,
                        &avx2_fma::closest_hit<Arch>,
                        &avx2_fma::any_hit<Arch>,

@@ -25,6 +25,7 @@ constexpr KernelTable make_table_avx512() {
     return KernelTable{Isa::avx512,
                        "avx512",
                        8,
+                       avx512::kTraversalWidth,
                        &avx512::camera_rays<Arch>,
                        &avx512::closest_hit<Arch>,
                        &avx512::any_hit<Arch>,

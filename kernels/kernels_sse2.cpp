@@ -17,6 +17,7 @@ constexpr KernelTable make_table_sse2() {
     return KernelTable{Isa::sse2,
                        "sse2",
                        4,
+                       sse2::kTraversalWidth,
                        &sse2::camera_rays<Arch>,
                        &sse2::closest_hit<Arch>,
                        &sse2::any_hit<Arch>,

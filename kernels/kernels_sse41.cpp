@@ -17,6 +17,7 @@ constexpr KernelTable make_table_sse4_1() {
     return KernelTable{Isa::sse4_1,
                        "sse4.1",
                        4,
+                       sse4_1::kTraversalWidth,
                        &sse4_1::camera_rays<Arch>,
                        &sse4_1::closest_hit<Arch>,
                        &sse4_1::any_hit<Arch>,

@@ -22,8 +22,9 @@ namespace {
 void run_info(const std::string& scene_spec, bool quiet) {
     const CpuSupport cpu = cpu_support();
     std::printf("octray   %s\n", kVersion);
-    std::printf("cpu      sse2 %s, sse4.1 %s, avx2 %s, fma %s\n", cpu.sse2 ? "yes" : "no",
-                cpu.sse4_1 ? "yes" : "no", cpu.avx2 ? "yes" : "no", cpu.fma ? "yes" : "no");
+    std::printf("cpu      sse2 %s, sse4.1 %s, avx2 %s, fma %s, avx512 %s\n",
+                cpu.sse2 ? "yes" : "no", cpu.sse4_1 ? "yes" : "no", cpu.avx2 ? "yes" : "no",
+                cpu.fma ? "yes" : "no", cpu.avx512 ? "yes" : "no");
     std::string compiled, usable;
     for (Isa isa : compiled_isas()) {
         const kernels::KernelTable& k = kernel_table(isa);
@@ -31,7 +32,11 @@ void run_info(const std::string& scene_spec, bool quiet) {
             std::string(compiled.empty() ? "" : ", ") + k.name + " (" +
             std::to_string(kernels::kPacketWidth / k.lanes_per_register) +
             (k.lanes_per_register == kernels::kPacketWidth ? " register" : " registers") +
-            " per 8-ray packet)";
+            " per 8-ray packet" +
+            (k.traversal_width == kernels::kPacketWidth
+                 ? std::string()
+                 : ", " + std::to_string(k.traversal_width) + "-ray BVH packets") +
+            ")";
     }
     for (Isa isa : supported_isas())
         usable += std::string(usable.empty() ? "" : ", ") + isa_name(isa);

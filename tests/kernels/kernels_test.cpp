@@ -402,6 +402,9 @@ TEST(KernelDispatch, ParsesAndResolvesIsas) {
     EXPECT_EQ(kernel_table(best).isa, best);
     for (Isa isa : compiled_isas()) EXPECT_STREQ(kernel_table(isa).name, isa_name(isa));
     EXPECT_EQ(kernel_table(Isa::avx512).lanes_per_register, 8u);
+    EXPECT_EQ(kernel_table(Isa::avx512).traversal_width, 16u);
+    for (Isa isa : {Isa::sse2, Isa::sse4_1, Isa::avx2})
+        EXPECT_EQ(kernel_table(isa).traversal_width, 8u) << isa_name(isa);
     EXPECT_EQ(kernel_table(Isa::avx2).lanes_per_register, 8u);
     EXPECT_EQ(kernel_table(Isa::sse2).lanes_per_register, 4u);
 }
