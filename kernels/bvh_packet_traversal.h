@@ -170,12 +170,13 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
         // A leaf: each sphere broadcast against the packet, as the brute-force kernel does,
         // with ties to the lower file index.
         V3<F> o[K], d[K];
-        F a[K], best_t[K], best_id[K];
+        F a[K], inv_a[K], best_t[K], best_id[K];
         for (std::uint32_t k = 0; k < K; ++k) {
             const std::uint32_t at = k * W;
             o[k] = load3<F>(p.ox, p.oy, p.oz, at);
             d[k] = load3<F>(p.dx, p.dy, p.dz, at);
             a[k] = F::load_aligned(p.a + at);
+            inv_a[k] = F(1.0f) / a[k];
             best_t[k] = F::load_aligned(p.best_t + at);
             best_id[k] = F::load_aligned(p.best_id + at);
         }
@@ -183,6 +184,10 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
         for (std::uint32_t i = first; i < end; ++i) {
             const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
             const F r2(s.bvh_r2[i]);
+            auto may_hit = zero != zero;
+            for (std::uint32_t k = 0; k < K; ++k)
+                may_hit = may_hit || sphere_may_hit(sub(o[k], c), d[k], inv_a[k], r2);
+            if (xsimd::none(may_hit)) continue;
             SphereQuadratic<F> quad[K];
             auto any_root = zero != zero;
             for (std::uint32_t k = 0; k < K; ++k) {
@@ -237,12 +242,13 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
             continue;
         }
         V3<F> o[K], d[K];
-        F a[K], t_max[K];
+        F a[K], inv_a[K], t_max[K];
         for (std::uint32_t k = 0; k < K; ++k) {
             const std::uint32_t at = k * W;
             o[k] = load3<F>(p.ox, p.oy, p.oz, at);
             d[k] = load3<F>(p.dx, p.dy, p.dz, at);
             a[k] = F::load_aligned(p.a + at);
+            inv_a[k] = F(1.0f) / a[k];
             t_max[k] = F::load_aligned(p.best_t + at);
         }
         const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
@@ -250,6 +256,7 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
             const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
             const F r2(s.bvh_r2[i]);
             for (std::uint32_t k = 0; k < K; ++k) {
+                if (xsimd::none(sphere_may_hit(sub(o[k], c), d[k], inv_a[k], r2))) continue;
                 const SphereQuadratic<F> quad = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
                 if (xsimd::none(quad.disc >= zero)) continue;
                 const auto [t_near, t_far] = sphere_roots(quad, a[k]);

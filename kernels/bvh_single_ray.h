@@ -26,7 +26,7 @@ struct BvhRay {
     F inv_x, inv_y, inv_z;
     F near_off_x, near_off_y, near_off_z, far_off_x, far_off_y, far_off_z;
     V3<F> o, d;
-    F a;
+    F a, inv_a;  // inv_a: sphere_may_hit's
 
     BvhRay(const BvhPacket& p, std::uint32_t lane) {
         const auto axis = [&](float inv, float lo_off, float hi_off, Plane& near, Plane& far,
@@ -48,6 +48,7 @@ struct BvhRay {
         o = {F(p.ox[lane]), F(p.oy[lane]), F(p.oz[lane])};
         d = {F(p.dx[lane]), F(p.dy[lane]), F(p.dz[lane])};
         a = F(p.a[lane]);
+        inv_a = F(1.0f / p.a[lane]);
     }
 
     // Bit i set when child i's widened box meets the ray on [t_near, t_far]; entry[i] is
@@ -86,8 +87,11 @@ LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t 
     const F zero(0.0f);
     const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
                   F::load_unaligned(s.bvh_cz + i)};
-    const SphereQuadratic<F> quad =
-        sphere_quadratic(sub(ray.o, c), ray.d, ray.a, F::load_unaligned(s.bvh_r2 + i));
+    const F r2 = F::load_unaligned(s.bvh_r2 + i);
+    const V3<F> oc = sub(ray.o, c);
+    if (xsimd::none(live_lanes<F>(at, count) && sphere_may_hit(oc, ray.d, ray.inv_a, r2)))
+        return {zero != zero, zero, zero};
+    const SphereQuadratic<F> quad = sphere_quadratic(oc, ray.d, ray.a, r2);
     const auto live = live_lanes<F>(at, count) && quad.disc >= zero;
     if (xsimd::none(live)) return {live, zero, zero};
     const SphereRoots<F> roots = sphere_roots(quad, ray.a);

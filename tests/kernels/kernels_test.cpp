@@ -8,11 +8,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <random>
 #include <vector>
 
 #include "core/aligned.h"
 #include "core/random.h"
+#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/reference.h"
 #include "scene/compile.h"
@@ -113,10 +115,16 @@ class KernelTest : public ::testing::Test {
     const kernels::KernelTable& k() const { return kernel_table(Tag::isa); }
 
     // Closest hits of `rays` (all with the same t_min) against the reference's intersect().
+    // `bvh_min_lanes`: through the spheres' BVH, packets with fewer live lanes going on
+    // ray by ray (0: packets only, 9: single rays only); without it, brute force.
     void expect_closest_hits_match(const Scene& scene, const std::vector<Ray>& rays,
-                                   float t_min) {
+                                   float t_min,
+                                   std::optional<std::uint32_t> bvh_min_lanes = {}) {
         const CompiledScene compiled = compile_scene(scene);
-        const kernels::SceneView view = make_scene_view(compiled);
+        const SphereBvh bvh = build_sphere_bvh(compiled.spheres);
+        const kernels::SceneView view =
+            bvh_min_lanes ? make_scene_view(compiled, bvh, *bvh_min_lanes, *bvh_min_lanes)
+                          : make_scene_view(compiled);
         const ReferenceTracer ref(scene);
         Rays stream(rays.size());
         for (std::size_t i = 0; i < rays.size(); ++i) stream.set(i, rays[i]);
@@ -139,9 +147,13 @@ class KernelTest : public ::testing::Test {
         }
     }
 
-    void expect_any_hits_match(const Scene& scene, const std::vector<Ray>& rays) {
+    void expect_any_hits_match(const Scene& scene, const std::vector<Ray>& rays,
+                               std::optional<std::uint32_t> bvh_min_lanes = {}) {
         const CompiledScene compiled = compile_scene(scene);
-        const kernels::SceneView view = make_scene_view(compiled);
+        const SphereBvh bvh = build_sphere_bvh(compiled.spheres);
+        const kernels::SceneView view =
+            bvh_min_lanes ? make_scene_view(compiled, bvh, *bvh_min_lanes, *bvh_min_lanes)
+                          : make_scene_view(compiled);
         const ReferenceTracer ref(scene);
         Rays stream(rays.size());
         for (std::size_t i = 0; i < rays.size(); ++i) stream.set(i, rays[i]);
@@ -231,6 +243,60 @@ TYPED_TEST(KernelTest, GrazingAndTangentRays) {
         rays.push_back({{0, -1, 0}, {1, dy, 0}, 0.0f, kInfinity});
     this->expect_closest_hits_match(scene, rays, 0.0f);
     this->expect_any_hits_match(scene, rays);
+}
+
+// Rays passing a sphere's surface by a hair, at every scale: radii from 1e-6 to 1e3, rays
+// from beside the sphere to 1e4 radii away, direction lengths from 1e-3 to 1e3, passing
+// the center at r (1 + delta) for delta from -2^-8 to 2^-6 (tangent within a few ulps
+// included). The BVH's leaves reject most spheres with a division-free test before the
+// exact one (kernels/sphere_test.h, sphere_may_hit); it must never reject a sphere the
+// exact test hits (without its |O'|^2 term, rays from 1e6 radii away fail here). Checked
+// for brute force and for the BVH's packet and single-ray leaves, against the reference
+// bit for bit.
+TYPED_TEST(KernelTest, NearMissesAtEveryScale) {
+    std::mt19937 rng(2026);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    const auto random_unit = [&] {
+        for (;;) {
+            const Vec3 v{unit(rng), unit(rng), unit(rng)};
+            if (length(v) > 0.1f) return normalize(v);
+        }
+    };
+    Scene scene;
+    scene.materials.push_back({"m", Material{}});
+    std::vector<Ray> rays;
+    for (const float radius : {1e-6f, 1e-3f, 1.0f, 1e3f}) {
+        Object sphere;
+        sphere.radius = radius;
+        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * (radius * 50.0f);
+        scene.objects.push_back(sphere);
+        for (const float delta :
+             {-0x1.0p-8f, -0x1.0p-16f, -0x1.0p-22f, 0.0f, 0x1.0p-22f, 0x1.0p-18f, 0x1.0p-14f,
+              0x1.0p-10f, 0x1.0p-8f, 0x1.0p-7f, 0x1.0p-6f, 0x1.0p-5f, 0x1.0p-4f})
+            for (const float away : {0.0f, 3.0f, 1e4f, 3e5f, 1e6f, 1e6f, 1e6f, 1e6f})
+                for (const float speed : {1e-3f, 1.0f, 1e3f}) {
+                    const Vec3 u = random_unit();
+                    const Vec3 side = normalize(cross(u, random_unit()));
+                    const Vec3 origin =
+                        sphere.center + side * (radius * (1.0f + delta)) - u * (radius * away);
+                    rays.push_back({origin, u * speed, 0.0f, kInfinity});
+                }
+    }
+    // Spheres elsewhere, so the BVH has inner nodes and leaves to skip.
+    for (int i = 0; i < 60; ++i) {
+        Object sphere;
+        sphere.radius = 0.5f;
+        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * 2e5f;
+        scene.objects.push_back(sphere);
+    }
+    this->expect_closest_hits_match(scene, rays, 0.0f);
+    this->expect_any_hits_match(scene, rays);
+    for (const std::uint32_t lanes : {0u, 9u}) {
+        SCOPED_TRACE("BVH, packets of fewer than " + std::to_string(lanes) +
+                     " lanes ray by ray");
+        this->expect_closest_hits_match(scene, rays, 0.0f, lanes);
+        this->expect_any_hits_match(scene, rays, lanes);
+    }
 }
 
 // A sphere and a plane hit at exactly the same t: the one listed first in the file wins,
