@@ -412,14 +412,34 @@ class PacketTracer {
         const float* cx = center_x_.data() + tile.x0;
         const float* cy = center_y_.data() + tile.y0;
         const auto w = static_cast<std::uint32_t>(tile.width);
+        const auto center_sample = [&](TilePixel p, std::size_t m) {
+            sx[m] = cx[p.x];
+            sy[m] = cy[p.y];
+            su[m] = sv[m] = 0.0f;
+            spixel[m] = p.y * w + p.x;
+        };
         if (centers) {  // per_pixel == 1
-            for (std::size_t m = 0; m < n; ++m) {
+            // Four samples in a row are mostly a row of a 4 x 2 block: four neighbouring
+            // columns of one row, copied four at a time (this loop was 3 % of a frame).
+            std::size_t m = 0;
+            for (; m + 4 <= n; m += 4) {
                 const TilePixel p = pixel[first + m];
-                sx[m] = cx[p.x];
-                sy[m] = cy[p.y];
-                su[m] = sv[m] = 0.0f;
-                spixel[m] = p.y * w + p.x;
+                const TilePixel q = pixel[first + m + 3];
+                if (q.y == p.y && q.x == p.x + 3 && pixel[first + m + 1].x == p.x + 1 &&
+                    pixel[first + m + 2].x == p.x + 2) {
+                    _mm_storeu_ps(sx + m, _mm_loadu_ps(cx + p.x));
+                    _mm_storeu_ps(sy + m, _mm_set1_ps(cy[p.y]));
+                    _mm_storeu_ps(su + m, _mm_setzero_ps());
+                    _mm_storeu_ps(sv + m, _mm_setzero_ps());
+                    const std::uint32_t at = p.y * w + p.x;
+                    _mm_storeu_si128(reinterpret_cast<__m128i*>(spixel + m),
+                                     _mm_add_epi32(_mm_set1_epi32(static_cast<int>(at)),
+                                                   _mm_setr_epi32(0, 1, 2, 3)));
+                    continue;
+                }
+                for (std::size_t k = m; k < m + 4; ++k) center_sample(pixel[first + k], k);
             }
+            for (; m < n; ++m) center_sample(pixel[first + m], m);
         } else {
             std::size_t order = first / per_pixel;
             auto k = static_cast<std::uint32_t>(first % per_pixel);
