@@ -48,12 +48,12 @@ template <class F>
 // lie within 20u|O'| of the exact perpendicular (b's rounding, then the quotient's or the
 // product's, then V q and the difference: about 10u|O'| per component), so
 // |l'| <= |l| + 40u|O'| and, with (x + y)^2 <= (1 + 2^-8) x^2 + 257 y^2,
-//   |l'|^2 <= (1 + 2^-8)(1 + 4u) r2 + 257 (40u)^2 |O'|^2 < (1 + 2^-8) r2 + 2^-29 |O'|^2.
+//   |l'|^2 <= (1 + 2^-8)(1 + 4u) r2 + 257 (40u)^2 |O'|^2 < (1 + 2^-8 + 8u) r2 + 2^-29 |O'|^2.
 // The bound below is twice that, and more, on each term (the rounding of the bound and of
 // the dot products, a few u, fits many times in that room); 1e-30 covers underflow in
 // the dot products of tiny spheres. A NaN anywhere keeps its lane (the comparison fails).
-// Near misses (a ray passing within r (1 + 2^-8) + 2^-14 |O'| of the center) still pay
-// for sphere_quadratic.
+// Near misses (a ray passing within about r (1 + 2^-8) + 2^-13.5 |O'| of the center)
+// still pay for sphere_quadratic.
 template <class F>
 [[gnu::always_inline]] inline auto sphere_may_hit(const V3<F>& oc, const V3<F>& d,
                                                   const F& inv_a, const F& r2) {
