@@ -35,9 +35,7 @@ class Image {
     // after `spare`'s is freed (never two frames at once). `spare` is left empty.
     static Image reuse(Image&& spare, int width, int height) {
         Image image;
-        const std::size_t n =
-            static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-        if (spare.pixels_.size() != n) {
+        if (!spare.fits(width, height)) {
             spare = Image();
             return Image(width, height, Uninitialized{});
         }
@@ -45,6 +43,12 @@ class Image {
         image.pixels_ = std::move(spare.pixels_);
         spare = Image();
         return image;
+    }
+
+    // Whether reuse() would hand this image's storage to a width x height image.
+    bool fits(int width, int height) const {
+        return pixels_.size() ==
+               static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
     }
 
     int width() const { return width_; }

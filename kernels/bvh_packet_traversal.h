@@ -184,14 +184,17 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
         for (std::uint32_t i = first; i < end; ++i) {
             const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
             const F r2(s.bvh_r2[i]);
+            V3<F> oc[K];
             auto may_hit = zero != zero;
-            for (std::uint32_t k = 0; k < K; ++k)
-                may_hit = may_hit || sphere_may_hit(sub(o[k], c), d[k], inv_a[k], r2);
+            for (std::uint32_t k = 0; k < K; ++k) {
+                oc[k] = sub(o[k], c);
+                may_hit = may_hit || sphere_may_hit(oc[k], d[k], inv_a[k], r2);
+            }
             if (xsimd::none(may_hit)) continue;
             SphereQuadratic<F> quad[K];
             auto any_root = zero != zero;
             for (std::uint32_t k = 0; k < K; ++k) {
-                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                quad[k] = sphere_quadratic(oc[k], d[k], a[k], r2);
                 any_root = any_root || quad[k].disc >= zero;
             }
             if (xsimd::none(any_root)) continue;
@@ -256,8 +259,9 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
             const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
             const F r2(s.bvh_r2[i]);
             for (std::uint32_t k = 0; k < K; ++k) {
-                if (xsimd::none(sphere_may_hit(sub(o[k], c), d[k], inv_a[k], r2))) continue;
-                const SphereQuadratic<F> quad = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                const V3<F> oc = sub(o[k], c);
+                if (xsimd::none(sphere_may_hit(oc, d[k], inv_a[k], r2))) continue;
+                const SphereQuadratic<F> quad = sphere_quadratic(oc, d[k], a[k], r2);
                 if (xsimd::none(quad.disc >= zero)) continue;
                 const auto [t_near, t_far] = sphere_roots(quad, a[k]);
                 const auto hit =

@@ -196,9 +196,9 @@ TileScratch& scratch_for_thread() {
 // Maps the fresh pages of a render's frame before its tiles write them, 2 MiB per task on
 // the render's threads: one madvise(MADV_POPULATE_WRITE) per 2 MiB instead of a page
 // fault per 4 KiB page. The kernel still zeroes every page; a 1920x1080 frame (25 MB)
-// took 9 ms this way against 10-14 ms of faults (docs/performance-log.md, "The first
-// frame"). Advice only: a kernel before Linux 5.14 refuses it, and the tiles' first
-// touch maps the pages as before.
+// took 7-10 ms this way against 10-14 ms of faults (docs/performance-log.md, "Division-free
+// rejection in the BVH leaves, render_tile's loops, the first frame"). Advice only: a kernel
+// before Linux 5.14 refuses it, and the tiles' first touch maps the pages as before.
 void populate_frame(Image& image) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     constexpr std::size_t kPage = 4096, kChunk = std::size_t{2} << 20;
@@ -234,6 +234,10 @@ void accumulate_primary(const kernels::SurfaceColor& c, const std::uint32_t* pix
     const float* const local[3] = {c.local_r, c.local_g, c.local_b};
     const float* const reflect[3] = {c.tail_reflect_r, c.tail_reflect_g, c.tail_reflect_b};
     const float* const refract[3] = {c.tail_refract_r, c.tail_refract_g, c.tail_refract_b};
+    const auto add_one = [&](std::uint32_t q) {
+        for (int k = 0; k < 3; ++k)
+            acc[k][pixel[q]] += (local[k][q] + reflect[k][q]) + refract[k][q];
+    };
     std::uint32_t r = 0;
     for (; r + 4 <= count; r += 4) {
         const std::uint32_t p = pixel[r];
@@ -246,13 +250,9 @@ void accumulate_primary(const kernels::SurfaceColor& c, const std::uint32_t* pix
             }
             continue;
         }
-        for (std::uint32_t q = r; q < r + 4; ++q)
-            for (int k = 0; k < 3; ++k)
-                acc[k][pixel[q]] += (local[k][q] + reflect[k][q]) + refract[k][q];
+        for (std::uint32_t q = r; q < r + 4; ++q) add_one(q);
     }
-    for (; r < count; ++r)
-        for (int k = 0; k < 3; ++k)
-            acc[k][pixel[r]] += (local[k][r] + reflect[k][r]) + refract[k][r];
+    for (; r < count; ++r) add_one(r);
 }
 
 // Adds each unoccluded shadow ray's light term to its parent's color. Shadow rays of one
@@ -577,7 +577,7 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     // Every pixel of the rectangle is written by its tile.
     // A frame in fresh storage (not a spare of the right size) has its pages mapped first.
     const bool fresh_frame = options.spare_image == nullptr ||
-                             options.spare_image->pixel_count() != rect.pixel_count();
+                             !options.spare_image->fits(rect.width(), rect.height());
     result.image =
         options.spare_image != nullptr
             ? Image::reuse(std::move(*options.spare_image), rect.width(), rect.height())

@@ -106,6 +106,21 @@ Ray random_ray(std::mt19937& rng, float t_min) {
     return r;
 }
 
+// A compiled scene and the view the kernels read: brute force, or, with `bvh_min_lanes`,
+// through the spheres' BVH, packets with fewer live lanes going on ray by ray (0: packets
+// only, 9: single rays only).
+struct TestView {
+    CompiledScene compiled;
+    SphereBvh bvh;
+    kernels::SceneView view;
+
+    TestView(const Scene& scene, std::optional<std::uint32_t> bvh_min_lanes)
+        : compiled(compile_scene(scene)),
+          bvh(bvh_min_lanes ? build_sphere_bvh(compiled.spheres) : SphereBvh{}),
+          view(bvh_min_lanes ? make_scene_view(compiled, bvh, *bvh_min_lanes, *bvh_min_lanes)
+                             : make_scene_view(compiled)) {}
+};
+
 template <class Tag>
 class KernelTest : public ::testing::Test {
   protected:
@@ -114,17 +129,13 @@ class KernelTest : public ::testing::Test {
     }
     const kernels::KernelTable& k() const { return kernel_table(Tag::isa); }
 
-    // Closest hits of `rays` (all with the same t_min) against the reference's intersect().
-    // `bvh_min_lanes`: through the spheres' BVH, packets with fewer live lanes going on
-    // ray by ray (0: packets only, 9: single rays only); without it, brute force.
+    // Closest hits of `rays` (all with the same t_min) against the reference's intersect(),
+    // brute force or through the BVH (TestView).
     void expect_closest_hits_match(const Scene& scene, const std::vector<Ray>& rays,
                                    float t_min,
                                    std::optional<std::uint32_t> bvh_min_lanes = {}) {
-        const CompiledScene compiled = compile_scene(scene);
-        const SphereBvh bvh = build_sphere_bvh(compiled.spheres);
-        const kernels::SceneView view =
-            bvh_min_lanes ? make_scene_view(compiled, bvh, *bvh_min_lanes, *bvh_min_lanes)
-                          : make_scene_view(compiled);
+        const TestView tv(scene, bvh_min_lanes);
+        const kernels::SceneView& view = tv.view;
         const ReferenceTracer ref(scene);
         Rays stream(rays.size());
         for (std::size_t i = 0; i < rays.size(); ++i) stream.set(i, rays[i]);
@@ -149,11 +160,8 @@ class KernelTest : public ::testing::Test {
 
     void expect_any_hits_match(const Scene& scene, const std::vector<Ray>& rays,
                                std::optional<std::uint32_t> bvh_min_lanes = {}) {
-        const CompiledScene compiled = compile_scene(scene);
-        const SphereBvh bvh = build_sphere_bvh(compiled.spheres);
-        const kernels::SceneView view =
-            bvh_min_lanes ? make_scene_view(compiled, bvh, *bvh_min_lanes, *bvh_min_lanes)
-                          : make_scene_view(compiled);
+        const TestView tv(scene, bvh_min_lanes);
+        const kernels::SceneView& view = tv.view;
         const ReferenceTracer ref(scene);
         Rays stream(rays.size());
         for (std::size_t i = 0; i < rays.size(); ++i) stream.set(i, rays[i]);
