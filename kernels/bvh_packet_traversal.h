@@ -141,6 +141,87 @@ void push_packet_children(const SceneView& s, const BvhNode8& n, const BvhPacket
     sp += count;
 }
 
+// A packet's rays in registers (K of them) for the sphere tests of a leaf or a beam
+// (bvh_beam.h), with its closest hits so far.
+template <class F, std::uint32_t K>
+struct PacketRays {
+    V3<F> o[K], d[K];
+    F a[K], inv_a[K], best_t[K], best_id[K];
+
+    explicit PacketRays(const BvhPacket& p) {
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const std::uint32_t at = k * F::size;
+            o[k] = load3<F>(p.ox, p.oy, p.oz, at);
+            d[k] = load3<F>(p.dx, p.dy, p.dz, at);
+            a[k] = F::load_aligned(p.a + at);
+            inv_a[k] = F(1.0f) / a[k];
+            best_t[k] = F::load_aligned(p.best_t + at);
+            best_id[k] = F::load_aligned(p.best_id + at);
+        }
+    }
+    void store(BvhPacket& p) const {
+        for (std::uint32_t k = 0; k < K; ++k) {
+            best_t[k].store_aligned(p.best_t + k * F::size);
+            best_id[k].store_aligned(p.best_id + k * F::size);
+        }
+    }
+};
+
+// Sphere i of the BVH's arrays against every lane of `r` (hits on (tmin, inf)): the
+// division-free test first (sphere_may_hit), then the exact one where some lane may hit.
+template <class F, std::uint32_t K>
+[[gnu::always_inline]] inline void packet_closest_sphere(const SceneView& s, std::uint32_t i,
+                                                         PacketRays<F, K>& r, const F& tmin) {
+    const F zero(0.0f);
+    const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
+    const F r2(s.bvh_r2[i]);
+    V3<F> oc[K];
+    auto may_hit = zero != zero;
+    for (std::uint32_t k = 0; k < K; ++k) {
+        oc[k] = sub(r.o[k], c);
+        may_hit = may_hit || sphere_may_hit(oc[k], r.d[k], r.inv_a[k], r2);
+    }
+    if (xsimd::none(may_hit)) return;
+    SphereQuadratic<F> quad[K];
+    auto any_root = zero != zero;
+    for (std::uint32_t k = 0; k < K; ++k) {
+        quad[k] = sphere_quadratic(oc[k], r.d[k], r.a[k], r2);
+        any_root = any_root || quad[k].disc >= zero;
+    }
+    if (xsimd::none(any_root)) return;
+    const F id(static_cast<float>(s.bvh_object[i]));
+    for (std::uint32_t k = 0; k < K; ++k) {
+        const auto [t_near, t_far] = sphere_roots(quad[k], r.a[k]);
+        const F t = xsimd::select(t_near > tmin, t_near, t_far);
+        const auto hit =
+            t > tmin && (t < r.best_t[k] || (t == r.best_t[k] && id < r.best_id[k]));
+        r.best_t[k] = xsimd::select(hit, t, r.best_t[k]);
+        r.best_id[k] = xsimd::select(hit, id, r.best_id[k]);
+    }
+}
+
+// The lanes of `r` that sphere i occludes on (0, t_max), t_max in r.best_t, as bits.
+template <class F, std::uint32_t K>
+[[gnu::always_inline]] inline std::uint32_t packet_occluding_sphere(const SceneView& s,
+                                                                    std::uint32_t i,
+                                                                    const PacketRays<F, K>& r) {
+    const F zero(0.0f);
+    const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
+    const F r2(s.bvh_r2[i]);
+    std::uint32_t bits = 0;
+    for (std::uint32_t k = 0; k < K; ++k) {
+        const V3<F> oc = sub(r.o[k], c);
+        if (xsimd::none(sphere_may_hit(oc, r.d[k], r.inv_a[k], r2))) continue;
+        const SphereQuadratic<F> quad = sphere_quadratic(oc, r.d[k], r.a[k], r2);
+        if (xsimd::none(quad.disc >= zero)) continue;
+        const auto [t_near, t_far] = sphere_roots(quad, r.a[k]);
+        const F t_max = r.best_t[k];
+        const auto hit = (t_near > zero && t_near < t_max) || (t_far > zero && t_far < t_max);
+        bits |= mask_bits<F>(hit) << (k * F::size);
+    }
+    return bits;
+}
+
 // Closest hits of the packet `p` (lanes `live`, not empty: packet_frustum) among the BVH's
 // spheres.
 template <class Arch>
@@ -169,49 +250,10 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
         }
         // A leaf: each sphere broadcast against the packet, as the brute-force kernel does,
         // with ties to the lower file index.
-        V3<F> o[K], d[K];
-        F a[K], inv_a[K], best_t[K], best_id[K];
-        for (std::uint32_t k = 0; k < K; ++k) {
-            const std::uint32_t at = k * W;
-            o[k] = load3<F>(p.ox, p.oy, p.oz, at);
-            d[k] = load3<F>(p.dx, p.dy, p.dz, at);
-            a[k] = F::load_aligned(p.a + at);
-            inv_a[k] = F(1.0f) / a[k];
-            best_t[k] = F::load_aligned(p.best_t + at);
-            best_id[k] = F::load_aligned(p.best_id + at);
-        }
+        PacketRays<F, K> r(p);
         const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
-        for (std::uint32_t i = first; i < end; ++i) {
-            const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
-            const F r2(s.bvh_r2[i]);
-            V3<F> oc[K];
-            auto may_hit = zero != zero;
-            for (std::uint32_t k = 0; k < K; ++k) {
-                oc[k] = sub(o[k], c);
-                may_hit = may_hit || sphere_may_hit(oc[k], d[k], inv_a[k], r2);
-            }
-            if (xsimd::none(may_hit)) continue;
-            SphereQuadratic<F> quad[K];
-            auto any_root = zero != zero;
-            for (std::uint32_t k = 0; k < K; ++k) {
-                quad[k] = sphere_quadratic(oc[k], d[k], a[k], r2);
-                any_root = any_root || quad[k].disc >= zero;
-            }
-            if (xsimd::none(any_root)) continue;
-            const F id(static_cast<float>(s.bvh_object[i]));
-            for (std::uint32_t k = 0; k < K; ++k) {
-                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
-                const F t = xsimd::select(t_near > tmin, t_near, t_far);
-                const auto hit =
-                    t > tmin && (t < best_t[k] || (t == best_t[k] && id < best_id[k]));
-                best_t[k] = xsimd::select(hit, t, best_t[k]);
-                best_id[k] = xsimd::select(hit, id, best_id[k]);
-            }
-        }
-        for (std::uint32_t k = 0; k < K; ++k) {
-            best_t[k].store_aligned(p.best_t + k * W);
-            best_id[k].store_aligned(p.best_id + k * W);
-        }
+        for (std::uint32_t i = first; i < end; ++i) packet_closest_sphere(s, i, r, tmin);
+        r.store(p);
     }
 }
 
@@ -222,9 +264,7 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
                                   BvhStacks& st) {
     using FN = xsimd::batch<float, Arch>;          // a node's children
     using F = xsimd::batch<float, RayArch<Arch>>;  // the packet's rays
-    constexpr std::uint32_t W = F::size;
-    constexpr std::uint32_t K = kTraversalWidth / W;
-    const F zero(0.0f);
+    constexpr std::uint32_t K = kTraversalWidth / F::size;
     const PacketFrustum<FN> fr = packet_frustum<FN, F>(p, live);
     std::uint32_t done = 0, sp = 0;
     st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint16_t>(live);
@@ -244,31 +284,10 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
                                             st, sp);
             continue;
         }
-        V3<F> o[K], d[K];
-        F a[K], inv_a[K], t_max[K];
-        for (std::uint32_t k = 0; k < K; ++k) {
-            const std::uint32_t at = k * W;
-            o[k] = load3<F>(p.ox, p.oy, p.oz, at);
-            d[k] = load3<F>(p.dx, p.dy, p.dz, at);
-            a[k] = F::load_aligned(p.a + at);
-            inv_a[k] = F(1.0f) / a[k];
-            t_max[k] = F::load_aligned(p.best_t + at);
-        }
+        const PacketRays<F, K> r(p);  // best_t: each lane's t_max
         const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
-        for (std::uint32_t i = first; i < end && (done & mask) != mask; ++i) {
-            const V3<F> c{F(s.bvh_cx[i]), F(s.bvh_cy[i]), F(s.bvh_cz[i])};
-            const F r2(s.bvh_r2[i]);
-            for (std::uint32_t k = 0; k < K; ++k) {
-                const V3<F> oc = sub(o[k], c);
-                if (xsimd::none(sphere_may_hit(oc, d[k], inv_a[k], r2))) continue;
-                const SphereQuadratic<F> quad = sphere_quadratic(oc, d[k], a[k], r2);
-                if (xsimd::none(quad.disc >= zero)) continue;
-                const auto [t_near, t_far] = sphere_roots(quad, a[k]);
-                const auto hit =
-                    (t_near > zero && t_near < t_max[k]) || (t_far > zero && t_far < t_max[k]);
-                done |= (mask_bits<F>(hit) << (k * W)) & mask;
-            }
-        }
+        for (std::uint32_t i = first; i < end && (done & mask) != mask; ++i)
+            done |= packet_occluding_sphere(s, i, r) & mask;
     }
     return done;
 }

@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "kernels/brute_force.h"
+#include "kernels/bvh_beam.h"
 #include "kernels/bvh_packet.h"
 #include "kernels/bvh_packet_traversal.h"
 #include "kernels/plane_test.h"
@@ -45,37 +46,70 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
     constexpr std::uint32_t W = F::size;
     BvhPacket p;
     BvhStacks st;
+    Beam beam;
     const F tmin(t_min);
-    for (std::uint32_t base = 0; base < count; base += kTraversalWidth) {
-        const std::uint32_t live = live_bits(base, count);
-        if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
-                                nullptr, base, count, p) &
-             live) != live) {
-            // Box tests would overflow: this packet against every sphere.
-            const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
-                                rays.dx + base,   rays.dy + base, rays.dz + base,
-                                rays.wr + base,   rays.wg + base, rays.wb + base,
-                                rays.pixel + base};
-            closest_hit_all<Arch>(
-                s, one, count - base < kTraversalWidth ? count - base : kTraversalWidth, t_min,
-                HitStream{hits.t + base, hits.object + base});
-            continue;
-        }
-        bvh_closest_packet<Arch>(s, p, live, t_min, st);
-        // Planes stay outside the tree.
-        for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
-            F best_t = F::load_aligned(p.best_t + at),
-              best_id = F::load_aligned(p.best_id + at);
-            closest_planes(s, load3<F>(p.ox, p.oy, p.oz, at), load3<F>(p.dx, p.dy, p.dz, at),
-                           tmin, best_t, best_id);
-            best_t.store_aligned(p.best_t + at);
-            best_id.store_aligned(p.best_id + at);
-        }
-        // Back to the stream by its own packets, none past its end.
-        for (std::uint32_t at = 0; at < kTraversalWidth && base + at < count; at += FN::size) {
-            FN::load_aligned(p.best_t + at).store_aligned(hits.t + base + at);
-            xsimd::to_int(FN::load_aligned(p.best_id + at))  // ids < 2^24
-                .store_aligned(hits.object + base + at);
+    for (std::uint32_t group = 0; group < count; group += kBeamRays) {
+        // A group of rays from one origin is a beam (bvh_beam.h).
+        const std::uint32_t n = count - group < kBeamRays ? count - group : kBeamRays;
+        const bool in_beam =
+            n > kTraversalWidth && beam_rays<FN>(s, rays, group, n, count, beam);
+        if (in_beam) beam_gather<FN>(s, beam, st.ray_node);
+        for (std::uint32_t base = group; base < group + n; base += kTraversalWidth) {
+            const std::uint32_t live = live_bits(base, count);
+            // Lanes the BVH traverses: all of them, or those a beam leaves unfinished.
+            std::uint32_t traverse = live;
+            alignas(64) float beam_t[kTraversalWidth], beam_id[kTraversalWidth];
+            if (in_beam) {
+                load_beam_packet<F>(rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
+                                    nullptr, base, count, p);
+                traverse = beam_closest_packet<Arch>(s, beam, base - group, p, live, t_min);
+                if (traverse != 0) {
+                    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
+                        F::load_aligned(p.best_t + at).store_aligned(beam_t + at);
+                        F::load_aligned(p.best_id + at).store_aligned(beam_id + at);
+                    }
+                }
+            }
+            if (traverse != 0) {
+                if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
+                                        nullptr, base, count, p) &
+                     live) != live) {
+                    // Box tests would overflow: this packet against every sphere.
+                    const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
+                                        rays.dx + base,   rays.dy + base, rays.dz + base,
+                                        rays.wr + base,   rays.wg + base, rays.wb + base,
+                                        rays.pixel + base};
+                    closest_hit_all<Arch>(
+                        s, one, count - base < kTraversalWidth ? count - base : kTraversalWidth,
+                        t_min, HitStream{hits.t + base, hits.object + base});
+                    continue;
+                }
+                if (in_beam) {
+                    // The traversal goes on from the beam's hits (the tie rule makes the
+                    // result the same as from none).
+                    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
+                        F::load_aligned(beam_t + at).store_aligned(p.best_t + at);
+                        F::load_aligned(beam_id + at).store_aligned(p.best_id + at);
+                    }
+                }
+                bvh_closest_packet<Arch>(s, p, traverse, t_min, st);
+            }
+            // Planes stay outside the tree.
+            for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
+                F best_t = F::load_aligned(p.best_t + at),
+                  best_id = F::load_aligned(p.best_id + at);
+                closest_planes(s, load3<F>(p.ox, p.oy, p.oz, at),
+                               load3<F>(p.dx, p.dy, p.dz, at), tmin, best_t, best_id);
+                best_t.store_aligned(p.best_t + at);
+                best_id.store_aligned(p.best_id + at);
+            }
+            // Back to the stream by its own packets, none past its end.
+            for (std::uint32_t at = 0; at < kTraversalWidth && base + at < count;
+                 at += FN::size) {
+                FN::load_aligned(p.best_t + at).store_aligned(hits.t + base + at);
+                xsimd::to_int(FN::load_aligned(p.best_id + at))  // ids < 2^24
+                    .store_aligned(hits.object + base + at);
+            }
         }
     }
 }
@@ -112,6 +146,30 @@ std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std:
     done &= live;
     if (done == live) return done;  // no lane left to trace
     return done | bvh_occluded_packet<Arch>(s, p, live & ~done, st);
+}
+
+// occluded_packet for rays of a shadow beam (bvh_beam.h): planes, then the beam's spheres,
+// then the BVH for the lanes the beam leaves unfinished.
+template <class Arch>
+std::uint32_t beam_occluded(const SceneView& s, const ShadowStream& rays, const Beam& beam,
+                            std::uint32_t group, std::uint32_t base, std::uint32_t count,
+                            std::uint32_t live, BvhPacket& p, BvhStacks& st) {
+    using F = xsimd::batch<float, RayArch<Arch>>;
+    constexpr std::uint32_t W = F::size;
+    load_beam_packet<F>(rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t_max, base,
+                        count, p);
+    std::uint32_t done = 0;
+    for (std::uint32_t at = 0; at < kTraversalWidth; at += W)
+        done |= mask_bits<F>(any_plane(s, load3<F>(p.ox, p.oy, p.oz, at),
+                                       load3<F>(p.dx, p.dy, p.dz, at),
+                                       F::load_aligned(p.best_t + at)))
+                << at;
+    done &= live;
+    if (done == live) return done;
+    std::uint32_t unfinished = 0;
+    done |= beam_occluded_packet<Arch>(s, beam, base - group, p, live & ~done, unfinished);
+    if (unfinished == 0) return done;
+    return done | occluded_packet<Arch>(s, rays, base, count, unfinished, p, st);
 }
 
 // Shadow rays are traced in batches of up to this many, regrouped into packets of rays
@@ -157,12 +215,24 @@ void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t cou
     BvhPacket p;
     BvhStacks st;
     if (count < kShadowSortMin || s.sphere_count < s.bvh_shadow_sort_min_spheres) {
-        for (std::uint32_t base = 0; base < count; base += kTraversalWidth) {
-            const std::uint32_t live = live_bits(base, count);
-            const std::uint32_t bits = occluded_packet<Arch>(s, rays, base, count, live, p, st);
-            // Whole stream packets (kernel_types.h), none past the stream's end.
-            for (std::uint32_t i = 0; i < kTraversalWidth && base + i < count; ++i)
-                occluded[base + i] = (bits >> i) & 1u;
+        using FN = xsimd::batch<float, Arch>;
+        Beam beam;
+        for (std::uint32_t group = 0; group < count; group += kBeamRays) {
+            // Rays towards one point light from one tile are a beam (bvh_beam.h).
+            const std::uint32_t n = count - group < kBeamRays ? count - group : kBeamRays;
+            const bool in_beam =
+                n > kTraversalWidth && shadow_beam_rays<FN>(s, rays, group, n, count, beam);
+            if (in_beam) beam_gather<FN>(s, beam, st.ray_node);
+            for (std::uint32_t base = group; base < group + n; base += kTraversalWidth) {
+                const std::uint32_t live = live_bits(base, count);
+                const std::uint32_t bits =
+                    in_beam
+                        ? beam_occluded<Arch>(s, rays, beam, group, base, count, live, p, st)
+                        : occluded_packet<Arch>(s, rays, base, count, live, p, st);
+                // Whole stream packets (kernel_types.h), none past the stream's end.
+                for (std::uint32_t i = 0; i < kTraversalWidth && base + i < count; ++i)
+                    occluded[base + i] = (bits >> i) & 1u;
+            }
         }
         return;
     }

@@ -592,6 +592,184 @@ class BvhTraversalTest : public ::testing::Test {
 };
 TYPED_TEST_SUITE(BvhTraversalTest, Isas);
 
+// Streams whose groups of 256 rays share their origin: the beams of closest_hit
+// (kernels/bvh_beam.h). Each group is a grid of 16 x 16 directions about a random axis,
+// from 1e-4 to 1 radian wide, from an origin in or around the scene; in every other group
+// the grid's first row grazes a sphere's silhouette (to within a few ulps, from 10 to 10^6
+// radii away), so that the sphere lies on the edge of the beam's pyramid and of its first
+// packet's. A last group of 37 rays leaves a partial beam.
+std::vector<Ray> beam_test_rays(const CompiledScene& c, std::mt19937& rng, int groups,
+                                bool wide) {
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f), unit(-1.0f, 1.0f);
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (std::uint32_t i = 0; i < c.spheres.count; ++i) {
+        const float p[3] = {c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
+        for (int a = 0; a < 3; ++a)
+            lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+    }
+    const auto in_box = [&](float grow) {
+        Vec3 p;
+        float* q[3] = {&p.x, &p.y, &p.z};
+        for (int a = 0; a < 3; ++a) {
+            const float ext = std::max(hi[a] - lo[a], 1e-3f);
+            *q[a] = lo[a] - grow * ext + (1 + 2 * grow) * ext * u01(rng);
+        }
+        return p;
+    };
+    std::vector<Ray> rays;
+    for (int g = 0; g <= groups; ++g) {
+        Vec3 origin = in_box(wide ? 0.0f : 1.5f), axis = normalize(in_box(0.0f) - origin);
+        // Radians across the grid; wide groups from inside the scene hold many spheres.
+        float width = wide ? 0.5f + u01(rng) : std::pow(10.0f, -4.0f + 4.0f * u01(rng));
+        Vec3 right = normalize(cross(axis, Vec3{0.36f, 0.8f, -0.48f}));
+        Vec3 up = cross(right, axis);
+        const bool graze = g % 2 == 1;
+        if (graze) {
+            // The ray along the axis passes sphere i at r + miss from its center, offset
+            // along the normal of one of the beam's planes (the plane of slopes through
+            // the axis that holds the coordinate axis b): the sphere lies just outside or
+            // inside the face of the pyramid. |miss| goes up to 64 u D, beyond the exact
+            // test's rounding (10 u |O'|), whose hits the beam must keep. The first row
+            // lies in that plane (column 8 on the axis); the others step away from the
+            // sphere, and the grid is narrow (down to rays equal in float), so that the
+            // pyramid's face is the grazing plane.
+            const auto i = static_cast<std::uint32_t>(rng() % c.spheres.count);
+            const Vec3 center{c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
+            const float r = c.spheres.radius[i];
+            const float distance = r * std::pow(10.0f, 1.0f + 5.0f * u01(rng));
+            axis = normalize(Vec3{unit(rng), unit(rng), unit(rng)});
+            const float comp[3] = {std::fabs(axis.x), std::fabs(axis.y), std::fabs(axis.z)};
+            const int m = comp[0] >= comp[1] && comp[0] >= comp[2] ? 0
+                          : comp[1] >= comp[2]                     ? 1
+                                                                   : 2;
+            const int b = (m + 1 + static_cast<int>(rng() % 2)) % 3;
+            const Vec3 e_b{b == 0 ? 1.0f : 0.0f, b == 1 ? 1.0f : 0.0f, b == 2 ? 1.0f : 0.0f};
+            const Vec3 side = normalize(cross(axis, e_b)) * (rng() % 2 ? 1.0f : -1.0f);
+            const float miss =
+                unit(rng) * 64.0f * 0x1.0p-24f * distance * std::pow(10.0f, -2.0f * u01(rng));
+            origin = center - axis * distance - side * (r + miss);
+            right = normalize(cross(axis, side));
+            up = side * -1.0f;
+            width = std::pow(10.0f, -9.0f + 5.0f * u01(rng));
+        }
+        const int count = g == groups ? 37 : 256;
+        for (int k = 0; k < count; ++k) {
+            const float x = (static_cast<float>(k % 16) - 8.0f) / 15.0f * width;
+            const float y =
+                (static_cast<float>(k / 16) - (graze ? 0.0f : 7.5f)) / 15.0f * width;
+            Ray r;
+            r.origin = origin;
+            r.direction = axis + right * x + up * y;
+            r.t_max = INFINITY;
+            rays.push_back(r);
+        }
+    }
+    return rays;
+}
+
+template <class Tag>
+class BeamTraversalTest : public BvhTraversalTest<Tag> {
+  protected:
+    // closest_hit on beams against the reference, ray by ray, bit for bit.
+    void check_beams(const NamedScene& ns, int groups, bool wide = false) {
+        SCOPED_TRACE(ns.name);
+        const CompiledScene c = compile_scene(ns.scene);
+        const SphereBvh bvh = build_sphere_bvh(c.spheres);
+        const kernels::SceneView view = make_scene_view(c, bvh, 3);
+        ASSERT_NE(view.bvh_nodes, nullptr);
+        const kernels::KernelTable& k = kernel_table(Tag::isa);
+        const ReferenceTracer ref(ns.scene);
+        std::mt19937 rng(4242);
+        const std::vector<Ray> rays = beam_test_rays(c, rng, groups, wide);
+        const auto n = static_cast<std::uint32_t>(rays.size());
+        RaySoA soa(rays);
+        int mismatches = 0;
+        for (const float t_min : {1e-3f, 0.0f}) {
+            AlignedVector<float> t(padded(n), -7.0f);
+            AlignedVector<std::int32_t> id(padded(n), -7);
+            k.closest_hit(view, soa.stream(), n, t_min, {t.data(), id.data()});
+            for (std::uint32_t i = 0; i < n && mismatches < 10; ++i) {
+                Ray r = rays[i];
+                r.t_min = t_min;
+                const std::optional<SurfaceHit> hit = ref.intersect(r);
+                const std::int32_t want_id = hit ? static_cast<std::int32_t>(hit->object) : -1;
+                const float want_t = hit ? hit->t : INFINITY;
+                if (id[i] != want_id || !(t[i] == want_t)) {
+                    ++mismatches;
+                    ADD_FAILURE() << "closest hit, ray " << i << " (group " << i / 256
+                                  << ") t_min " << t_min << ": got " << id[i] << " at " << t[i]
+                                  << ", reference " << want_id << " at " << want_t;
+                }
+            }
+        }
+    }
+
+    // any_hit on shadow beams against the reference: the same groups turned around, each
+    // ray a segment from a point beyond the scene (or inside it) back to the group's
+    // origin, as shadow rays towards a point light (V = L - P, t_max = 1), in every other
+    // group from points moved off by up to 1e-3 of the segment (as P + eps N is).
+    void check_shadow_beams(const NamedScene& ns, int groups, bool wide = false) {
+        SCOPED_TRACE(ns.name + ", shadow beams");
+        const CompiledScene c = compile_scene(ns.scene);
+        const SphereBvh bvh = build_sphere_bvh(c.spheres);
+        kernels::SceneView view = make_scene_view(c, bvh, 3);
+        view.bvh_shadow_sort_min_spheres = ~0u;  // in the order given: the beams' path
+        const kernels::KernelTable& k = kernel_table(Tag::isa);
+        const ReferenceTracer ref(ns.scene);
+        std::mt19937 rng(4243);
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f), unit(-1.0f, 1.0f);
+        std::vector<Ray> rays = beam_test_rays(c, rng, groups, wide);
+        for (std::size_t g = 0; g < rays.size(); g += 256) {
+            const float reach = std::pow(10.0f, (wide ? 0.0f : -1.0f) + 3.0f * u01(rng));
+            const bool moved = g / 256 % 2 == 1;
+            for (std::size_t i = g; i < std::min(rays.size(), g + 256); ++i) {
+                Ray& r = rays[i];
+                const Vec3 light = r.origin;
+                Vec3 from = light + r.direction * reach;
+                if (moved)
+                    from = from + Vec3{unit(rng), unit(rng), unit(rng)} * (1e-4f * reach);
+                r.origin = from;
+                r.direction = light - from;
+                r.t_max = 1.0f;
+            }
+        }
+        const auto n = static_cast<std::uint32_t>(rays.size());
+        RaySoA soa(rays);
+        AlignedVector<std::uint32_t> occluded(padded(n) + kPacketWidth, 7u);
+        k.any_hit(view, soa.shadow(), n, occluded.data());
+        int mismatches = 0;
+        for (std::uint32_t i = 0; i < n && mismatches < 10; ++i) {
+            const bool want = ref.occluded(rays[i]);
+            if (occluded[i] != (want ? 1u : 0u)) {
+                ++mismatches;
+                ADD_FAILURE() << "any hit, ray " << i << " (group " << i / 256 << "): got "
+                              << occluded[i] << ", reference " << want;
+            }
+        }
+    }
+};
+TYPED_TEST_SUITE(BeamTraversalTest, Isas);
+
+TYPED_TEST(BeamTraversalTest, GroupsFromOneOrigin) {
+    for (const NamedScene& ns : test_scenes()) this->check_beams(ns, 16);
+}
+
+TYPED_TEST(BeamTraversalTest, ShadowGroupsTowardsOnePoint) {
+    for (const NamedScene& ns : test_scenes()) this->check_shadow_beams(ns, 16);
+}
+
+// More spheres in a beam than it gathers (kBeamMaxSpheres): its packets finish in the BVH
+// where their hits lie beyond the spheres gathered.
+TYPED_TEST(BeamTraversalTest, CrowdedBeams) {
+    std::mt19937 rng(77);
+    const NamedScene crowded{"4000 small spheres",
+                             scene_of(random_spheres(rng, 4000, 2.0f, 0.01f, 0.04f))};
+    this->check_beams(crowded, 16, true);
+    this->check_shadow_beams(crowded, 16, true);
+    this->check_beams(large_scene(), 8);
+    this->check_shadow_beams(large_scene(), 8);
+}
+
 TYPED_TEST(BvhTraversalTest, PacketsSwitchingToSingleRays) {
     for (const NamedScene& ns : test_scenes()) this->check(ns, 3, 1200);
 }
