@@ -169,7 +169,9 @@ struct PacketRays {
 
 // Sphere i of the BVH's arrays against every lane of `r` (hits on (tmin, inf)): the
 // division-free test first (sphere_may_hit), then the exact one where some lane may hit.
-template <class F, std::uint32_t K>
+// kPreTest: whether sphere_may_hit runs first (in the leaves, where most spheres miss
+// every lane; not in a beam, whose spheres lie in the packet's pyramid).
+template <class F, std::uint32_t K, bool kPreTest = true>
 [[gnu::always_inline]] inline void packet_closest_sphere(const SceneView& s, std::uint32_t i,
                                                          PacketRays<F, K>& r, const F& tmin) {
     const F zero(0.0f);
@@ -179,9 +181,10 @@ template <class F, std::uint32_t K>
     auto may_hit = zero != zero;
     for (std::uint32_t k = 0; k < K; ++k) {
         oc[k] = sub(r.o[k], c);
-        may_hit = may_hit || sphere_may_hit(oc[k], r.d[k], r.inv_a[k], r2);
+        if constexpr (kPreTest)
+            may_hit = may_hit || sphere_may_hit(oc[k], r.d[k], r.inv_a[k], r2);
     }
-    if (xsimd::none(may_hit)) return;
+    if (kPreTest && xsimd::none(may_hit)) return;
     SphereQuadratic<F> quad[K];
     auto any_root = zero != zero;
     for (std::uint32_t k = 0; k < K; ++k) {
@@ -201,7 +204,7 @@ template <class F, std::uint32_t K>
 }
 
 // The lanes of `r` that sphere i occludes on (0, t_max), t_max in r.best_t, as bits.
-template <class F, std::uint32_t K>
+template <class F, std::uint32_t K, bool kPreTest = true>
 [[gnu::always_inline]] inline std::uint32_t packet_occluding_sphere(const SceneView& s,
                                                                     std::uint32_t i,
                                                                     const PacketRays<F, K>& r) {
@@ -211,7 +214,7 @@ template <class F, std::uint32_t K>
     std::uint32_t bits = 0;
     for (std::uint32_t k = 0; k < K; ++k) {
         const V3<F> oc = sub(r.o[k], c);
-        if (xsimd::none(sphere_may_hit(oc, r.d[k], r.inv_a[k], r2))) continue;
+        if (kPreTest && xsimd::none(sphere_may_hit(oc, r.d[k], r.inv_a[k], r2))) continue;
         const SphereQuadratic<F> quad = sphere_quadratic(oc, r.d[k], r.a[k], r2);
         if (xsimd::none(quad.disc >= zero)) continue;
         const auto [t_near, t_far] = sphere_roots(quad, r.a[k]);
