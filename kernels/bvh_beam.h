@@ -479,9 +479,9 @@ std::uint32_t beam_occluded_packet(const SceneView& s, const Beam& beam, std::ui
         for (std::uint32_t block = first; block < first + 16; block += W)
             for (std::uint32_t bits = pyramid.keeps(beam, block); bits != 0 && done != live;
                  bits &= bits - 1)
-                done |= packet_occluding_sphere<F, K, false>(
-                            s, beam.sphere[block + __builtin_ctz(bits)], r) &
-                        live;
+                done |=
+                    packet_occluding_sphere(s, beam.sphere[block + __builtin_ctz(bits)], r) &
+                    live;
     }
     unfinished = 0;
     if (beam.horizon != kInf) {
