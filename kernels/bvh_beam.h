@@ -93,26 +93,39 @@ struct Beam {
     float block_near[kBeamMaxSpheres / 16];
 };
 
-// The beam's slope bounds from per-lane bounds (F: their registers), and its planes'
-// norms.
+// The rays' slopes, stored per ray in the beam and bounded lane by lane as they come;
+// set() reduces the lanes into the beam's bounds and its planes' norms.
 template <class F>
-void set_beam_bounds(Beam& beam, const F& u_lo, const F& u_hi, const F& v_lo, const F& v_hi) {
-    constexpr std::uint32_t W = F::size;
-    alignas(64) float lanes[4][W];
-    u_lo.store_aligned(lanes[0]), u_hi.store_aligned(lanes[1]);
-    v_lo.store_aligned(lanes[2]), v_hi.store_aligned(lanes[3]);
-    beam.u_lo = beam.v_lo = kInf, beam.u_hi = beam.v_hi = -kInf;
-    for (std::uint32_t i = 0; i < W; ++i) {
-        beam.u_lo = lanes[0][i] < beam.u_lo ? lanes[0][i] : beam.u_lo;
-        beam.u_hi = lanes[1][i] > beam.u_hi ? lanes[1][i] : beam.u_hi;
-        beam.v_lo = lanes[2][i] < beam.v_lo ? lanes[2][i] : beam.v_lo;
-        beam.v_hi = lanes[3][i] > beam.v_hi ? lanes[3][i] : beam.v_hi;
+struct SlopeBounds {
+    F u_lo = F(kInf), u_hi = F(-kInf), v_lo = F(kInf), v_hi = F(-kInf);
+
+    template <class M>
+    void add(Beam& beam, std::uint32_t at, const M& live, const F& u, const F& v) {
+        u.store_aligned(beam.u + at);
+        v.store_aligned(beam.v + at);
+        u_lo = xsimd::min(u_lo, xsimd::select(live, u, F(kInf)));
+        u_hi = xsimd::max(u_hi, xsimd::select(live, u, F(-kInf)));
+        v_lo = xsimd::min(v_lo, xsimd::select(live, v, F(kInf)));
+        v_hi = xsimd::max(v_hi, xsimd::select(live, v, F(-kInf)));
     }
-    beam.n_ulo = sqrtf(1.0f + beam.u_lo * beam.u_lo);
-    beam.n_uhi = sqrtf(1.0f + beam.u_hi * beam.u_hi);
-    beam.n_vlo = sqrtf(1.0f + beam.v_lo * beam.v_lo);
-    beam.n_vhi = sqrtf(1.0f + beam.v_hi * beam.v_hi);
-}
+    void set(Beam& beam) const {
+        constexpr std::uint32_t W = F::size;
+        alignas(64) float lanes[4][W];
+        u_lo.store_aligned(lanes[0]), u_hi.store_aligned(lanes[1]);
+        v_lo.store_aligned(lanes[2]), v_hi.store_aligned(lanes[3]);
+        beam.u_lo = beam.v_lo = kInf, beam.u_hi = beam.v_hi = -kInf;
+        for (std::uint32_t i = 0; i < W; ++i) {
+            beam.u_lo = lanes[0][i] < beam.u_lo ? lanes[0][i] : beam.u_lo;
+            beam.u_hi = lanes[1][i] > beam.u_hi ? lanes[1][i] : beam.u_hi;
+            beam.v_lo = lanes[2][i] < beam.v_lo ? lanes[2][i] : beam.v_lo;
+            beam.v_hi = lanes[3][i] > beam.v_hi ? lanes[3][i] : beam.v_hi;
+        }
+        beam.n_ulo = sqrtf(1.0f + beam.u_lo * beam.u_lo);
+        beam.n_uhi = sqrtf(1.0f + beam.u_hi * beam.u_hi);
+        beam.n_vlo = sqrtf(1.0f + beam.v_lo * beam.v_lo);
+        beam.n_vhi = sqrtf(1.0f + beam.v_hi * beam.v_hi);
+    }
+};
 
 // Whether the apex and the scene's box lie within kBeamLimit.
 inline bool beam_in_range(const SceneView& s, const float apex[3]) {
@@ -146,8 +159,8 @@ bool beam_rays(const SceneView& s, const RayStream& rays, std::uint32_t base, st
     set_beam_axes(beam, d0);
     const std::uint32_t m = beam.m;
     const F ox(beam.o[0]), oy(beam.o[1]), oz(beam.o[2]), sign(beam.sign);
-    const F max_slope(kBeamMaxSlope), inf(kInf);
-    F u_lo = inf, u_hi = -inf, v_lo = inf, v_hi = -inf;
+    const F max_slope(kBeamMaxSlope);
+    SlopeBounds<F> slopes;
     const std::uint32_t left = count - base;
     for (std::uint32_t at = 0; at < n; at += W) {
         const auto load = [&](const float* v) { return load_stream<F>(v, at, left); };
@@ -157,27 +170,22 @@ bool beam_rays(const SceneView& s, const RayStream& rays, std::uint32_t base, st
                           xsimd::abs(v) < max_slope;
         const auto live = live_lanes<F>(at, n);
         if (xsimd::any(live && !good)) return false;
-        u.store_aligned(beam.u + at);
-        v.store_aligned(beam.v + at);
-        u_lo = xsimd::min(u_lo, xsimd::select(live, u, inf));
-        u_hi = xsimd::max(u_hi, xsimd::select(live, u, -inf));
-        v_lo = xsimd::min(v_lo, xsimd::select(live, v, inf));
-        v_hi = xsimd::max(v_hi, xsimd::select(live, v, -inf));
+        slopes.add(beam, at, live, u, v);
     }
-    set_beam_bounds<F>(beam, u_lo, u_hi, v_lo, v_hi);
+    slopes.set(beam);
     beam.w_far = kInf, beam.reach_extra = 0.0f;
     return true;
 }
 
-// Step 1 for shadow rays: segments O_i + t V_i, 0 < t < t_max_i, that all end near one
-// point (towards a point light V = L - P and t_max = 1 from O = P + eps N: they end at
-// L + eps N). The apex A is where the first one ends; seen from A, each segment runs from
-// (near) A out to its origin, at depth w_i. Reaches grow by how far the segments' ends lie
-// from A (one more rounding: 2^-20 |A|), and by 2^-13 of the longest segment (the exact
-// test's 10u|O'| with |O'| <= |O - A| + |q|, and the rounding of O - A).
+// Step 1 for shadow rays (the same name: beam_for_group takes either stream): segments O_i + t
+// V_i, 0 < t < t_max_i, that all end near one point (towards a point light V = L - P and t_max
+// = 1 from O = P + eps N: they end at L + eps N). The apex A is where the first one ends; seen
+// from A, each segment runs from (near) A out to its origin, at depth w_i. Reaches grow by how
+// far the segments' ends lie from A (one more rounding: 2^-20 |A|), and by 2^-13 of the longest
+// segment (the exact test's 10u|O'| with |O'| <= |O - A| + |q|, and the rounding of O - A).
 template <class F>
-bool shadow_beam_rays(const SceneView& s, const ShadowStream& rays, std::uint32_t base,
-                      std::uint32_t n, std::uint32_t count, Beam& beam) {
+bool beam_rays(const SceneView& s, const ShadowStream& rays, std::uint32_t base,
+               std::uint32_t n, std::uint32_t count, Beam& beam) {
     constexpr std::uint32_t W = F::size;
     const float* const o[3] = {rays.ox + base, rays.oy + base, rays.oz + base};
     const float* const d[3] = {rays.dx + base, rays.dy + base, rays.dz + base};
@@ -192,8 +200,8 @@ bool shadow_beam_rays(const SceneView& s, const ShadowStream& rays, std::uint32_
     set_beam_axes(beam, out);
     const F apex[3] = {F(beam.o[0]), F(beam.o[1]), F(beam.o[2])};
     const F sign(beam.sign), max_slope(kBeamMaxSlope), inf(kInf), zero(0.0f);
-    F u_lo = inf, u_hi = -inf, v_lo = inf, v_hi = -inf, w_max = zero, dev_max = zero,
-      length_max = zero;
+    SlopeBounds<F> slopes;
+    F w_max = zero, dev_max = zero, length_max = zero;
     const std::uint32_t left = count - base;
     for (std::uint32_t at = 0; at < n; at += W) {
         const auto load = [&](const float* v) { return load_stream<F>(v, at, left); };
@@ -210,18 +218,13 @@ bool shadow_beam_rays(const SceneView& s, const ShadowStream& rays, std::uint32_
                           xsimd::abs(v) < max_slope && dev <= F(0x1.0p-8f) * length;
         const auto live = live_lanes<F>(at, n);
         if (xsimd::any(live && !good)) return false;
-        u.store_aligned(beam.u + at);
-        v.store_aligned(beam.v + at);
+        slopes.add(beam, at, live, u, v);
         w.store_aligned(beam.w + at);
-        u_lo = xsimd::min(u_lo, xsimd::select(live, u, inf));
-        u_hi = xsimd::max(u_hi, xsimd::select(live, u, -inf));
-        v_lo = xsimd::min(v_lo, xsimd::select(live, v, inf));
-        v_hi = xsimd::max(v_hi, xsimd::select(live, v, -inf));
         w_max = xsimd::max(w_max, xsimd::select(live, w, zero));
         dev_max = xsimd::max(dev_max, xsimd::select(live, dev, zero));
         length_max = xsimd::max(length_max, xsimd::select(live, length, zero));
     }
-    set_beam_bounds<F>(beam, u_lo, u_hi, v_lo, v_hi);
+    slopes.set(beam);
     alignas(64) float lanes[3][W];
     w_max.store_aligned(lanes[0]), dev_max.store_aligned(lanes[1]);
     length_max.store_aligned(lanes[2]);
@@ -371,6 +374,17 @@ void beam_gather(const SceneView& s, Beam& beam, std::uint32_t* stack) {
         beam.qa[count] = beam.qb[count] = beam.qw[count] = 0.0f;
         beam.reach[count] = -1.0f, beam.sphere[count] = 0;
     }
+}
+
+// Whether rays [group, group + n) of a stream of `count` (RayStream or ShadowStream) form a
+// beam; if so, its spheres are gathered. A group of one packet or less is left to the
+// packet traversal (nothing to share).
+template <class F, class Stream>
+bool beam_for_group(const SceneView& s, const Stream& rays, std::uint32_t group,
+                    std::uint32_t n, std::uint32_t count, Beam& beam, BvhStacks& st) {
+    if (n <= kTraversalWidth || !beam_rays<F>(s, rays, group, n, count, beam)) return false;
+    beam_gather<F>(s, beam, st.ray_node);
+    return true;
 }
 
 // Loads what a beam packet reads (its rays, V·V, best_t = t_far or +inf, no hit yet) into

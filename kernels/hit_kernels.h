@@ -51,9 +51,7 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
     for (std::uint32_t group = 0; group < count; group += kBeamRays) {
         // A group of rays from one origin is a beam (bvh_beam.h).
         const std::uint32_t n = count - group < kBeamRays ? count - group : kBeamRays;
-        const bool in_beam =
-            n > kTraversalWidth && beam_rays<FN>(s, rays, group, n, count, beam);
-        if (in_beam) beam_gather<FN>(s, beam, st.ray_node);
+        const bool in_beam = beam_for_group<FN>(s, rays, group, n, count, beam, st);
         for (std::uint32_t base = group; base < group + n; base += kTraversalWidth) {
             const std::uint32_t live = live_bits(base, count);
             // Lanes the BVH traverses: all of them, or those a beam leaves unfinished.
@@ -114,6 +112,19 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
     }
 }
 
+// The lanes of `live` in packet `p` (its t_max in best_t) that a plane occludes, as bits.
+template <class Arch>
+std::uint32_t plane_occluded(const SceneView& s, const BvhPacket& p, std::uint32_t live) {
+    using F = xsimd::batch<float, RayArch<Arch>>;
+    std::uint32_t done = 0;
+    for (std::uint32_t at = 0; at < kTraversalWidth; at += F::size)
+        done |= mask_bits<F>(any_plane(s, load3<F>(p.ox, p.oy, p.oz, at),
+                                       load3<F>(p.dx, p.dy, p.dz, at),
+                                       F::load_aligned(p.best_t + at)))
+                << at;
+    return done & live;
+}
+
 // Whether each live lane of the kTraversalWidth rays from `base` of `rays` (a stream of
 // `count`) is occluded, as bits.
 template <class Arch>
@@ -121,7 +132,6 @@ std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std:
                               std::uint32_t count, std::uint32_t live, BvhPacket& p,
                               BvhStacks& st) {
     using F = xsimd::batch<float, RayArch<Arch>>;
-    constexpr std::uint32_t W = F::size;
     if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t_max,
                             base, count, p) &
          live) != live) {
@@ -137,13 +147,7 @@ std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std:
         return bits & live;
     }
     // Planes first: a lane they occlude needs no traversal.
-    std::uint32_t done = 0;
-    for (std::uint32_t at = 0; at < kTraversalWidth; at += W)
-        done |= mask_bits<F>(any_plane(s, load3<F>(p.ox, p.oy, p.oz, at),
-                                       load3<F>(p.dx, p.dy, p.dz, at),
-                                       F::load_aligned(p.best_t + at)))
-                << at;
-    done &= live;
+    const std::uint32_t done = plane_occluded<Arch>(s, p, live);
     if (done == live) return done;  // no lane left to trace
     return done | bvh_occluded_packet<Arch>(s, p, live & ~done, st);
 }
@@ -155,16 +159,9 @@ std::uint32_t beam_occluded(const SceneView& s, const ShadowStream& rays, const 
                             std::uint32_t group, std::uint32_t base, std::uint32_t count,
                             std::uint32_t live, BvhPacket& p, BvhStacks& st) {
     using F = xsimd::batch<float, RayArch<Arch>>;
-    constexpr std::uint32_t W = F::size;
     load_beam_packet<F>(rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t_max, base,
                         count, p);
-    std::uint32_t done = 0;
-    for (std::uint32_t at = 0; at < kTraversalWidth; at += W)
-        done |= mask_bits<F>(any_plane(s, load3<F>(p.ox, p.oy, p.oz, at),
-                                       load3<F>(p.dx, p.dy, p.dz, at),
-                                       F::load_aligned(p.best_t + at)))
-                << at;
-    done &= live;
+    std::uint32_t done = plane_occluded<Arch>(s, p, live);
     if (done == live) return done;
     std::uint32_t unfinished = 0;
     done |= beam_occluded_packet<Arch>(s, beam, base - group, p, live & ~done, unfinished);
@@ -220,9 +217,7 @@ void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t cou
         for (std::uint32_t group = 0; group < count; group += kBeamRays) {
             // Rays towards one point light from one tile are a beam (bvh_beam.h).
             const std::uint32_t n = count - group < kBeamRays ? count - group : kBeamRays;
-            const bool in_beam =
-                n > kTraversalWidth && shadow_beam_rays<FN>(s, rays, group, n, count, beam);
-            if (in_beam) beam_gather<FN>(s, beam, st.ray_node);
+            const bool in_beam = beam_for_group<FN>(s, rays, group, n, count, beam, st);
             for (std::uint32_t base = group; base < group + n; base += kTraversalWidth) {
                 const std::uint32_t live = live_bits(base, count);
                 const std::uint32_t bits =

@@ -406,18 +406,21 @@ struct RaySoA {
     }
 };
 
-// Random rays (random origins and directions, some unnormalised, some axis-aligned), and
-// coherent bundles from one point towards the scene (packets that stay together).
-std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_t count) {
+// The box of the scene's sphere centers (a unit box without spheres), and random points in
+// it grown by `grow` of its extent on each side.
+struct CenterBox {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (std::uint32_t i = 0; i < c.spheres.count; ++i) {
-        const float p[3] = {c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
-        for (int a = 0; a < 3; ++a)
-            lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+
+    explicit CenterBox(const CompiledScene& c) {
+        for (std::uint32_t i = 0; i < c.spheres.count; ++i) {
+            const float p[3] = {c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
+            for (int a = 0; a < 3; ++a)
+                lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+        }
+        if (c.spheres.count == 0) lo[0] = lo[1] = lo[2] = -1, hi[0] = hi[1] = hi[2] = 1;
     }
-    if (c.spheres.count == 0) lo[0] = lo[1] = lo[2] = -1, hi[0] = hi[1] = hi[2] = 1;
-    std::uniform_real_distribution<float> u01(0.0f, 1.0f), unit(-1.0f, 1.0f);
-    const auto in_box = [&](float grow) {
+    Vec3 random_point(std::mt19937& rng, float grow) const {
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
         Vec3 p;
         float* q[3] = {&p.x, &p.y, &p.z};
         for (int a = 0; a < 3; ++a) {
@@ -425,7 +428,15 @@ std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_
             *q[a] = lo[a] - grow * ext + (1 + 2 * grow) * ext * u01(rng);
         }
         return p;
-    };
+    }
+};
+
+// Random rays (random origins and directions, some unnormalised, some axis-aligned), and
+// coherent bundles from one point towards the scene (packets that stay together).
+std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_t count) {
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f), unit(-1.0f, 1.0f);
+    const CenterBox box(c);
+    const auto in_box = [&](float grow) { return box.random_point(rng, grow); };
     std::vector<Ray> rays;
     while (rays.size() < count) {
         const int kind = static_cast<int>(rays.size() / 8 % 6);
@@ -484,7 +495,8 @@ std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_
                 Ray r;
                 r.origin = origin;
                 const Vec3 jitter{0.02f * unit(rng), 0.02f * unit(rng), 0.02f * unit(rng)};
-                r.direction = normalize(target + jitter * (hi[0] - lo[0] + 1e-3f) - origin);
+                r.direction =
+                    normalize(target + jitter * (box.hi[0] - box.lo[0] + 1e-3f) - origin);
                 r.t_max = 0.5f + 2 * u01(rng);
                 rays.push_back(r);
             }
@@ -601,21 +613,8 @@ TYPED_TEST_SUITE(BvhTraversalTest, Isas);
 std::vector<Ray> beam_test_rays(const CompiledScene& c, std::mt19937& rng, int groups,
                                 bool wide) {
     std::uniform_real_distribution<float> u01(0.0f, 1.0f), unit(-1.0f, 1.0f);
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (std::uint32_t i = 0; i < c.spheres.count; ++i) {
-        const float p[3] = {c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
-        for (int a = 0; a < 3; ++a)
-            lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-    }
-    const auto in_box = [&](float grow) {
-        Vec3 p;
-        float* q[3] = {&p.x, &p.y, &p.z};
-        for (int a = 0; a < 3; ++a) {
-            const float ext = std::max(hi[a] - lo[a], 1e-3f);
-            *q[a] = lo[a] - grow * ext + (1 + 2 * grow) * ext * u01(rng);
-        }
-        return p;
-    };
+    const CenterBox box(c);
+    const auto in_box = [&](float grow) { return box.random_point(rng, grow); };
     std::vector<Ray> rays;
     for (int g = 0; g <= groups; ++g) {
         Vec3 origin = in_box(wide ? 0.0f : 1.5f), axis = normalize(in_box(0.0f) - origin);
