@@ -1,6 +1,7 @@
 #pragma once
-// Beams: the rays of a camera tile, from one origin, traced against the few spheres their
-// pyramid holds, gathered from the BVH once for all the tile's packets.
+// Beams: the rays of a camera tile, from one origin (or its shadow rays, towards one point
+// light), traced against the few spheres their pyramid holds, gathered from the BVH once
+// for all the tile's packets.
 //
 // Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
 // (packet_math.h; kernels/README.md, "the ODR rule").
@@ -16,11 +17,16 @@
 //    u = d_a / d_m and v = d_b / d_m on the two other axes. The rays lie in the pyramid
 //    u_lo <= p_a / w <= u_hi, v_lo <= p_b / w <= v_hi, w >= 0, in coordinates about O with
 //    the main axis's sign folded in (p = sign (X - O) on a and b, w = sign (X - O)_m).
-// 2. beam_gather: one walk of the BVH with that pyramid collects the spheres it may hold
-//    (up to kBeamMaxSpheres; more, and the group's packets traverse the BVH as before).
+// 2. beam_gather: one walk of the BVH with that pyramid, nearest boxes first, collects the
+//    spheres it may hold, up to kBeamMaxSpheres; the spheres left out then lie beyond a
+//    depth, the beam's horizon.
 // 3. beam_closest_packet: each packet bounds its own rays' slopes, keeps the gathered
 //    spheres inside its own pyramid (16 spheres per test), and tests those with the leaves'
-//    exact arithmetic (packet_closest_sphere).
+//    exact arithmetic (packet_closest_sphere). A lane whose hit lies beyond the horizon
+//    goes on through the BVH (hit_kernels.h, closest_hit).
+// Shadow rays that end near one point (a point light) are a beam seen from that point,
+// each segment reaching out to its origin (beam_rays for a ShadowStream, then
+// beam_occluded_packet); any_hit forms them where it keeps the stream's order.
 //
 // Bit-exactness. The pyramid tests only decide which spheres are tested; the exact test
 // and its tie rule (the lower file index wins) decide the hits, in any order. So a sphere
