@@ -393,27 +393,6 @@ bool beam_for_group(const SceneView& s, const Stream& rays, std::uint32_t group,
     return true;
 }
 
-// Loads what a beam packet reads (its rays, V·V, best_t = t_far or +inf, no hit yet) into
-// `p`: the rays [base, base + kTraversalWidth) of a stream holding `count`.
-template <class F>
-void load_beam_packet(const float* ox, const float* oy, const float* oz, const float* dx,
-                      const float* dy, const float* dz, const float* t_far, std::uint32_t base,
-                      std::uint32_t count, BvhPacket& p) {
-    constexpr std::uint32_t W = F::size;
-    const std::uint32_t left = count - base;
-    const auto load = [&](const float* v, std::uint32_t at) {
-        return load_stream<F>(v + base, at, left);
-    };
-    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
-        store3(V3<F>{load(ox, at), load(oy, at), load(oz, at)}, p.ox, p.oy, p.oz, at);
-        const V3<F> d{load(dx, at), load(dy, at), load(dz, at)};
-        store3(d, p.dx, p.dy, p.dz, at);
-        dot(d, d).store_aligned(p.a + at);
-        (t_far ? load(t_far, at) : F(kInf)).store_aligned(p.best_t + at);
-        F(-1.0f).store_aligned(p.best_id + at);
-    }
-}
-
 // A packet's own pyramid (the slopes of lanes `live` of the beam's rays [at, ...)), tested
 // against the beam's spheres a register at a time.
 template <class F>

@@ -136,14 +136,33 @@ F load_stream(const float* v, std::uint32_t at, std::uint32_t left) {
     return F::load_aligned(v + at);
 }
 
-// Loads a packet's rays (of a stream holding `count` rays) into `p`; best_t starts at
-// `t_far` (+inf or t_max), best_id at -1. Returns the lanes whose box tests stay finite
+// Loads a packet's rays [base, base + kTraversalWidth) of a stream holding `count` into
+// `p`: origins, directions, V·V; best_t starts at `t_far` (+inf where null), best_id at
+// -1. What a beam packet reads (bvh_beam.h); the box tests need packet_box_offsets too.
+template <class F>
+void load_packet_rays(const float* ox, const float* oy, const float* oz, const float* dx,
+                      const float* dy, const float* dz, const float* t_far, std::uint32_t base,
+                      std::uint32_t count, BvhPacket& p) {
+    constexpr std::uint32_t W = F::size;
+    const std::uint32_t left = count - base;
+    const auto load = [&](const float* v, std::uint32_t at) {
+        return load_stream<F>(v + base, at, left);
+    };
+    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
+        store3(V3<F>{load(ox, at), load(oy, at), load(oz, at)}, p.ox, p.oy, p.oz, at);
+        const V3<F> d{load(dx, at), load(dy, at), load(dz, at)};
+        store3(d, p.dx, p.dy, p.dz, at);
+        dot(d, d).store_aligned(p.a + at);
+        (t_far ? load(t_far, at) : F(kInf)).store_aligned(p.best_t + at);
+        F(-1.0f).store_aligned(p.best_id + at);
+    }
+}
+
+// The box tests' fields of the rays in `p` (reciprocal directions and the widened slab
+// offsets); leaves its hits alone. Returns the lanes whose box tests stay finite
 // (kBvhFiniteLimit).
 template <class F>
-std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* oy,
-                              const float* oz, const float* dx, const float* dy,
-                              const float* dz, const float* t_far, std::uint32_t base,
-                              std::uint32_t count, BvhPacket& p) {
+std::uint32_t packet_box_offsets(const SceneView& s, BvhPacket& p) {
     constexpr std::uint32_t W = F::size;
     float box_max = 0.0f;  // no fmaxf: it is a libm call, not an instruction
     for (int a = 0; a < 3; ++a) {
@@ -152,16 +171,8 @@ std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* 
         box_max = box_max > hi ? box_max : hi;
     }
     std::uint32_t finite = 0;
-    const std::uint32_t left = count - base;
-    const auto load = [&](const float* v, std::uint32_t at) {
-        return load_stream<F>(v + base, at, left);
-    };
     for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
-        const V3<F> o{load(ox, at), load(oy, at), load(oz, at)};
-        const V3<F> d{load(dx, at), load(dy, at), load(dz, at)};
-        store3(o, p.ox, p.oy, p.oz, at);
-        store3(d, p.dx, p.dy, p.dz, at);
-        dot(d, d).store_aligned(p.a + at);
+        const V3<F> o = load3<F>(p.ox, p.oy, p.oz, at), d = load3<F>(p.dx, p.dy, p.dz, at);
         const V3<F> inv{safe_reciprocal(d.x), safe_reciprocal(d.y), safe_reciprocal(d.z)};
         store3(inv, p.inv_x, p.inv_y, p.inv_z, at);
         const F m = bvh_margin(s, o);
@@ -173,10 +184,18 @@ std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* 
         const V3<F> lo{o.x + m, o.y + m, o.z + m}, hi{o.x - m, o.y - m, o.z - m};
         store3(hadamard(lo, inv), p.lo_off_x, p.lo_off_y, p.lo_off_z, at);
         store3(hadamard(hi, inv), p.hi_off_x, p.hi_off_y, p.hi_off_z, at);
-        (t_far ? load(t_far, at) : F(kInf)).store_aligned(p.best_t + at);
-        F(-1.0f).store_aligned(p.best_id + at);
     }
     return finite;
+}
+
+// Both: a packet ready for the BVH traversal. Returns packet_box_offsets's lanes.
+template <class F>
+std::uint32_t load_bvh_packet(const SceneView& s, const float* ox, const float* oy,
+                              const float* oz, const float* dx, const float* dy,
+                              const float* dz, const float* t_far, std::uint32_t base,
+                              std::uint32_t count, BvhPacket& p) {
+    load_packet_rays<F>(ox, oy, oz, dx, dy, dz, t_far, base, count, p);
+    return packet_box_offsets<F>(s, p);
 }
 
 inline std::uint32_t leaf_first(std::uint32_t ref) {

@@ -54,44 +54,31 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
         const bool in_beam = beam_for_group<FN>(s, rays, group, n, count, beam, st);
         for (std::uint32_t base = group; base < group + n; base += kTraversalWidth) {
             const std::uint32_t live = live_bits(base, count);
-            // Lanes the BVH traverses: all of them, or those a beam leaves unfinished.
-            std::uint32_t traverse = live;
-            alignas(64) float beam_t[kTraversalWidth], beam_id[kTraversalWidth];
+            // Lanes the BVH traverses: all of them, or those a beam leaves unfinished,
+            // which go on from the beam's hits (the tie rule makes the result the same
+            // as from none).
+            std::uint32_t traverse = live, finite;
             if (in_beam) {
-                load_beam_packet<F>(rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
+                load_packet_rays<F>(rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
                                     nullptr, base, count, p);
                 traverse = beam_closest_packet<Arch>(s, beam, base - group, p, live, t_min);
-                if (traverse != 0) {
-                    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
-                        F::load_aligned(p.best_t + at).store_aligned(beam_t + at);
-                        F::load_aligned(p.best_id + at).store_aligned(beam_id + at);
-                    }
-                }
+                finite = traverse != 0 ? packet_box_offsets<F>(s, p) : live;
+            } else {
+                finite = load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy,
+                                            rays.dz, nullptr, base, count, p);
             }
-            if (traverse != 0) {
-                if ((load_bvh_packet<F>(s, rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz,
-                                        nullptr, base, count, p) &
-                     live) != live) {
-                    // Box tests would overflow: this packet against every sphere.
-                    const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
-                                        rays.dx + base,   rays.dy + base, rays.dz + base,
-                                        rays.wr + base,   rays.wg + base, rays.wb + base,
-                                        rays.pixel + base};
-                    closest_hit_all<Arch>(
-                        s, one, count - base < kTraversalWidth ? count - base : kTraversalWidth,
-                        t_min, HitStream{hits.t + base, hits.object + base});
-                    continue;
-                }
-                if (in_beam) {
-                    // The traversal goes on from the beam's hits (the tie rule makes the
-                    // result the same as from none).
-                    for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
-                        F::load_aligned(beam_t + at).store_aligned(p.best_t + at);
-                        F::load_aligned(beam_id + at).store_aligned(p.best_id + at);
-                    }
-                }
-                bvh_closest_packet<Arch>(s, p, traverse, t_min, st);
+            if ((finite & live) != live) {
+                // Box tests would overflow: this packet against every sphere.
+                const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
+                                    rays.dx + base,   rays.dy + base, rays.dz + base,
+                                    rays.wr + base,   rays.wg + base, rays.wb + base,
+                                    rays.pixel + base};
+                closest_hit_all<Arch>(
+                    s, one, count - base < kTraversalWidth ? count - base : kTraversalWidth,
+                    t_min, HitStream{hits.t + base, hits.object + base});
+                continue;
             }
+            if (traverse != 0) bvh_closest_packet<Arch>(s, p, traverse, t_min, st);
             // Planes stay outside the tree.
             for (std::uint32_t at = 0; at < kTraversalWidth; at += W) {
                 F best_t = F::load_aligned(p.best_t + at),
@@ -159,7 +146,7 @@ std::uint32_t beam_occluded(const SceneView& s, const ShadowStream& rays, const 
                             std::uint32_t group, std::uint32_t base, std::uint32_t count,
                             std::uint32_t live, BvhPacket& p, BvhStacks& st) {
     using F = xsimd::batch<float, RayArch<Arch>>;
-    load_beam_packet<F>(rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t_max, base,
+    load_packet_rays<F>(rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t_max, base,
                         count, p);
     std::uint32_t done = plane_occluded<Arch>(s, p, live);
     if (done == live) return done;
