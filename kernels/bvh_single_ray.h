@@ -98,6 +98,59 @@ LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t 
     return {live, roots.t_near, roots.t_far};
 }
 
+#if defined(__AVX2__)
+// Eight keys sorted into descending order (unsigned) by a bitonic network: six rounds of
+// a permutation, a min, a max and a blend, and no branch.
+inline __m256i sort8_descending(__m256i v) {
+    const auto round = [&](__m256i partner, int upper) {
+        const __m256i lo = _mm256_min_epu32(v, partner), hi = _mm256_max_epu32(v, partner);
+        // The lanes of `upper` take the smaller key, the others the larger.
+        switch (upper) {
+            case 0xAA: return _mm256_blend_epi32(hi, lo, 0xAA);
+            case 0xCC: return _mm256_blend_epi32(hi, lo, 0xCC);
+            default: return _mm256_blend_epi32(hi, lo, 0xF0);
+        }
+    };
+    v = round(_mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1)), 0xAA);
+    v = round(_mm256_shuffle_epi32(v, _MM_SHUFFLE(0, 1, 2, 3)), 0xCC);
+    v = round(_mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1)), 0xAA);
+    v = round(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0)), 0xF0);
+    v = round(_mm256_shuffle_epi32(v, _MM_SHUFFLE(1, 0, 3, 2)), 0xCC);
+    v = round(_mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1)), 0xAA);
+    return v;
+}
+
+// push_children without a branch per child: each child's key is its entry distance (a
+// non-negative float, so its bits order as integers) with its slot in the low 3 bits, and
+// 0 for a child the ray misses. Sorted in descending order, the hit children come first,
+// farthest first; all eight references are stored, the stack grows by the hits less the
+// nearest, which is returned. Ties (entries equal but for their 3 low bits) fall in any
+// order, which changes no hit (the closest-hit rule does not depend on the order).
+inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
+                                   std::uint32_t* stack, std::uint32_t& sp) {
+    const __m256i slot = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256i hit = _mm256_cmpgt_epi32(
+        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)),
+                         _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+        _mm256_setzero_si256());
+    const __m256i bits_of_entry = _mm256_castps_si256(_mm256_load_ps(entry));
+    const __m256i key = _mm256_and_si256(
+        hit, _mm256_or_si256(_mm256_andnot_si256(_mm256_set1_epi32(7), bits_of_entry), slot));
+    // The nearest by a horizontal minimum (misses as the largest key): the next node's
+    // address waits on three rounds, not on the network's six.
+    __m256i m = _mm256_or_si256(key, _mm256_xor_si256(hit, _mm256_set1_epi32(-1)));
+    m = _mm256_min_epu32(m, _mm256_permute2x128_si256(m, m, 1));
+    m = _mm256_min_epu32(m, _mm256_shuffle_epi32(m, _MM_SHUFFLE(1, 0, 3, 2)));
+    m = _mm256_min_epu32(m, _mm256_shuffle_epi32(m, _MM_SHUFFLE(2, 3, 0, 1)));
+    const std::uint32_t nearest = n.child[_mm256_cvtsi256_si32(m) & 7];
+    const __m256i order = sort8_descending(key);
+    const __m256i child = _mm256_permutevar8x32_epi32(
+        _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)), order);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack + sp), child);
+    sp += static_cast<std::uint32_t>(__builtin_popcount(bits)) - 1;
+    return nearest;
+}
+#else
 // Children of `n` in `bits`, nearest first by `entry`: the nearest is returned, the rest
 // pushed farthest first.
 inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
@@ -114,6 +167,8 @@ inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const 
     for (std::uint32_t k = 0; k + 1 < count; ++k) stack[sp++] = n.child[order[k]];
     return n.child[order[count - 1]];
 }
+
+#endif
 
 // Children of `n` in `bits` in the node's order (the builder's: largest box first, the
 // likeliest to occlude): the first is returned, the rest pushed last first.
