@@ -97,6 +97,7 @@ struct BvhStacks {
     std::uint32_t packet_node[kBvhStackSize];
     std::uint16_t packet_mask[kBvhStackSize];  // lanes, one bit each
     std::uint32_t ray_node[kBvhStackSize];
+    std::uint32_t ray_node_b[kBvhStackSize];  // a second ray's (bvh_closest_rays)
 };
 
 // The widening of every box for rays from `o` (the margin derived above).

@@ -242,9 +242,7 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
         --sp;
         const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp];
         if (static_cast<std::uint32_t>(__builtin_popcount(mask)) < s.bvh_packet_min_lanes) {
-            for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1)
-                bvh_closest_ray<Arch>(s, p, static_cast<std::uint32_t>(__builtin_ctz(bits)),
-                                      node, t_min, st.ray_node);
+            bvh_closest_rays<Arch>(s, p, mask, node, t_min, st);
             continue;
         }
         if ((node & kBvhLeafBit) == 0) {

@@ -28,6 +28,7 @@ struct BvhRay {
     V3<F> o, d;
     F a, inv_a;  // inv_a: sphere_may_hit's
 
+    BvhRay() = default;
     BvhRay(const BvhPacket& p, std::uint32_t lane) {
         const auto axis = [&](float inv, float lo_off, float hi_off, Plane& near, Plane& far,
                               F& near_off, F& far_off, Plane min, Plane max) {
@@ -82,7 +83,7 @@ struct LeafRoots {
 };
 
 template <class F>
-LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t i,
+[[gnu::always_inline]] inline LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t i,
                         std::uint32_t at, std::uint32_t count) {
     const F zero(0.0f);
     const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
@@ -195,26 +196,32 @@ inline void prefetch_children(const SceneView& s, const BvhNode8& n, std::uint32
     }
 }
 
-// Closest hit of lane `lane` of `p` in the subtree `start`, on (t_min, best_t].
-template <class Arch>
-void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::uint32_t start,
-                     float t_min, std::uint32_t* stack) {
-    using F = xsimd::batch<float, Arch>;
-    constexpr std::uint32_t W = F::size;
-    const BvhRay<F> ray(p, lane);
-    const F tmin(t_min), zero(0.0f);
-    float& best_t = p.best_t[lane];
-    float& best_id = p.best_id[lane];
-    alignas(64) float entry[kBvhWidth];
-    std::uint32_t sp = 0, node = start;
-    for (;;) {
+// One ray's closest-hit walk, a node at a time (bvh_closest_rays interleaves two).
+template <class F>
+struct ClosestWalk {
+    BvhRay<F> ray;
+    float best_t, best_id;
+    std::uint32_t node, sp;
+    std::uint32_t* stack;
+
+    void begin(const BvhPacket& p, std::uint32_t lane, std::uint32_t start,
+               std::uint32_t* stack_) {
+        ray = BvhRay<F>(p, lane);
+        best_t = p.best_t[lane], best_id = p.best_id[lane];
+        node = start, sp = 0, stack = stack_;
+    }
+
+    // Visits `node`; false once the walk is over.
+    [[gnu::always_inline]] bool step(const SceneView& s, const F& tmin) {
+        constexpr std::uint32_t W = F::size;
         if ((node & kBvhLeafBit) == 0) {
+            alignas(64) float entry[kBvhWidth];
             const BvhNode8& n = s.bvh_nodes[node];
             const std::uint32_t bits = ray.test(n, tmin, F(best_t), entry);
             if (bits != 0) {
                 prefetch_children(s, n, bits);
                 node = push_children(n, bits, entry, stack, sp);
-                continue;
+                return true;
             }
         } else {
             // Up to 8 spheres against the ray, the brute-force arithmetic per lane.
@@ -223,12 +230,9 @@ void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::
                 const std::uint32_t i = first + at;
                 const LeafRoots<F> r = leaf_roots(s, ray, i, at, count);
                 if (xsimd::none(r.live)) continue;
-                const auto& live = r.live;
-                const F& t_near = r.t_near;
-                const F& t_far = r.t_far;
                 // The sphere's candidate is its first root above t_min.
-                const F t = xsimd::select(t_near > tmin, t_near, t_far);
-                std::uint32_t bits = mask_bits<F>(live && t > tmin && t <= F(best_t));
+                const F t = xsimd::select(r.t_near > tmin, r.t_near, r.t_far);
+                std::uint32_t bits = mask_bits<F>(r.live && t > tmin && t <= F(best_t));
                 if (bits == 0) continue;
                 alignas(64) float ts[W];
                 t.store_aligned(ts);
@@ -240,8 +244,60 @@ void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::
                 }
             }
         }
-        if (sp == 0) return;
+        if (sp == 0) return false;
         node = stack[--sp];
+        return true;
+    }
+};
+
+// Closest hit of lane `lane` of `p` in the subtree `start`, on (t_min, best_t].
+template <class Arch>
+void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::uint32_t start,
+                     float t_min, std::uint32_t* stack) {
+    using F = xsimd::batch<float, Arch>;
+    const F tmin(t_min);
+    ClosestWalk<F> w;
+    w.begin(p, lane, start, stack);
+    while (w.step(s, tmin)) {
+    }
+    p.best_t[lane] = w.best_t, p.best_id[lane] = w.best_id;
+}
+
+// bvh_closest_ray for each lane of `lanes`, two walks at a time: each node visit waits on
+// its parent's (the node's load, the box test, the choice of the nearest child), and the
+// other ray's visits fill that wait.
+template <class Arch>
+void bvh_closest_rays(const SceneView& s, BvhPacket& p, std::uint32_t lanes,
+                      std::uint32_t start, float t_min, BvhStacks& st) {
+    using F = xsimd::batch<float, Arch>;
+    if (__builtin_popcount(lanes) < 2) {
+        if (lanes != 0)
+            bvh_closest_ray<Arch>(s, p, static_cast<std::uint32_t>(__builtin_ctz(lanes)), start,
+                                  t_min, st.ray_node);
+        return;
+    }
+    const F tmin(t_min);
+    const auto next = [&] {
+        const auto lane = static_cast<std::uint32_t>(__builtin_ctz(lanes));
+        lanes &= lanes - 1;
+        return lane;
+    };
+    std::uint32_t la = next(), lb = next();
+    ClosestWalk<F> a, b;
+    a.begin(p, la, start, st.ray_node);
+    b.begin(p, lb, start, st.ray_node_b);
+    bool live_a = true, live_b = true;
+    // A walk that ends hands in its hit and takes the next lane, if any.
+    const auto end = [&](ClosestWalk<F>& w, std::uint32_t& lane, std::uint32_t* stack) {
+        p.best_t[lane] = w.best_t, p.best_id[lane] = w.best_id;
+        if (lanes == 0) return false;
+        lane = next();
+        w.begin(p, lane, start, stack);
+        return true;
+    };
+    while (live_a || live_b) {
+        if (live_a && !a.step(s, tmin)) live_a = end(a, la, st.ray_node);
+        if (live_b && !b.step(s, tmin)) live_b = end(b, lb, st.ray_node_b);
     }
 }
 
