@@ -43,7 +43,8 @@ struct BenchOptions {
     std::vector<Accel> accels{Accel::automatic};
     std::vector<std::uint32_t> packet_lanes{kBvhPacketMinLanes};
     // Whether packet_lanes also holds for secondary rays; if not (the default), they follow
-    // the renderer's rule (kBvhSecondaryRayByRayMinSpheres: single rays in large BVHs).
+    // the renderer's rule (kBvhSecondaryRayByRayMinSpheres and ...DenseMinSpheres: single
+    // rays in large or dense BVHs).
     bool packet_lanes_for_secondary = false;
     // Brute force (accel none) is skipped on scenes with more spheres than this: on 10^6
     // spheres a frame of it would take hours.

@@ -67,8 +67,9 @@ constexpr std::uint32_t kTraversalWidth = kPacketWidth;
 #endif
 static_assert(kTraversalWidth % kPacketWidth == 0 && kTraversalWidth <= 16);
 
-// Entries of a traversal stack: a node pushes at most 8 children, and the builder keeps
-// the tree below 48 + 28 levels (kernels/bvh_sah.cpp, kMaxSahDepth).
+// Entries of a traversal stack: a node pushes at most 8 children (the single-ray
+// traversal writes all 8 slots above the top at once), and the builder keeps the tree
+// below 48 + 28 levels (kernels/bvh_sah.cpp, kMaxSahDepth).
 constexpr std::uint32_t kBvhStackSize = 1024;
 // 32u and 64u of the margin above.
 constexpr float kBvhFuzz = 0x1.0p-19f;

@@ -1,6 +1,7 @@
 #pragma once
 // BVH traversal one ray at a time (closest hit and occlusion), the hybrid traversal's
-// second half (bvh_packet.h).
+// second half (bvh_packet.h). Closest-hit rays walk two at a time (bvh_closest_rays), and
+// with AVX2 a node's children are ordered without a branch per child (push_children).
 //
 // Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
 // (packet_math.h; kernels/README.md, "the ODR rule").

@@ -2,6 +2,7 @@
 
 #include "kernels/dispatch.h"
 
+#include <numbers>
 #include <stdexcept>
 #include <xsimd/xsimd.hpp>
 
@@ -159,6 +160,16 @@ kernels::SceneView make_scene_view(const CompiledScene& c) {
     return v;
 }
 
+double sphere_crossings(const float* r2, std::uint32_t count, const float lo[3],
+                        const float hi[3]) {
+    double area = 0.0;
+    for (std::uint32_t i = 0; i < count; ++i) area += 4.0 * std::numbers::pi * r2[i];
+    const double x = static_cast<double>(hi[0]) - lo[0], y = static_cast<double>(hi[1]) - lo[1],
+                 z = static_cast<double>(hi[2]) - lo[2];
+    const double box = 2.0 * (x * y + y * z + z * x);
+    return box > 0.0 ? area / box : 0.0;
+}
+
 kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& bvh,
                                    std::uint32_t packet_min_lanes,
                                    std::uint32_t secondary_min_lanes) {
@@ -169,10 +180,15 @@ kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& 
     v.bvh_r2 = bvh.r2.data(), v.bvh_object = bvh.object.data();
     for (int a = 0; a < 3; ++a) v.bvh_lo[a] = bvh.lo[a], v.bvh_hi[a] = bvh.hi[a];
     v.bvh_packet_min_lanes = packet_min_lanes;
-    v.bvh_secondary_min_lanes =
-        secondary_min_lanes != kBvhSecondaryLanesAuto            ? secondary_min_lanes
-        : scene.spheres.count >= kBvhSecondaryRayByRayMinSpheres ? kernels::kPacketWidth + 1
-                                                                 : packet_min_lanes;
+    const std::uint32_t n = scene.spheres.count;
+    const bool ray_by_ray =
+        n >= kBvhSecondaryRayByRayMinSpheres ||
+        (n >= kBvhSecondaryRayByRayDenseMinSpheres &&
+         sphere_crossings(scene.spheres.r2.data(), n, bvh.lo, bvh.hi) >=
+             kBvhSecondaryRayByRayMinCrossings);
+    v.bvh_secondary_min_lanes = secondary_min_lanes != kBvhSecondaryLanesAuto ? secondary_min_lanes
+                                : ray_by_ray ? kernels::kPacketWidth + 1
+                                             : packet_min_lanes;
     v.bvh_shadow_sort_min_spheres = kBvhShadowSortMinSpheres;
     return v;
 }

@@ -284,7 +284,11 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                         std::to_string(kMaxPacketLanes) +
                         " single rays only [default: " + std::to_string(kBvhPacketMinLanes) +
                         "; secondary rays " + std::to_string(kMaxPacketLanes) + " from " +
-                        std::to_string(kBvhSecondaryRayByRayMinSpheres) + " spheres on]")
+                        std::to_string(kBvhSecondaryRayByRayMinSpheres) + " spheres on, or " +
+                        std::to_string(kBvhSecondaryRayByRayDenseMinSpheres) +
+                        " where a line crosses " +
+                        std::to_string(static_cast<int>(kBvhSecondaryRayByRayMinCrossings)) +
+                        " or more]")
         ->delimiter(',')
         ->type_name("LIST")
         ->transform(decimal_integer(0, kMaxPacketLanes));

@@ -330,6 +330,29 @@ TEST(SphereBvh, SecondaryRaysGoRayByRayInLargeScenes) {
     }
 }
 
+// ... and from kBvhSecondaryRayByRayDenseMinSpheres on where a line through the scene
+// crosses kBvhSecondaryRayByRayMinCrossings spheres or more: 32768 spheres on a 64 x 64 x 8
+// grid (box area ~10240) cross 2.5 of radius 1/4 and 8.1 of radius 0.45.
+TEST(SphereBvh, SecondaryRaysGoRayByRayInDenseScenes) {
+    for (const std::uint32_t count :
+         {kBvhSecondaryRayByRayDenseMinSpheres - 1, kBvhSecondaryRayByRayDenseMinSpheres})
+        for (const float radius : {0.25f, 0.45f}) {
+            std::vector<Object> o;
+            for (std::uint32_t i = 0; i < count; ++i)
+                o.push_back(sphere({static_cast<float>(i % 64), static_cast<float>(i / 64 % 64),
+                                    static_cast<float>(i / 4096)},
+                                   radius));
+            const CompiledScene c = compile_scene(scene_of(o));
+            const SphereBvh bvh = build_sphere_bvh(c.spheres);
+            const double crossings = sphere_crossings(c.spheres.r2.data(), count, bvh.lo, bvh.hi);
+            EXPECT_NEAR(crossings, radius < 0.3f ? 2.5 : 8.1, 0.1);
+            const bool dense = count >= kBvhSecondaryRayByRayDenseMinSpheres && radius > 0.3f;
+            EXPECT_EQ(make_scene_view(c, bvh, 3).bvh_secondary_min_lanes,
+                      dense ? kPacketWidth + 1 : 3u)
+                << count << " spheres of radius " << radius;
+        }
+}
+
 TEST(SphereBvh, NoSpheresNoTree) {
     const CompiledScene c = compile_scene(scene_of({plane({0, 0, 0}, {0, 1, 0})}));
     const SphereBvh bvh = build_sphere_bvh(c.spheres);
