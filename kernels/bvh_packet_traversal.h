@@ -235,6 +235,9 @@ void bvh_closest_packet(const SceneView& s, BvhPacket& p, std::uint32_t live, fl
     constexpr std::uint32_t W = F::size;
     constexpr std::uint32_t K = kTraversalWidth / W;
     const F tmin(t_min), zero(0.0f);
+    // Too few lanes for a packet from the root (or single rays only): no frustum needed.
+    if (static_cast<std::uint32_t>(__builtin_popcount(live)) < s.bvh_packet_min_lanes)
+        return bvh_closest_rays<Arch>(s, p, live, 0, t_min, st);
     const PacketFrustum<FN> fr = packet_frustum<FN, F>(p, live);
     std::uint32_t sp = 0;
     st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint16_t>(live);
