@@ -84,8 +84,9 @@ struct LeafRoots {
 };
 
 template <class F>
-[[gnu::always_inline]] inline LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray, std::uint32_t i,
-                        std::uint32_t at, std::uint32_t count) {
+[[gnu::always_inline]] inline LeafRoots<F> leaf_roots(const SceneView& s, const BvhRay<F>& ray,
+                                                      std::uint32_t i, std::uint32_t at,
+                                                      std::uint32_t count) {
     const F zero(0.0f);
     const V3<F> c{F::load_unaligned(s.bvh_cx + i), F::load_unaligned(s.bvh_cy + i),
                   F::load_unaligned(s.bvh_cz + i)};
@@ -108,9 +109,12 @@ inline __m256i sort8_descending(__m256i v) {
         const __m256i lo = _mm256_min_epu32(v, partner), hi = _mm256_max_epu32(v, partner);
         // The lanes of `upper` take the smaller key, the others the larger.
         switch (upper) {
-            case 0xAA: return _mm256_blend_epi32(hi, lo, 0xAA);
-            case 0xCC: return _mm256_blend_epi32(hi, lo, 0xCC);
-            default: return _mm256_blend_epi32(hi, lo, 0xF0);
+            case 0xAA:
+                return _mm256_blend_epi32(hi, lo, 0xAA);
+            case 0xCC:
+                return _mm256_blend_epi32(hi, lo, 0xCC);
+            default:
+                return _mm256_blend_epi32(hi, lo, 0xF0);
         }
     };
     v = round(_mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1)), 0xAA);
@@ -131,10 +135,10 @@ inline __m256i sort8_descending(__m256i v) {
 inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
                                    std::uint32_t* stack, std::uint32_t& sp) {
     const __m256i slot = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256i hit = _mm256_cmpgt_epi32(
-        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)),
-                         _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-        _mm256_setzero_si256());
+    const __m256i hit =
+        _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)),
+                                            _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+                           _mm256_setzero_si256());
     const __m256i bits_of_entry = _mm256_castps_si256(_mm256_load_ps(entry));
     const __m256i key = _mm256_and_si256(
         hit, _mm256_or_si256(_mm256_andnot_si256(_mm256_set1_epi32(7), bits_of_entry), slot));

@@ -181,12 +181,12 @@ kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& 
     for (int a = 0; a < 3; ++a) v.bvh_lo[a] = bvh.lo[a], v.bvh_hi[a] = bvh.hi[a];
     v.bvh_packet_min_lanes = packet_min_lanes;
     const std::uint32_t n = scene.spheres.count;
-    const bool ray_by_ray =
-        n >= kBvhSecondaryRayByRayMinSpheres ||
-        (n >= kBvhSecondaryRayByRayDenseMinSpheres &&
-         sphere_crossings(scene.spheres.r2.data(), n, bvh.lo, bvh.hi) >=
-             kBvhSecondaryRayByRayMinCrossings);
-    v.bvh_secondary_min_lanes = secondary_min_lanes != kBvhSecondaryLanesAuto ? secondary_min_lanes
+    const bool ray_by_ray = n >= kBvhSecondaryRayByRayMinSpheres ||
+                            (n >= kBvhSecondaryRayByRayDenseMinSpheres &&
+                             sphere_crossings(scene.spheres.r2.data(), n, bvh.lo, bvh.hi) >=
+                                 kBvhSecondaryRayByRayMinCrossings);
+    v.bvh_secondary_min_lanes = secondary_min_lanes != kBvhSecondaryLanesAuto
+                                    ? secondary_min_lanes
                                 : ray_by_ray ? kernels::kPacketWidth + 1
                                              : packet_min_lanes;
     v.bvh_shadow_sort_min_spheres = kBvhShadowSortMinSpheres;

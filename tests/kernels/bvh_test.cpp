@@ -344,7 +344,8 @@ TEST(SphereBvh, SecondaryRaysGoRayByRayInDenseScenes) {
                                    radius));
             const CompiledScene c = compile_scene(scene_of(o));
             const SphereBvh bvh = build_sphere_bvh(c.spheres);
-            const double crossings = sphere_crossings(c.spheres.r2.data(), count, bvh.lo, bvh.hi);
+            const double crossings =
+                sphere_crossings(c.spheres.r2.data(), count, bvh.lo, bvh.hi);
             EXPECT_NEAR(crossings, radius < 0.3f ? 2.5 : 8.1, 0.1);
             const bool dense = count >= kBvhSecondaryRayByRayDenseMinSpheres && radius > 0.3f;
             EXPECT_EQ(make_scene_view(c, bvh, 3).bvh_secondary_min_lanes,
