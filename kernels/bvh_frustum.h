@@ -46,8 +46,9 @@ struct PacketFrustum {
     F inv_lo[3], inv_hi[3], near_off[3], far_off[3];
 };
 
-// Lanes of `bits` (of 8) as an AVX mask. AVX2 translation unit only (F::size == 8); a
-// template, so that no other translation unit compiles it (the ODR rule).
+// Lanes of `bits` (of 8) as an AVX mask. Translation units with AVX2 only (8-wide
+// registers, or push_children's keys); a template, so that no other translation unit
+// compiles it (the ODR rule).
 template <class F>
 __m256 lane_mask8(std::uint32_t bits) {
     const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 
+#include "kernels/bvh_frustum.h"
 #include "kernels/bvh_packet.h"
 #include "kernels/sphere_test.h"
 
@@ -135,10 +136,7 @@ inline __m256i sort8_descending(__m256i v) {
 inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
                                    std::uint32_t* stack, std::uint32_t& sp) {
     const __m256i slot = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256i hit =
-        _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)),
-                                            _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-                           _mm256_setzero_si256());
+    const __m256i hit = _mm256_castps_si256(lane_mask8<__m256>(bits));
     const __m256i bits_of_entry = _mm256_castps_si256(_mm256_load_ps(entry));
     const __m256i key = _mm256_and_si256(
         hit, _mm256_or_si256(_mm256_andnot_si256(_mm256_set1_epi32(7), bits_of_entry), slot));
