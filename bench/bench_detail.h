@@ -50,8 +50,9 @@ void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
 
 // ---- bench_validation.cpp: scenes and their checks ----
 
-// The rays checked against the scalar oracle per ray set, from the rays asked for.
-std::uint32_t capped_validation(std::uint32_t asked, std::uint32_t objects);
+// The rays of `exact` (the scalar reference's oracle) that the double-precision brute-force
+// oracle answers for Embree's rows: all of them, or an even stride within its budget.
+OracleHits double_oracle_rays(const OracleHits& exact, std::size_t objects);
 // Loads the spec at the bench's resolution.
 Scene load_bench_scene(const std::string& spec, int width, int height);
 // Time to first pixel (SceneInfo::first_pixel_ms), the median of three runs.

@@ -131,7 +131,7 @@ struct BenchScene {
 #endif
     // Primary hits (the origins of shadow and mirror rays) come from the fastest view.
     kernels::SceneView fast_view;
-    std::uint32_t validate_rays = 0;  // per ray set (detail::capped_validation)
+    std::uint32_t validate_rays = 0;  // rays per set checked against the reference (0: all)
     std::vector<SimdConfig> simd_configs;
     SceneInfo info;
 };
@@ -278,7 +278,7 @@ void set_up_scene(BenchRun& run, BenchScene& bs) {
     info.compile_ms = bs.compiled.compile_seconds * 1e3;
     build_bvhs(run, bs);
     bs.fast_view = bs.bvh.nodes.empty() ? bs.view : make_scene_view(bs.compiled, bs.bvh);
-    bs.validate_rays = detail::capped_validation(run.o.validate_rays, info.objects);
+    bs.validate_rays = run.o.validate_rays;
     choose_simd_configs(run, bs);
     log_scene(run, bs);
 }
@@ -342,7 +342,10 @@ void measure_ray_set(BenchRun& run, const RaySetRun& rs, BenchRow row, const Tra
 void measure_embree_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun& rs,
                             const Variant& v, const OracleHits& oracle) {
     OracleHits truth;
-    run.arena.execute([&] { truth = oracle_hits_double(bs.scene, rs.set, oracle); });
+    run.arena.execute([&] {
+        truth = oracle_hits_double(bs.scene, rs.set,
+                                   detail::double_oracle_rays(oracle, bs.scene.objects.size()));
+    });
     for (const EmbreeScene* e : {bs.embree.get(), bs.embree_point.get()}) {
         const bool user = e->geometry() == EmbreeGeometry::user;
         for (EmbreeMode mode :
@@ -456,7 +459,8 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile,
         if (path == RenderPath::scalar || configs.empty()) configs = {nullptr};
         for (Isa isa : path_isas)
             for (const SimdConfig* config : configs) {
-                const Accel accel = config ? config->accel : Accel::none;
+                // The scalar path finds its spheres through the reference's own BVH.
+                const Accel accel = config ? config->accel : Accel::automatic;
                 BenchRow row =
                     base_row(run, bs.spec, Workload::whitted, Variant{PixelOrder::tiled, tile});
                 row.system = "octray";
@@ -464,6 +468,7 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile,
                                                     : "single";
                 row.isa = path == RenderPath::simd ? isa_name(isa) : "scalar";
                 if (config) row.accel = config->bvh ? "bvh" : "none";
+                if (path == RenderPath::scalar) row.accel = "bvh";
                 if (path == RenderPath::simd) {
                     const auto key = std::make_pair(isa, config && config->bvh);
                     auto it = render_validation.find(key);

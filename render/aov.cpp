@@ -88,7 +88,7 @@ AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet 
     if (set.id) out.id.assign(n, 0u);
     if (!set.any()) return out;
 
-    const ReferenceTracer tracer(scene);
+    const ReferenceTracer tracer(scene, reference_accel(options.accel));
     const auto compute_rows = [&] {
         tbb::parallel_for(tbb::blocked_range<int>(rect.y0, rect.y1), [&](const auto& rows) {
             for (int j = rows.begin(); j < rows.end(); ++j)

@@ -67,6 +67,11 @@ constexpr std::uint64_t kBvhNodeBytesPerSphere = sizeof(BvhNode8) / 4;
 constexpr std::uint64_t kBvhSphereBytes = 5 * 4;
 constexpr std::uint64_t kBvhPageRounding = 8 * (std::uint64_t{2} << 20);
 
+// render/reference_bvh.cpp, per sphere: the builder's copy of the spheres (20 bytes), the
+// object indices in leaf order (4) and about 2 nodes per kLeafSize = 4 spheres (32 bytes
+// each), counted as one node per sphere.
+constexpr std::uint64_t kReferenceBvhBytesPerSphere = 20 + 4 + 32;
+
 // render/batch/frame_loop.cpp: each frame renders a posed copy of the scene (scene_at_frame)
 // while the batch keeps the loaded one.
 constexpr std::uint64_t kAuthoredCopies = 2;
@@ -188,8 +193,11 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
                       kBvhBuildBytesPerSphere + kBvhNodeBytesPerSphere + kBvhSphereBytes);
         bvh = sat_add(bvh, kBvhPageRounding);
     }
+    // The scalar path builds its own BVH (render/reference_bvh.h) unless --accel none.
+    if (!params.packet_path && spheres > 0 && params.accel != Accel::none)
+        bvh = sat_mul(spheres, kReferenceBvhBytesPerSphere);
     e.scene = sat_add(sat_mul(authored, kAuthoredCopies),
-                      params.packet_path ? sat_add(compiled, bvh) : 0);
+                      params.packet_path ? sat_add(compiled, bvh) : bvh);
     // Loading comes before rendering, and what it allocates is freed before the first
     // frame (measured: the peak of a render is the larger of the two, not their sum).
     e.load = params.scene_file_bytes > 0

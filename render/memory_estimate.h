@@ -30,7 +30,7 @@ struct RenderMemoryParams {
     int tile_width = 16;
     int tile_height = 16;
     bool packet_path = true;         // the SIMD renderer's per-tile ray streams (the default)
-    Accel accel = Accel::automatic;  // the packet path's sphere BVH (--accel)
+    Accel accel = Accel::automatic;  // the sphere BVH of either path (--accel)
     bool float32_output = false;     // EXR written as 32-bit floats instead of half
     int exr_lines_per_chunk = 16;    // the codec's scan lines per block (zip: 16, dwab: 256)
     bool png_preview = false;        // --png

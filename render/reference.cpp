@@ -88,7 +88,7 @@ float floor_parity(float x) {
 
 }  // namespace
 
-ReferenceTracer::ReferenceTracer(const Scene& scene)
+ReferenceTracer::ReferenceTracer(const Scene& scene, ReferenceAccel accel)
     : scene_(scene),
       camera_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)),
       background_up_(normalize(scene.camera.up)),
@@ -97,6 +97,11 @@ ReferenceTracer::ReferenceTracer(const Scene& scene)
     for (const Object& o : scene.objects)
         checker_bases_.push_back(o.type == ObjectType::plane ? checker_basis(o.normal)
                                                              : TangentBasis{});
+    if (accel == ReferenceAccel::bvh) {
+        bvh_.emplace(scene.objects);
+        for (std::uint32_t k = 0; k < scene.objects.size(); ++k)
+            if (scene.objects[k].type == ObjectType::plane) planes_.push_back(k);
+    }
 }
 
 std::optional<Ray> ReferenceTracer::camera_ray(int i, int j, std::uint32_t sample,
@@ -152,30 +157,43 @@ std::optional<Ray> ReferenceTracer::camera_ray(int i, int j, std::uint32_t sampl
     return ray;
 }
 
+std::optional<float> ReferenceTracer::intersect_object(std::uint32_t k, const Ray& ray) const {
+    const Object& o = scene_.objects[k];
+    return o.type == ObjectType::sphere ? intersect_sphere(o, ray) : intersect_plane(o, ray);
+}
+
 std::optional<SurfaceHit> ReferenceTracer::intersect(const Ray& ray) const {
-    std::optional<SurfaceHit> best;
-    Ray live = ray;  // shrink t_max as hits are found: strict '<' keeps the first listed
-    for (std::uint32_t k = 0; k < scene_.objects.size(); ++k) {
-        const Object& o = scene_.objects[k];
-        const std::optional<float> t =
-            o.type == ObjectType::sphere ? intersect_sphere(o, live) : intersect_plane(o, live);
-        if (!t) continue;
-        live.t_max = *t;
-        best = SurfaceHit{*t, k, {}, {}};
+    // The closest-hit rule: the smallest t in the live interval, and of equal t the object
+    // listed first. Each object's t does not depend on the others, so the order in which
+    // objects are tested (file order, or the BVH's) does not change the result.
+    float best_t = kInfinity;
+    std::optional<std::uint32_t> best;
+    const auto consider = [&](std::uint32_t k) {
+        const std::optional<float> t = intersect_object(k, ray);
+        if (t && (*t < best_t || (*t == best_t && (!best || k < *best)))) best_t = *t, best = k;
+    };
+    if (bvh_) {
+        for (const std::uint32_t k : planes_) consider(k);
+        bvh_->closest(ray, best_t, consider);
+    } else {
+        for (std::uint32_t k = 0; k < scene_.objects.size(); ++k) consider(k);
     }
-    if (!best) return best;
-    const Object& o = scene_.objects[best->object];
-    best->point = ray.at(best->t);
-    best->normal = o.type == ObjectType::sphere ? sphere_normal(best->point, o, ray) : o.normal;
-    return best;
+    if (!best) return std::nullopt;
+    SurfaceHit hit{best_t, *best, ray.at(best_t), {}};
+    const Object& o = scene_.objects[*best];
+    hit.normal = o.type == ObjectType::sphere ? sphere_normal(hit.point, o, ray) : o.normal;
+    return hit;
 }
 
 bool ReferenceTracer::occluded(const Ray& ray) const {
-    for (const Object& o : scene_.objects) {
-        const std::optional<float> t =
-            o.type == ObjectType::sphere ? intersect_sphere(o, ray) : intersect_plane(o, ray);
-        if (t) return true;
+    const auto hits = [&](std::uint32_t k) { return intersect_object(k, ray).has_value(); };
+    if (bvh_) {
+        for (const std::uint32_t k : planes_)
+            if (hits(k)) return true;
+        return bvh_->any(ray, hits);
     }
+    for (std::uint32_t k = 0; k < scene_.objects.size(); ++k)
+        if (hits(k)) return true;
     return false;
 }
 
@@ -314,7 +332,7 @@ Rgb ReferenceTracer::render_pixel(int i, int j, std::uint32_t frame, RayCounts& 
 
 RenderResult render_reference(const Scene& scene, const RenderOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    const ReferenceTracer tracer(scene);
+    const ReferenceTracer tracer(scene, reference_accel(options.accel));
     RenderResult result;
     // The crop and the sample range (render/crop.h): pixel (i, j) of the full image lands
     // at (i - rect.x0, j - rect.y0); its value does not depend on either.
@@ -374,7 +392,7 @@ RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRe
                                      Image& target, const RenderOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     check_block_render(blocks, target, scene.image.width, scene.image.height, options);
-    const ReferenceTracer tracer(scene);
+    const ReferenceTracer tracer(scene, reference_accel(options.accel));
     RenderResult result;
     result.full_width = scene.image.width;
     result.full_height = scene.image.height;

@@ -2,6 +2,8 @@
 // The scalar reference renderer: one ray at a time, written for clarity. It implements
 // docs/rendering-model.md literally and is the oracle the SIMD path is judged by.
 // It is built on core/ and scene/ only, never on kernels/, so it stays an independent check.
+// Its spheres are found through a plain binary BVH of its own (reference_bvh.h), or by
+// testing every object (ReferenceAccel::brute_force): the same hits, bit for bit.
 
 #include <cstdint>
 #include <optional>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include "core/ray.h"
+#include "render/reference_bvh.h"
 #include "render/types.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -22,10 +25,20 @@ struct SurfaceHit {
     Vec3 normal;  // geometric unit normal, not yet flipped towards the ray
 };
 
+// How the reference finds the objects a ray meets: its own BVH over the spheres (planes
+// are always tested one by one), or every object in file order. Both give the same hits.
+enum class ReferenceAccel { bvh, brute_force };
+
+// The reference's choice for a render's `--accel` (render/types.h): none is brute force,
+// auto and bvh its BVH.
+constexpr ReferenceAccel reference_accel(Accel accel) {
+    return accel == Accel::none ? ReferenceAccel::brute_force : ReferenceAccel::bvh;
+}
+
 class ReferenceTracer {
   public:
-    // The scene must have passed validate_scene().
-    explicit ReferenceTracer(const Scene& scene);
+    // The scene must have passed validate_scene(), and outlive the tracer.
+    explicit ReferenceTracer(const Scene& scene, ReferenceAccel accel = ReferenceAccel::bvh);
 
     // The camera ray of sample `sample` of pixel (i, j) in frame `frame`. A fisheye
     // sample outside the image circle has no ray (it is black).
@@ -61,8 +74,12 @@ class ReferenceTracer {
     Rgb shade(const Ray& ray, const SurfaceHit& hit, int depth, Rgb weight,
               RayCounts& counts) const;
     Rgb background(Vec3 direction) const;
+    // The ray's hit t on object k in its live interval, if any.
+    std::optional<float> intersect_object(std::uint32_t k, const Ray& ray) const;
 
     const Scene& scene_;
+    std::optional<ReferenceBvh> bvh_;    // ReferenceAccel::bvh
+    std::vector<std::uint32_t> planes_;  // with a BVH: the planes' object indices
     CameraFrame camera_;
     Vec3 background_up_;  // the camera's up as given, normalised (gradient background)
     float epsilon_;
@@ -71,7 +88,7 @@ class ReferenceTracer {
 
 // Renders the whole image, or options.crop of it, and options.samples of each pixel (see
 // render/types.h); tiles may run in parallel (TBB), one ray at a time per thread. The image
-// is bit-identical for any thread count, tile size and crop.
+// is bit-identical for any thread count, tile size, crop and options.accel.
 RenderResult render_reference(const Scene& scene, const RenderOptions& options = {});
 
 // Renders the pixels of each of `blocks` into `target` at their places, as

@@ -295,7 +295,8 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option(
            "--validate-rays", a->validate_rays,
            "Rays per set checked against the oracles (octray rows: the scalar reference, bit "
-           "for bit; Embree rows: double precision, within 1e-4), " +
+           "for bit; Embree rows: double precision, within 1e-4, brute force, so at most "
+           "2^30 / objects of them), " +
                integer_range_text(0, kMaxValidateRays) + "; 0 for all [default: 65536]")
         ->transform(decimal_integer(0, kMaxValidateRays));
     cmd->add_flag("--no-embree", a->no_embree, "Measure octray alone");

@@ -437,10 +437,10 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("ISA")
         ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
         ->capture_default_str();
-    cmd->add_option(
-           "--accel", args->accel,
-           "Sphere acceleration of the simd path: auto (a BVH above a measured sphere\n"
-           "count), bvh or none (brute force); the image does not depend on it")
+    cmd->add_option("--accel", args->accel,
+                    "Sphere acceleration: auto (simd: a BVH above a measured sphere count;\n"
+                    "scalar: its own BVH), bvh, or none (every ray against every object: the\n"
+                    "scalar reference at its most literal); the image does not depend on it")
         ->type_name("MODE")
         ->check(quiet(CLI::IsMember({"auto", "bvh", "none"})))
         ->capture_default_str();

@@ -168,6 +168,20 @@ TEST(MemoryLimit, HugeSppIsBoundedByTheTileChunks) {
     EXPECT_NO_THROW(check_memory_limit(s, kGiB, p));
 }
 
+TEST(RenderMemory, TheReferencePathCountsItsOwnBvhUnlessAccelNone) {
+    // render/reference_bvh.h: about 56 bytes per sphere while it is built; --accel none
+    // tests every object and builds nothing.
+    const Scene s = make_builtin_scene("random:100000");
+    RenderMemoryParams with_tree, without;
+    with_tree.packet_path = without.packet_path = false;
+    with_tree.threads = without.threads = 1;
+    without.accel = Accel::none;
+    const std::uint64_t tree =
+        estimate_render_memory(s, with_tree).scene - estimate_render_memory(s, without).scene;
+    EXPECT_GE(tree, 100000u * 40u);
+    EXPECT_LE(tree, 100000u * 80u);
+}
+
 TEST(MemorySize, ParsesBinaryUnits) {
     EXPECT_EQ(parse_memory_size("1048576"), std::uint64_t{1048576});
     EXPECT_EQ(parse_memory_size("512K"), 512u * 1024u);
