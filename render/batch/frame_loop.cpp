@@ -1,6 +1,7 @@
 #include "render/batch/frame_loop.h"
 
 #include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <chrono>
@@ -155,9 +156,16 @@ void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job,
     if (aovs.set.any())
         append_aov_channels(exr, aovs,
                             settings_.exr.float32 ? ExrPixelType::float32 : ExrPixelType::half);
-    write_exr(job.output, exr);
+    if (job.png.empty()) {
+        write_exr(job.output, exr);
+    } else {
+        // The preview is encoded while OpenEXR compresses the EXR's blocks: on 2 cores the
+        // two files take the time of the longer one. Both are written atomically, each on
+        // its own; the frame counts as finished only when both are (resume.h).
+        tbb::parallel_invoke([&] { write_exr(job.output, exr); },
+                             [&] { write_png_preview(job.png, result.image); });
+    }
     spare_channels_ = std::move(exr.channels);
-    if (!job.png.empty()) write_png_preview(job.png, result.image);
 }
 
 FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {

@@ -162,8 +162,11 @@ void write_exr(const std::string& path, const Image& image, const ExrWriteOption
 void write_png_preview(const std::string& path, const Image& image);
 
 // A linear value clamped to [0, 1] (NaN and negatives to 0) through the sRGB OETF
-// (IEC 61966-2-1), rounded to 8 bits: what the PNG preview stores.
+// (IEC 61966-2-1), rounded to 8 bits: what the PNG preview stores. Found in a table of the
+// values where the byte steps up; srgb8_by_formula computes the same byte with the
+// OETF's power (the tests hold the two equal).
 std::uint8_t srgb8(float linear);
+std::uint8_t srgb8_by_formula(float linear);
 
 // An 8-bit RGB PNG of `rgb` (3 * width * height bytes, row 0 on top) with an sRGB chunk,
 // in memory (`octray view` sends it to the browser): zlib's fastest level, since it is

@@ -15,6 +15,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -528,6 +529,38 @@ TEST_F(ImageIoTest, ExrThreadCountIsSetAndDoesNotChangeTheBytes) {
                            std::istreambuf_iterator<char>());
     };
     EXPECT_EQ(bytes(dir_ / "serial.exr"), bytes(dir_ / "threaded.exr"));
+}
+
+// srgb8 looks the byte up in a table of the values where it steps up; it must give the
+// formula's byte for every float. Every 61st float of [0, 1] (17 million), every float
+// within 4 ulps of each step, and the values outside [0, 1].
+TEST(Srgb8, TheTableGivesTheFormulasByteForEveryFloat) {
+    const std::uint32_t one = std::bit_cast<std::uint32_t>(1.0f);
+    std::size_t mismatches = 0;
+    const auto check = [&](float x) {
+        if (srgb8(x) != srgb8_by_formula(x) && ++mismatches <= 5)
+            ADD_FAILURE() << "x = " << x << " (bits " << std::bit_cast<std::uint32_t>(x)
+                          << "): table " << int(srgb8(x)) << ", formula "
+                          << int(srgb8_by_formula(x));
+    };
+    for (std::uint32_t bits = 0; bits <= one; bits += 61) check(std::bit_cast<float>(bits));
+    std::uint8_t last = 0;
+    for (std::uint32_t bits = 0; bits <= one; bits += 4096) {  // the steps, coarsely
+        const std::uint8_t v = srgb8_by_formula(std::bit_cast<float>(bits));
+        if (v != last)
+            for (std::uint32_t b = bits > 4100 ? bits - 4100 : 0; b <= bits + 4; ++b)
+                check(std::bit_cast<float>(b));
+        last = v;
+    }
+    for (const float x : {-0.0f, -1e-30f, -1.0f, 1.0f, 1.0000001f, 2.0f, 1e30f,
+                          std::numeric_limits<float>::denorm_min(),
+                          std::numeric_limits<float>::infinity(),
+                          -std::numeric_limits<float>::infinity(),
+                          std::numeric_limits<float>::quiet_NaN()})
+        check(x);
+    EXPECT_EQ(mismatches, 0u);
+    EXPECT_EQ(srgb8(1.0f), 255);
+    EXPECT_EQ(srgb8(std::numeric_limits<float>::quiet_NaN()), 0);
 }
 
 }  // namespace
