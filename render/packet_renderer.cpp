@@ -557,14 +557,15 @@ std::uint32_t ray_chunk_of(const RenderOptions& options) {
                : (std::max<std::uint32_t>(options.ray_chunk, 1u) + 15u) / 16u * 16u;
 }
 
-}  // namespace
+// Where a frame's BVH comes from: built for this frame (as options.accel says), or
+// prepared beforehand (`prepared`, nullptr when the prepared scene is traced brute force).
+struct FrameTree {
+    bool is_prepared = false;
+    const SphereBvh* prepared = nullptr;
+};
 
-RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options, Isa isa) {
-    return render_packet(scene, options, kernel_table(resolve_isa(isa)));
-}
-
-RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options,
-                           const kernels::KernelTable& table) {
+RenderResult render_frame(const CompiledScene& scene, FrameTree tree,
+                          const RenderOptions& options, const kernels::KernelTable& table) {
     const auto start = std::chrono::steady_clock::now();
     RenderResult result;
     // The crop and the sample range (render/crop.h), checked before any work. Tiles are
@@ -593,14 +594,18 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     TileTallies tallies;
     TileControl control(options);
 
-    // The spheres' BVH (options.accel), built on the render's threads and timed with it.
+    // The spheres' BVH: the prepared one, or (options.accel) one built on the render's
+    // threads and timed with it.
     SphereBvh bvh;
-    const bool use_bvh = accel_uses_bvh(options.accel, scene.spheres.count);
+    const bool build_bvh =
+        !tree.is_prepared && accel_uses_bvh(options.accel, scene.spheres.count);
     const auto render_tiles = [&] {
         if (fresh_frame) populate_frame(result.image);
-        if (use_bvh) bvh = build_sphere_bvh(scene.spheres);
-        const PacketTracer tracer(scene, table, options.frame, use_bvh ? &bvh : nullptr,
-                                  ray_chunk_of(options));
+        if (build_bvh) bvh = build_sphere_bvh(scene.spheres);
+        const PacketTracer tracer(
+            scene, table, options.frame,
+            tree.is_prepared ? tree.prepared : (build_bvh ? &bvh : nullptr),
+            ray_chunk_of(options));
         trace_tiles(
             tracer, target, tiles_x * tiles_y,
             [&](int t) {
@@ -613,10 +618,26 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
     run_with_threads(options.threads, render_tiles);
     control.finish();
     tallies.add_to(result);
-    result.bvh_seconds = use_bvh ? bvh.build_seconds : 0.0;
+    result.bvh_seconds = build_bvh ? bvh.build_seconds : 0.0;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+}  // namespace
+
+RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options, Isa isa) {
+    return render_packet(scene, options, kernel_table(resolve_isa(isa)));
+}
+
+RenderResult render_packet(const CompiledScene& scene, const RenderOptions& options,
+                           const kernels::KernelTable& table) {
+    return render_frame(scene, FrameTree{}, options, table);
+}
+
+RenderResult render_packet(const PreparedScene& scene, const RenderOptions& options, Isa isa) {
+    return render_frame(scene.compiled(), FrameTree{true, scene.bvh()}, options,
+                        kernel_table(resolve_isa(isa)));
 }
 
 RenderResult render_packet(const Scene& scene, const RenderOptions& options, Isa isa) {

@@ -40,10 +40,9 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
                            const kernels::KernelTable& table);
 
 // A compiled scene with its spheres' BVH (when `accel` asks for one), made once for many
-// renders of parts of the picture (render_packet_blocks): `octray view`'s frameless order
-// renders 8x8 blocks a batch at a time, and a render_packet call per block would compile
-// the scene and build the BVH per block. Neither depends on the camera, so set_camera()
-// keeps both.
+// renders: the frames of a still or camera-only animation (render/batch's frame loop),
+// and the parts of the picture that `octray view`'s frameless order renders as 8x8 blocks
+// (render_packet_blocks). Neither depends on the camera, so set_camera() keeps both.
 class PreparedScene {
   public:
     // Compiles `scene` (which must have passed validate_scene()) and builds the BVH on
@@ -54,12 +53,21 @@ class PreparedScene {
     const CompiledScene& compiled() const { return compiled_; }
     // The spheres' BVH, or nullptr where the scene is traced brute force.
     const SphereBvh* bvh() const { return use_bvh_ ? &bvh_ : nullptr; }
+    // What preparing took: compiling, and building the BVH (0 without one).
+    double compile_seconds() const { return compiled_.compile_seconds; }
+    double bvh_seconds() const { return use_bvh_ ? bvh_.build_seconds : 0.0; }
 
   private:
     CompiledScene compiled_;
     bool use_bvh_ = false;
     SphereBvh bvh_;
 };
+
+// Renders a frame of a prepared scene (its camera as set_camera left it): no compile and no
+// BVH build, so seconds is the render alone. The same image as render_packet of the
+// scene posed with that camera.
+RenderResult render_packet(const PreparedScene& scene, const RenderOptions& options = {},
+                           Isa isa = Isa::automatic);
 
 // Renders the pixels of each of `blocks` into `target` (the scene's width x height
 // picture) at their places, every sample of each; the other pixels of `target` keep their

@@ -231,11 +231,12 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
         case ProgressMode::lines:
             if (report.outcome == FrameOutcome::rendered)
                 std::printf(
-                    "frame %zu/%zu  %s frame %d  -> %s%s%s  trace %.3f s  %.2f Mrays/s  "
-                    "write %.3f s\n",
+                    "frame %zu/%zu  %s frame %d  -> %s%s%s  prepare %.3f s  trace %.3f s  "
+                    "%.2f Mrays/s  write %.3f s\n",
                     report.index, frame_count_, report.scene.c_str(), report.frame,
                     report.output.c_str(), report.preview.empty() ? "" : " + ",
-                    report.preview.c_str(), report.trace_seconds, mrays, report.write_seconds);
+                    report.preview.c_str(), report.prepare_seconds, report.trace_seconds, mrays,
+                    report.write_seconds);
             else if (report.outcome == FrameOutcome::failed)
                 std::printf("frame %zu/%zu  %s frame %d  FAILED: %s\n", report.index,
                             frame_count_, report.scene.c_str(), report.frame,
@@ -256,6 +257,7 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
                                     {"output", report.output},
                                     {"outcome", outcome_key(report.outcome)},
                                     {"seconds", report.seconds},
+                                    {"prepare_seconds", report.prepare_seconds},
                                     {"trace_seconds", report.trace_seconds},
                                     {"write_seconds", report.write_seconds},
                                     {"rays", report.rays},
@@ -307,6 +309,7 @@ void ProgressReporter::run_finished(const BatchSummary& summary) {
                                 {"not_started", summary.not_started},
                                 {"interrupted", summary.interrupted},
                                 {"seconds", summary.seconds},
+                                {"prepare_seconds", summary.prepare_seconds},
                                 {"trace_seconds", summary.trace_seconds},
                                 {"write_seconds", summary.write_seconds},
                                 {"rays", summary.rays},
@@ -327,10 +330,10 @@ void ProgressReporter::run_finished(const BatchSummary& summary) {
             std::snprintf(text, sizeof text, "%.3fs", seconds);
             return std::string(text);
         };
-        std::printf(" in %s: trace %s (%.2f Mrays/s), write %s\n",
-                    format_duration(summary.seconds).c_str(),
-                    phase(summary.trace_seconds).c_str(), mrays,
-                    phase(summary.write_seconds).c_str());
+        std::printf(
+            " in %s: prepare %s, trace %s (%.2f Mrays/s), write %s\n",
+            format_duration(summary.seconds).c_str(), phase(summary.prepare_seconds).c_str(),
+            phase(summary.trace_seconds).c_str(), mrays, phase(summary.write_seconds).c_str());
     }
     std::fflush(stdout);
 }

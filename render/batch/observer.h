@@ -26,20 +26,21 @@ struct FrameReport {
     std::string output;
     std::string preview;  // the PNG, if any
     FrameOutcome outcome = FrameOutcome::rendered;
-    double seconds = 0.0;        // everything: claims, trace, write
-    double trace_seconds = 0.0;  // rendering (AOVs included), what Mrays/s is over
-    double write_seconds = 0.0;  // EXR and PNG encoding and writing (every progressive pass)
-    std::uint64_t rays = 0;      // rendered frames
-    std::string message;         // failed frames: the reason
+    double seconds = 0.0;          // everything: claims, prepare, trace, write
+    double prepare_seconds = 0.0;  // compile + BVH build (0 on a frame of a prepared scene)
+    double trace_seconds = 0.0;    // rendering (AOVs included), what Mrays/s is over
+    double write_seconds = 0.0;    // EXR and PNG encoding and writing (every progressive pass)
+    std::uint64_t rays = 0;        // rendered frames
+    std::string message;           // failed frames: the reason
     // Rendered frames, the phases of `--stats`: the scene's load (once per scene, on each
-    // of its frames), compile, BVH build and the render itself (parts of trace_seconds).
+    // of its frames), compile and BVH build (prepare_seconds), and the render itself.
     double load_seconds = 0.0, compile_seconds = 0.0, bvh_seconds = 0.0, render_seconds = 0.0;
 };
 
 struct BatchSummary {
     std::size_t rendered = 0, skipped = 0, failed = 0, not_started = 0;
-    double seconds = 0.0;                             // wall time of the run
-    double trace_seconds = 0.0, write_seconds = 0.0;  // of the rendered frames
+    double seconds = 0.0;  // wall time of the run, and of loading its scenes before it
+    double prepare_seconds = 0.0, trace_seconds = 0.0, write_seconds = 0.0;  // rendered frames
     std::uint64_t rays = 0;
     bool interrupted = false;  // the cancel flag was set
     // What kinds of failure the failed frames had (a frame stopped by the cancel flag is

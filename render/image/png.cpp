@@ -186,7 +186,7 @@ std::uint8_t srgb8_formula(float linear) {
 // step), which one comparison finds; the loop after it is for safety and never runs.
 struct SrgbTable {
     static constexpr std::uint32_t kOneBits = 0x3F800000u;  // 1.0f
-    float threshold[257];                                  // [256]: +inf, a sentinel
+    float threshold[257];                                   // [256]: +inf, a sentinel
     std::uint8_t bucket_start[(kOneBits >> 16) + 1];
     SrgbTable() {
         threshold[0] = -std::numeric_limits<float>::infinity();

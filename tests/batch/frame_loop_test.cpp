@@ -29,6 +29,8 @@
 #include "render/batch/observer.h"
 #include "render/batch/plan.h"
 #include "render/image/image_read.h"
+#include "render/packet_renderer.h"
+#include "scene/animation.h"
 
 namespace octray::batch {
 namespace {
@@ -288,6 +290,59 @@ TEST_F(FrameLoopTest, CancelAbandonsTheFrameInProgressAndLeavesNothingBehind) {
     EXPECT_TRUE(none.interrupted);
     EXPECT_EQ(none.not_started, 3u);
     EXPECT_TRUE(files().empty());
+}
+
+// Prepare once (frame_loop.cpp): a camera-only animation on the simd path compiles the
+// scene and builds its BVH for its first frame only, and every frame is, bit for bit, the
+// frame rendered on its own (the scene posed at that frame, compiled and built afresh).
+TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBits) {
+    std::string json = R"({"image": {"width": 24, "height": 16},
+        "camera": {"eye": [0, 3, 12], "lookat": [0, 0, 0], "fov": 50},
+        "materials": {"m": {"color": [0.8, 0.5, 0.3], "ks": 0.3, "reflect": 0.3}},
+        "lights": [{"type": "point", "position": [5, 9, 6], "color": 1}],
+        "objects": [{"type": "plane", "point": [0, -2, 0], "normal": [0, 1, 0], "material": "m"})";
+    for (int k = 0; k < 48; ++k)  // past the 32 spheres from which the simd path builds a BVH
+        json += R"(, {"type": "sphere", "center": [)" + std::to_string(k % 8 - 4) + ", " +
+                std::to_string(k / 8 % 3) + ", " + std::to_string(k / 24 - 1) +
+                R"(], "radius": 0.4, "material": "m"})";
+    json += R"(], "animation": {"frames": 3, "camera": [
+        {"frame": 0, "eye": [0, 3, 12]}, {"frame": 2, "eye": [9, 5, 7], "fov": 40}]}})";
+    const fs::path file = dir_ / "orbit.json";
+    std::ofstream(file) << json;
+    BatchRequest request;
+    request.output = (dir_ / "o.#.exr").string();
+    scenes_ = {load_batch_scene(file.string(), request)};
+    request_ = request;
+    settings_.exr.float32 = true;
+
+    RecordingObserver observer;
+    const BatchSummary summary = run(observer);
+    ASSERT_EQ(summary.rendered, 3u);
+    ASSERT_EQ(observer.finished.size(), 3u);
+    EXPECT_GT(observer.finished[0].prepare_seconds, 0.0);
+    EXPECT_GT(observer.finished[0].bvh_seconds, 0.0);
+    for (int f = 1; f < 3; ++f) {
+        EXPECT_EQ(observer.finished[f].prepare_seconds, 0.0) << "frame " << f;
+        EXPECT_EQ(observer.finished[f].bvh_seconds, 0.0) << "frame " << f;
+    }
+    for (int f = 0; f < 3; ++f) {
+        RenderOptions options;
+        options.frame = static_cast<std::uint32_t>(f);
+        const RenderResult alone =
+            render_packet(scene_at_frame(scenes_[0].scene, f), options, settings_.isa);
+        const ChannelImage file_image =
+            read_image((dir_ / ("o." + std::to_string(f) + ".exr")).string());
+        ASSERT_EQ(file_image.pixel_count(), alone.image.pixel_count());
+        const float* r = file_image.plane(file_image.find_channel("R"));
+        const float* g = file_image.plane(file_image.find_channel("G"));
+        const float* b = file_image.plane(file_image.find_channel("B"));
+        std::size_t differ = 0;
+        for (std::size_t k = 0; k < alone.image.pixel_count(); ++k) {
+            const Rgb c = alone.image.data()[k];
+            differ += r[k] != c.r || g[k] != c.g || b[k] != c.b;
+        }
+        EXPECT_EQ(differ, 0u) << "frame " << f;
+    }
 }
 
 }  // namespace

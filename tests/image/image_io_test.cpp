@@ -552,11 +552,10 @@ TEST(Srgb8, TheTableGivesTheFormulasByteForEveryFloat) {
                 check(std::bit_cast<float>(b));
         last = v;
     }
-    for (const float x : {-0.0f, -1e-30f, -1.0f, 1.0f, 1.0000001f, 2.0f, 1e30f,
-                          std::numeric_limits<float>::denorm_min(),
-                          std::numeric_limits<float>::infinity(),
-                          -std::numeric_limits<float>::infinity(),
-                          std::numeric_limits<float>::quiet_NaN()})
+    for (const float x :
+         {-0.0f, -1e-30f, -1.0f, 1.0f, 1.0000001f, 2.0f, 1e30f,
+          std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::infinity(),
+          -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()})
         check(x);
     EXPECT_EQ(mismatches, 0u);
     EXPECT_EQ(srgb8(1.0f), 255);

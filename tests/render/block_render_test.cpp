@@ -107,6 +107,32 @@ TEST(BlockRender, APreparedSceneTakesANewCamera) {
     EXPECT_TRUE(same_bits(picture, render_packet(scene).image));
 }
 
+// A whole frame of a prepared scene (render_packet(PreparedScene)), camera after camera,
+// with and without its BVH, with a gradient sky (which follows the camera's up), at spp 4
+// and a frame counter other than 0: the render of the scene posed with that camera.
+TEST(BlockRender, WholeFramesOfAPreparedSceneEqualRendersOfThePosedScene) {
+    for (const Accel accel : {Accel::bvh, Accel::none}) {
+        Scene scene = test_scene("random:64", 4);
+        scene.background = {
+            BackgroundType::gradient, Rgb(0.0f), {0.9f, 0.8f, 0.7f}, {0.1f, 0.3f, 0.9f}};
+        PreparedScene prepared(scene, accel);
+        EXPECT_EQ(prepared.bvh() != nullptr, accel == Accel::bvh);
+        RenderOptions options;
+        options.frame = 7;
+        options.accel = accel;
+        for (int k = 0; k < 3; ++k) {
+            scene.camera.eye = scene.camera.eye + Vec3{1.5f, 0.5f, -0.5f};
+            scene.camera.up = Vec3{0.2f * float(k), 1.0f, 0.0f};
+            prepared.set_camera(scene.camera);
+            const RenderResult frame = render_packet(prepared, options);
+            EXPECT_EQ(frame.compile_seconds, 0.0);
+            EXPECT_EQ(frame.bvh_seconds, 0.0);
+            EXPECT_TRUE(same_bits(frame.image, render_packet(scene, options).image))
+                << "camera " << k << ", accel " << accel_name(accel);
+        }
+    }
+}
+
 TEST(BlockRender, ReferenceBlocksEqualAWholeReferenceRender) {
     const Scene scene = test_scene("whitted", 2);
     RenderOptions options;

@@ -54,9 +54,11 @@ TEST_F(BatchCliTest, FrameSpecsPickTheFramesInOrder) {
 TEST_F(BatchCliTest, FrameLinesReportTraceAndWriteTimesInAFixedOrder) {
     const std::regex frame_line(
         R"(frame [1-3]/3  shot frame [0-2]  -> out/t\.[0-2]\.exr \+ out/t\.[0-2]\.png  )"
-        R"(trace [0-9]+\.[0-9]{3} s  [0-9]+\.[0-9]{2} Mrays/s  write [0-9]+\.[0-9]{3} s)");
-    const std::regex summary(R"(done: 3 frames: 3 rendered, 0 skipped, 0 failed in \S+: )"
-                             R"(trace \S+ \([0-9]+\.[0-9]{2} Mrays/s\), write \S+)");
+        R"(prepare [0-9]+\.[0-9]{3} s  trace [0-9]+\.[0-9]{3} s  [0-9]+\.[0-9]{2} Mrays/s  )"
+        R"(write [0-9]+\.[0-9]{3} s)");
+    const std::regex summary(
+        R"(done: 3 frames: 3 rendered, 0 skipped, 0 failed in \S+: )"
+        R"(prepare \S+, trace \S+ \([0-9]+\.[0-9]{2} Mrays/s\), write \S+)");
     for (int run = 0; run < 4; ++run) {
         const auto r = run_octray(
             {"render", "shot.json", "--frames", "0-2", "--width", "64", "--height", "48", "-o",
