@@ -372,6 +372,7 @@ void measure_octray_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun
             row.system = "octray";
             row.mode = "single";
             row.isa = "scalar";
+            row.accel = "bvh";  // the reference's own
             measure_ray_set(run, rs, std::move(row),
                             detail::octray_scalar_tracer(run.arena, bs.reference), oracle,
                             kExactRule, false);

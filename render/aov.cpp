@@ -1,5 +1,6 @@
-// AOVs from the scalar reference tracer: one primary ray per pixel (sample 0), its first
-// hit, and what the shading of that hit would use (render/README.md, "AOVs").
+// AOVs: one primary ray per pixel (sample 0), its first hit (the reference's search, or
+// hits the packet path traced), and what the shading of that hit would use, computed by
+// the scalar reference tracer (render/README.md, "AOVs").
 
 #include "render/aov.h"
 
@@ -76,7 +77,12 @@ std::optional<AovSet> parse_aov_list(std::string_view list, std::string* error) 
     return set;
 }
 
-AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set) {
+namespace {
+
+// The AOVs of the pixels of options.crop from each pixel's first hit: traced by the
+// reference here (`hits` null), or given (the packet path's, trace_first_hits).
+AovImages aovs_from(const Scene& scene, const RenderOptions& options, AovSet set,
+                    const FirstHits* hits) {
     const PixelRect rect = render_rect(options, scene.image.width, scene.image.height);
     AovImages out;
     out.set = set;
@@ -87,8 +93,15 @@ AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet 
     if (set.albedo) out.albedo.assign(n, Rgb{});
     if (set.id) out.id.assign(n, 0u);
     if (!set.any()) return out;
+    if (hits != nullptr &&
+        (!(hits->rect == rect) || hits->t.size() != n || hits->object.size() != n))
+        throw std::invalid_argument("compute_aovs: the first hits cover " +
+                                    to_string(hits->rect) + ", the AOVs " + to_string(rect));
 
-    const ReferenceTracer tracer(scene, reference_accel(options.accel));
+    // Given hits need no search: the tracer is only asked for camera rays, points, normals
+    // and colors, so it builds no BVH.
+    const ReferenceTracer tracer(
+        scene, hits != nullptr ? ReferenceAccel::brute_force : reference_accel(options.accel));
     const auto compute_rows = [&] {
         tbb::parallel_for(tbb::blocked_range<int>(rect.y0, rect.y1), [&](const auto& rows) {
             for (int j = rows.begin(); j < rows.end(); ++j)
@@ -97,10 +110,15 @@ AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet 
                     // none and keeps the miss values.
                     const std::optional<Ray> ray = tracer.camera_ray(i, j, 0, options.frame);
                     if (!ray) continue;
-                    const std::optional<SurfaceHit> hit = tracer.intersect(*ray);
-                    if (!hit) continue;
                     const std::size_t k =
                         static_cast<std::size_t>(j - rect.y0) * rect.width() + (i - rect.x0);
+                    std::optional<SurfaceHit> hit;
+                    if (hits == nullptr)
+                        hit = tracer.intersect(*ray);
+                    else if (hits->object[k] >= 0)
+                        hit = tracer.surface_hit(*ray, hits->t[k],
+                                                 static_cast<std::uint32_t>(hits->object[k]));
+                    if (!hit) continue;
                     if (set.depth) out.depth[k] = hit->t;
                     if (set.normal)  // the normal shading uses: facing the incoming ray
                         out.normal[k] = dot(hit->normal, ray->direction) > 0.0f ? -hit->normal
@@ -112,6 +130,17 @@ AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet 
     };
     run_with_threads(options.threads, compute_rows);
     return out;
+}
+
+}  // namespace
+
+AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set) {
+    return aovs_from(scene, options, set, nullptr);
+}
+
+AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
+                       const FirstHits& hits) {
+    return aovs_from(scene, options, set, &hits);
 }
 
 void append_aov_channels(ExrImage& exr, const AovImages& aovs, ExrPixelType color_type) {

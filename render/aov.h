@@ -1,8 +1,9 @@
 #pragma once
 // Arbitrary output variables: per-pixel data about the first surface each camera ray hits
 // (depth, normal, albedo, object id), written as extra channels of the render's EXR
-// (render/README.md, "AOVs"). They come from the scalar reference tracer, one primary ray
-// per pixel, so they are the same whichever path renders the color.
+// (render/README.md, "AOVs"). They come from one primary ray per pixel, its first hit found
+// by either path and turned into values by the scalar reference tracer, so they are the
+// same whichever path renders the color.
 
 #include <cstdint>
 #include <optional>
@@ -47,6 +48,13 @@ struct AovImages {
 // parallel over options.threads threads. The scene must have passed validate_scene().
 // Throws std::invalid_argument for a bad crop, as the renderers do.
 AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set);
+
+// The same from first hits traced beforehand (the packet path's: trace_first_hits in
+// render/packet_renderer.h, over the same crop), with the same bits: the reference only
+// turns each hit's t and object into a point, a normal and a color, as its own search
+// would have. Throws std::invalid_argument when `hits` covers another rectangle.
+AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
+                       const FirstHits& hits);
 
 // Appends the AOV channels to `exr` (whose data window must be aovs.rect): Z float32; N.*
 // and albedo.* in `color_type` (the R, G, B type: half, or float32 with --float); id

@@ -67,10 +67,10 @@ constexpr std::uint64_t kBvhNodeBytesPerSphere = sizeof(BvhNode8) / 4;
 constexpr std::uint64_t kBvhSphereBytes = 5 * 4;
 constexpr std::uint64_t kBvhPageRounding = 8 * (std::uint64_t{2} << 20);
 
-// render/reference_bvh.cpp, per sphere: the builder's copy of the spheres (20 bytes), the
+// render/reference_bvh.cpp, per sphere: the builder's copy of the spheres (40 bytes), the
 // object indices in leaf order (4) and about 2 nodes per kLeafSize = 4 spheres (32 bytes
 // each), counted as one node per sphere.
-constexpr std::uint64_t kReferenceBvhBytesPerSphere = 20 + 4 + 32;
+constexpr std::uint64_t kReferenceBvhBytesPerSphere = 40 + 4 + 32;
 
 // render/batch/frame_loop.cpp: each frame renders a posed copy of the scene (scene_at_frame)
 // while the batch keeps the loaded one.

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -355,17 +356,7 @@ class PacketTracer {
         // and the chunking.
         // It depends on the tile's shape alone: built when the shape changes (most tiles of
         // a render have one shape; this loop was 2 % of a random:1024 frame).
-        if (s.order_width != tile.width || s.order_height != tile.height) {
-            s.pixel_order.clear();
-            s.pixel_order.reserve(pixels);
-            for (int by = 0; by < tile.height; by += kBlockHeight)
-                for (int bx = 0; bx < tile.width; bx += kBlockWidth)
-                    for (int y = by; y < std::min(by + kBlockHeight, tile.height); ++y)
-                        for (int x = bx; x < std::min(bx + kBlockWidth, tile.width); ++x)
-                            s.pixel_order.push_back(
-                                {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y)});
-            s.order_width = tile.width, s.order_height = tile.height;
-        }
+        pixel_order_for(tile, s);
 
         // Camera samples, primary rays and their trees, a chunk of samples at a time.
         for (std::size_t first = 0; first < samples; first += ray_chunk_) {
@@ -396,7 +387,50 @@ class PacketTracer {
         finish_streaming();
     }
 
+    // The closest hit of each pixel's sample-0 camera ray (the AOVs' hits: FirstHits in
+    // render/types.h), into `out` at the tile's place; a ray the camera drops (a fisheye
+    // pixel outside its circle) and a miss leave object -1 and t = +inf.
+    void first_hits(const Tile& tile, TileScratch& s, FirstHits& out) const {
+        pixel_order_for(tile, s);
+        const std::size_t pixels = static_cast<std::size_t>(tile.width) * tile.height;
+        const auto w = static_cast<std::uint32_t>(tile.width);
+        for (std::size_t first = 0; first < pixels; first += ray_chunk_) {
+            const std::size_t n = std::min<std::size_t>(ray_chunk_, pixels - first);
+            camera_samples(tile, s, first, n, 0, 1);
+            s.primary.reserve(n);
+            const std::uint32_t count = k_.camera_rays(
+                view_, s.samples.view(), static_cast<std::uint32_t>(n), s.primary.view());
+            if (count == 0) continue;
+            s.hits.reserve(count);
+            k_.closest_hit(view_, s.primary.view(), count, scene_.epsilon, s.hits.view());
+            for (std::uint32_t r = 0; r < count; ++r) {
+                const std::uint32_t p = s.primary.pixel[r];
+                const std::size_t at =
+                    static_cast<std::size_t>(tile.y0 + static_cast<int>(p / w) - out.rect.y0) *
+                        static_cast<std::size_t>(out.rect.width()) +
+                    static_cast<std::size_t>(tile.x0 + static_cast<int>(p % w) - out.rect.x0);
+                out.t[at] = s.hits.t[r];
+                out.object[at] = s.hits.object[r];
+            }
+        }
+    }
+
   private:
+    // The tile's pixels block by block (4 x 2 pixels each), row by row in a block, in
+    // s.pixel_order. It depends on the tile's shape alone: built when the shape changes.
+    static void pixel_order_for(const Tile& tile, TileScratch& s) {
+        if (s.order_width == tile.width && s.order_height == tile.height) return;
+        s.pixel_order.clear();
+        s.pixel_order.reserve(static_cast<std::size_t>(tile.width) * tile.height);
+        for (int by = 0; by < tile.height; by += kBlockHeight)
+            for (int bx = 0; bx < tile.width; bx += kBlockWidth)
+                for (int y = by; y < std::min(by + kBlockHeight, tile.height); ++y)
+                    for (int x = bx; x < std::min(bx + kBlockWidth, tile.width); ++x)
+                        s.pixel_order.push_back(
+                            {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y)});
+        s.order_width = tile.width, s.order_height = tile.height;
+    }
+
     // Samples [first, first + n) of the tile's stream (pixel_order, each pixel's samples
     // [first_sample, first_sample + per_pixel) in turn) into s.samples, padded to a whole
     // packet with a harmless film position.
@@ -638,6 +672,35 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
 RenderResult render_packet(const PreparedScene& scene, const RenderOptions& options, Isa isa) {
     return render_frame(scene.compiled(), FrameTree{true, scene.bvh()}, options,
                         kernel_table(resolve_isa(isa)));
+}
+
+FirstHits trace_first_hits(const PreparedScene& prepared, const RenderOptions& options,
+                           Isa isa) {
+    const CompiledScene& scene = prepared.compiled();
+    FirstHits out;
+    out.rect = render_rect(options, scene.width, scene.height);
+    out.t.assign(out.rect.pixel_count(), std::numeric_limits<float>::infinity());
+    out.object.assign(out.rect.pixel_count(), kernels::kNoHit);
+    const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
+    const PixelRect rect = out.rect;
+    const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
+    const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
+    run_with_threads(options.threads, [&] {
+        const PacketTracer tracer(scene, table, options.frame, prepared.bvh(),
+                                  ray_chunk_of(options));
+        tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
+                          [&](const tbb::blocked_range<int>& range) {
+                              TileScratch& s = scratch_for_thread();
+                              for (int t = range.begin(); t < range.end(); ++t) {
+                                  const int x0 = rect.x0 + (t % tiles_x) * tw;
+                                  const int y0 = rect.y0 + (t / tiles_x) * th;
+                                  tracer.first_hits(Tile{x0, y0, std::min(tw, rect.x1 - x0),
+                                                         std::min(th, rect.y1 - y0)},
+                                                    s, out);
+                              }
+                          });
+    });
+    return out;
 }
 
 RenderResult render_packet(const Scene& scene, const RenderOptions& options, Isa isa) {

@@ -69,6 +69,13 @@ class PreparedScene {
 RenderResult render_packet(const PreparedScene& scene, const RenderOptions& options = {},
                            Isa isa = Isa::automatic);
 
+// The closest hit of each pixel's sample-0 camera ray over options.crop (or the whole
+// image) of frame options.frame, traced by the kernels of `isa` on options.threads
+// threads: the hits the AOVs read (compute_aovs in render/aov.h), the same the scalar
+// reference finds. The scene's camera is as set_camera left it.
+FirstHits trace_first_hits(const PreparedScene& scene, const RenderOptions& options = {},
+                           Isa isa = Isa::automatic);
+
 // Renders the pixels of each of `blocks` into `target` (the scene's width x height
 // picture) at their places, every sample of each; the other pixels of `target` keep their
 // values. Each pixel is the same pixel of render_packet's image bit for bit. Each block is

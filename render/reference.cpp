@@ -179,8 +179,12 @@ std::optional<SurfaceHit> ReferenceTracer::intersect(const Ray& ray) const {
         for (std::uint32_t k = 0; k < scene_.objects.size(); ++k) consider(k);
     }
     if (!best) return std::nullopt;
-    SurfaceHit hit{best_t, *best, ray.at(best_t), {}};
-    const Object& o = scene_.objects[*best];
+    return surface_hit(ray, best_t, *best);
+}
+
+SurfaceHit ReferenceTracer::surface_hit(const Ray& ray, float t, std::uint32_t object) const {
+    SurfaceHit hit{t, object, ray.at(t), {}};
+    const Object& o = scene_.objects[object];
     hit.normal = o.type == ObjectType::sphere ? sphere_normal(hit.point, o, ray) : o.normal;
     return hit;
 }

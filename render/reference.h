@@ -48,6 +48,10 @@ class ReferenceTracer {
     // Closest hit over all objects in the ray's live interval (ties: first listed).
     std::optional<SurfaceHit> intersect(const Ray& ray) const;
 
+    // The hit of `ray` on object `object` at `t` (found by another search, the packet
+    // path's): its point and geometric normal, as intersect() computes them.
+    SurfaceHit surface_hit(const Ray& ray, float t, std::uint32_t object) const;
+
     // True if any object is hit in the ray's live interval.
     bool occluded(const Ray& ray) const;
 

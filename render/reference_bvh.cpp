@@ -3,6 +3,8 @@
 
 #include "render/reference_bvh.h"
 
+#include <oneapi/tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -22,29 +24,54 @@ float box_hi(float c, float r) {
 
 }  // namespace
 
-// The builder works on a copy of the spheres (centers, radii, object indices), so that its
+// Nodes of the subtree over `count` spheres (the node itself included). Median splits
+// give every subtree a shape fixed by its count, so each subtree's nodes can be placed
+// before it is built, and subtrees build in parallel into their own places: the tree is
+// the same whatever the threads do.
+std::uint32_t ReferenceBvh::subtree_nodes(std::uint32_t count) {
+    if (count <= kLeafSize) return 1;
+    // At most two distinct counts per level (floor and ceiling halves): memoised.
+    if (const std::uint32_t known = known_subtree_nodes(count); known > 0) return known;
+    const std::uint32_t n = 1 + subtree_nodes(count / 2) + subtree_nodes(count - count / 2);
+    subtree_sizes_.emplace_back(count, n);
+    return n;
+}
+
+std::uint32_t ReferenceBvh::known_subtree_nodes(std::uint32_t count) const {
+    if (count <= kLeafSize) return 1;
+    for (const auto& [c, n] : subtree_sizes_)
+        if (c == count) return n;
+    return 0;
+}
+
+// The builder works on a copy of the spheres (boxes, centers, object indices), so that its
 // passes read contiguous memory; the tree keeps only the object indices in leaf order.
 ReferenceBvh::ReferenceBvh(std::span<const Object> objects) {
     std::vector<Prim> prims;
     for (std::uint32_t k = 0; k < objects.size(); ++k) {
         const Object& o = objects[k];
         if (o.type != ObjectType::sphere) continue;
-        prims.push_back({{o.center.x, o.center.y, o.center.z}, o.radius, k});
+        Prim p;
+        const float c[3] = {o.center.x, o.center.y, o.center.z};
+        for (int a = 0; a < 3; ++a) {
+            p.c[a] = c[a];
+            p.lo[a] = box_lo(c[a], o.radius);
+            p.hi[a] = box_hi(c[a], o.radius);
+        }
+        p.object = k;
+        prims.push_back(p);
     }
     if (prims.empty()) return;
-    // A median split leaves ceil(n / 2) spheres on the larger side: about n / 2 leaves
-    // below n / kLeafSize nodes each level, 2n / kLeafSize nodes at most in all.
-    nodes_.reserve(2 * (prims.size() / kLeafSize + 1));
-    nodes_.emplace_back();
-    build_node(0, prims, 0, static_cast<std::uint32_t>(prims.size()), 1);
+    const auto n = static_cast<std::uint32_t>(prims.size());
+    nodes_.resize(subtree_nodes(n));
+    depth_ = build_node(0, 1, prims, 0, n, 1);
     spheres_.reserve(prims.size());
     for (const Prim& p : prims) spheres_.push_back(p.object);
 }
 
-void ReferenceBvh::build_node(std::uint32_t node, std::vector<Prim>& prims, std::uint32_t first,
-                              std::uint32_t count, int level) {
+int ReferenceBvh::build_node(std::uint32_t node, std::uint32_t below, std::vector<Prim>& prims,
+                             std::uint32_t first, std::uint32_t count, int level) {
     if (level > kMaxDepth) throw std::logic_error("ReferenceBvh: tree deeper than kMaxDepth");
-    depth_ = std::max(depth_, level);
 
     // The node's box (the spheres' boxes) and the box of their centers (the split's).
     float lo[3], hi[3], clo[3], chi[3];
@@ -55,18 +82,19 @@ void ReferenceBvh::build_node(std::uint32_t node, std::vector<Prim>& prims, std:
     for (std::uint32_t i = first; i < first + count; ++i) {
         const Prim& p = prims[i];
         for (int a = 0; a < 3; ++a) {
-            lo[a] = std::min(lo[a], box_lo(p.c[a], p.r));
-            hi[a] = std::max(hi[a], box_hi(p.c[a], p.r));
+            lo[a] = std::min(lo[a], p.lo[a]);
+            hi[a] = std::max(hi[a], p.hi[a]);
             clo[a] = std::min(clo[a], p.c[a]);
             chi[a] = std::max(chi[a], p.c[a]);
         }
     }
-    for (int a = 0; a < 3; ++a) nodes_[node].lo[a] = lo[a], nodes_[node].hi[a] = hi[a];
+    Node& n = nodes_[node];
+    for (int a = 0; a < 3; ++a) n.lo[a] = lo[a], n.hi[a] = hi[a];
 
     if (count <= kLeafSize) {
-        nodes_[node].first = first;
-        nodes_[node].count = count;
-        return;
+        n.first = first;
+        n.count = count;
+        return level;
     }
 
     // Object median along the widest extent of the centers: half the spheres (by center,
@@ -82,13 +110,28 @@ void ReferenceBvh::build_node(std::uint32_t node, std::vector<Prim>& prims, std:
         return x.c[axis] < y.c[axis] || (x.c[axis] == y.c[axis] && x.object < y.object);
     });
 
-    const auto children = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.emplace_back();
-    nodes_.emplace_back();
-    nodes_[node].first = children;
-    nodes_[node].count = 0;
-    build_node(children, prims, first, half, level + 1);
-    build_node(children + 1, prims, first + half, count - half, level + 1);
+    // The children sit side by side at `below`; the left child's subtree comes after them,
+    // then the right child's.
+    n.first = below;
+    n.count = 0;
+    const std::uint32_t left_below = below + 2;
+    // (Every count of this tree was memoised by the constructor's subtree_nodes: the
+    // parallel builds only read the table.)
+    const std::uint32_t right_below = left_below + known_subtree_nodes(half) - 1;
+    int left = 0, right = 0;
+    const auto build_left = [&] {
+        left = build_node(below, left_below, prims, first, half, level + 1);
+    };
+    const auto build_right = [&] {
+        right =
+            build_node(below + 1, right_below, prims, first + half, count - half, level + 1);
+    };
+    // Large subtrees on two threads; small ones are not worth a task.
+    if (count >= kParallelSpheres)
+        tbb::parallel_invoke(build_left, build_right);
+    else
+        build_left(), build_right();
+    return std::max(left, right);
 }
 
 ReferenceBvh::BoxRay ReferenceBvh::box_ray(const Ray& ray) const {

@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/ray.h"
@@ -79,15 +80,22 @@ class ReferenceBvh {
     // The ray's interval [t0, t1] inside node n's widened box, empty when t0 > t1.
     void enter(const BoxRay& r, const Node& n, double& t0, double& t1) const;
 
-    // A sphere as the builder sorts it.
+    // A sphere as the builder sorts it: its box, its center, its object index.
     struct Prim {
-        float c[3];
-        float r;
+        float lo[3], hi[3], c[3];
         std::uint32_t object;
     };
-    // Fills node `node` with prims[first, first + count) at depth `level` (the root's 1).
-    void build_node(std::uint32_t node, std::vector<Prim>& prims, std::uint32_t first,
-                    std::uint32_t count, int level);
+    // Subtrees of at least this many spheres build their two halves on two threads.
+    static constexpr std::uint32_t kParallelSpheres = 1u << 14;
+    // Fills node `node` with prims[first, first + count) at depth `level` (the root's 1),
+    // its descendants from node `below` on; returns the depth of its deepest leaf.
+    int build_node(std::uint32_t node, std::uint32_t below, std::vector<Prim>& prims,
+                   std::uint32_t first, std::uint32_t count, int level);
+    // Nodes of a subtree over `count` spheres, itself included (memoised in
+    // subtree_sizes_ while building).
+    std::uint32_t subtree_nodes(std::uint32_t count);
+    std::uint32_t known_subtree_nodes(std::uint32_t count) const;  // 0: not memoised
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> subtree_sizes_;
 
     std::vector<Node> nodes_;
     std::vector<std::uint32_t> spheres_;  // object indices in leaf order

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string_view>
+#include <vector>
 
 #include "core/image.h"
 #include "core/pixel_rect.h"
@@ -95,6 +96,16 @@ struct RenderOptions {
 class RenderCancelled : public std::runtime_error {
   public:
     RenderCancelled() : std::runtime_error("render cancelled") {}
+};
+
+// The closest hit of each pixel's sample-0 camera ray over `rect`, row by row (top row
+// first): the first hits the AOVs read, traced by either path. object is the hit's
+// Scene::objects index, or -1 (t = +inf) for a miss or a camera sample with no ray (a
+// fisheye pixel outside its image circle).
+struct FirstHits {
+    PixelRect rect;
+    std::vector<float> t;
+    std::vector<std::int32_t> object;
 };
 
 struct RenderResult {

@@ -38,12 +38,6 @@ struct FrameResult {
     FailureKind failure = FailureKind::none;
 };
 
-RenderResult render_still(const BatchSettings& settings, const Scene& scene,
-                          const RenderOptions& options) {
-    if (settings.path == RenderPath::scalar) return render_reference(scene, options);
-    return render_packet(scene, options, settings.isa);
-}
-
 // Whether the frames of `scene` can share one prepared scene: its objects never move (a
 // still, or an animation of the camera alone), so only the camera differs between frames.
 bool objects_still(const Scene& scene) {
@@ -283,34 +277,44 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         // Writing (EXR and PNG encoding) is timed apart from tracing: the frame line and
         // the summary report each, and the rate is rays over trace time alone.
         const auto trace_started = Clock::now();
-        const AovImages aovs = compute_aovs(posed, options, settings_.aovs);
+
+        // Prepare once: the simd path renders a prepared scene (compiled, its BVH built).
+        // A scene whose objects stay still (a still, a camera-only animation) is prepared
+        // for its first frame and only takes each next frame's camera; one whose objects
+        // move is prepared for every frame.
+        double prepare_seconds = 0.0;
+        const bool simd = settings_.path == RenderPath::simd;
+        const bool reuse =
+            simd && objects_still(scene.scene) && prepared_ && prepared_index_ == job.scene;
+        if (reuse) {
+            prepared_->set_camera(posed.camera);
+        } else if (simd) {
+            prepared_.reset();  // one prepared scene at a time
+            prepared_.emplace(posed, options.accel, options.threads);
+            prepared_index_ = job.scene;
+            out.report.compile_seconds = prepared_->compile_seconds();
+            out.report.bvh_seconds = prepared_->bvh_seconds();
+            prepare_seconds = out.report.compile_seconds + out.report.bvh_seconds;
+        } else {
+            prepared_.reset();
+        }
+        const auto render_pass = [&](const RenderOptions& o) {
+            return simd ? render_packet(*prepared_, o, settings_.isa)
+                        : render_reference(posed, o);
+        };
+        // AOVs from each pixel's first hit: traced by the kernels on the simd path, by the
+        // reference on the scalar one (the same bits either way).
+        const AovImages aovs =
+            !settings_.aovs.any() || !simd
+                ? compute_aovs(posed, options, settings_.aovs)
+                : compute_aovs(posed, options, settings_.aovs,
+                               trace_first_hits(*prepared_, options, settings_.isa));
         double write_seconds = 0.0;
         const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
             const auto write_started = Clock::now();
             write_outputs(scene, job, posed, r, aovs, samples_so_far);
             write_seconds +=
                 std::chrono::duration<double>(Clock::now() - write_started).count();
-        };
-
-        // Prepare once: the first frame of a scene whose objects stay still compiles it
-        // and builds its BVH; its next frames only set their camera.
-        double prepare_seconds = 0.0;
-        const bool reuse = settings_.path == RenderPath::simd && objects_still(scene.scene);
-        if (reuse && (!prepared_ || prepared_index_ != job.scene)) {
-            prepared_.reset();
-            prepared_.emplace(posed, options.accel, options.threads);
-            prepared_index_ = job.scene;
-            out.report.compile_seconds = prepared_->compile_seconds();
-            out.report.bvh_seconds = prepared_->bvh_seconds();
-            prepare_seconds = out.report.compile_seconds + out.report.bvh_seconds;
-        } else if (reuse) {
-            prepared_->set_camera(posed.camera);
-        } else {
-            prepared_.reset();
-        }
-        const auto render_pass = [&](const RenderOptions& o) {
-            return reuse ? render_packet(*prepared_, o, settings_.isa)
-                         : render_still(settings_, posed, o);
         };
 
         RenderResult result;
@@ -325,11 +329,6 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         }
         // trace: the render (and AOVs) alone; preparing (compile, BVH) and writing are
         // reported apart.
-        if (!reuse) {
-            out.report.compile_seconds = result.compile_seconds;
-            out.report.bvh_seconds = result.bvh_seconds;
-            prepare_seconds = result.compile_seconds + result.bvh_seconds;
-        }
         out.report.prepare_seconds = prepare_seconds;
         out.report.trace_seconds =
             std::chrono::duration<double>(Clock::now() - trace_started).count() -

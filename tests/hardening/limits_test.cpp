@@ -169,7 +169,7 @@ TEST(MemoryLimit, HugeSppIsBoundedByTheTileChunks) {
 }
 
 TEST(RenderMemory, TheReferencePathCountsItsOwnBvhUnlessAccelNone) {
-    // render/reference_bvh.h: about 56 bytes per sphere while it is built; --accel none
+    // render/reference_bvh.h: about 76 bytes per sphere while it is built; --accel none
     // tests every object and builds nothing.
     const Scene s = make_builtin_scene("random:100000");
     RenderMemoryParams with_tree, without;
@@ -179,7 +179,7 @@ TEST(RenderMemory, TheReferencePathCountsItsOwnBvhUnlessAccelNone) {
     const std::uint64_t tree =
         estimate_render_memory(s, with_tree).scene - estimate_render_memory(s, without).scene;
     EXPECT_GE(tree, 100000u * 40u);
-    EXPECT_LE(tree, 100000u * 80u);
+    EXPECT_LE(tree, 100000u * 100u);
 }
 
 TEST(MemorySize, ParsesBinaryUnits) {

@@ -96,6 +96,20 @@ TEST(ReferenceBvh, HoldsEverySphereInShallowSmallLeaves) {
     EXPECT_LE(bvh.depth(), 10);
 }
 
+TEST(ReferenceBvh, ALargeTreeBuiltOnSeveralThreadsFindsTheSameHits) {
+    // Past ReferenceBvh's parallel build threshold: subtrees build on TBB's threads into
+    // places fixed beforehand.
+    std::mt19937 rng(5);
+    const Scene s = degenerate_scene(rng, 40000, 30.0f);
+    const ReferenceTracer bvh(s, ReferenceAccel::bvh), brute(s, ReferenceAccel::brute_force);
+    std::uniform_real_distribution<float> pos(-40.0f, 40.0f);
+    for (int k = 0; k < 400; ++k) {
+        const Ray ray{{pos(rng), pos(rng), pos(rng)}, random_unit(rng), 0.0f, kInfinity};
+        expect_same_hits(bvh, brute, ray, "ray " + std::to_string(k));
+        if (::testing::Test::HasFailure()) return;
+    }
+}
+
 TEST(ReferenceBvh, ClosestHitAndOcclusionMatchBruteForceOnDegenerateScenes) {
     std::mt19937 rng(2026);
     for (int trial = 0; trial < 12; ++trial) {
