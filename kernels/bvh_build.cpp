@@ -19,6 +19,7 @@
 #include <chrono>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "kernels/bvh_sah.h"
@@ -37,6 +38,28 @@ double SphereBvh::bytes_per_sphere() const {
 namespace {
 
 using namespace bvh_sah;
+
+// A sphere's box c ± sqrt(r2), rounded outwards: it holds every point of the sphere the
+// kernels intersect (which knows only r2). In float: sqrtf is exact to half an ulp, and
+// the factor and the relative and absolute steps cover every rounding after it.
+void sphere_box(float cx, float cy, float cz, float r2, float lo[3], float hi[3]) {
+    const __m128 grow_r = _mm_set1_ps(1.0f + 0x1.0p-21f);
+    const __m128 rel = _mm_set1_ps(0x1.0p-21f);
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
+    const __m128 c = _mm_setr_ps(cx, cy, cz, 0.0f);
+    const __m128 radius = _mm_mul_ps(_mm_set1_ps(sqrtf(r2)), grow_r);
+    __m128 l = _mm_sub_ps(c, radius), h = _mm_add_ps(c, radius);
+    const auto step = [&](__m128 v) {
+        return _mm_add_ps(_mm_mul_ps(_mm_and_ps(v, abs_mask), rel), tiny);
+    };
+    l = _mm_sub_ps(l, step(l));
+    h = _mm_add_ps(h, step(h));
+    alignas(16) float lv[4], hv[4];
+    _mm_store_ps(lv, l);
+    _mm_store_ps(hv, h);
+    for (int a = 0; a < 3; ++a) lo[a] = lv[a], hi[a] = hv[a];
+}
 
 // The 8-wide collapse hands subtrees of this many spheres or more to tasks of their own.
 constexpr std::uint32_t kParallelCollapse = 1024;
@@ -236,35 +259,18 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
     // The builder's buffers (references, binary nodes) on huge pages: core/aligned.h.
     using PrimRefs = std::vector<PrimRef, UninitializedAllocator<PrimRef, Pages::huge>>;
     PrimRefs refs(n);
-    // Each sphere's box c ± sqrt(r2), rounded outwards: it holds every point of the sphere
-    // the kernels intersect (which knows only r2).
-    tbb::parallel_for(
-        tbb::blocked_range<std::uint32_t>(0, n, 4096),
-        [&](const tbb::blocked_range<std::uint32_t>& r) {
-            // c -+ r rounded outwards in float: sqrtf is exact to half an
-            // ulp, the factor and the relative and absolute steps cover
-            // every rounding after it.
-            const __m128 grow_r = _mm_set1_ps(1.0f + 0x1.0p-21f);
-            const __m128 rel = _mm_set1_ps(0x1.0p-21f);
-            const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-            const __m128 tiny = _mm_set1_ps(std::numeric_limits<float>::min());
-            for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
-                const auto index = static_cast<float>(i);
-                const __m128 c = _mm_setr_ps(spheres.cx[i], spheres.cy[i], spheres.cz[i], 0.0f);
-                const __m128 radius = _mm_mul_ps(_mm_set1_ps(sqrtf(spheres.r2[i])), grow_r);
-                __m128 lo = _mm_sub_ps(c, radius), hi = _mm_add_ps(c, radius);
-                const auto step = [&](__m128 v) {
-                    return _mm_add_ps(_mm_mul_ps(_mm_and_ps(v, abs_mask), rel), tiny);
-                };
-                lo = _mm_sub_ps(lo, step(lo));
-                hi = _mm_add_ps(hi, step(hi));
-                alignas(16) float l[4], h[4];
-                _mm_store_ps(l, lo);
-                _mm_store_ps(h, hi);
-                refs[i].box.lo = _mm_setr_ps(l[0], l[1], l[2], index);
-                refs[i].box.hi = _mm_setr_ps(h[0], h[1], h[2], index);
-            }
-        });
+    // Each sphere's box c ± sqrt(r2), rounded outwards (sphere_box).
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) {
+                          for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                              const auto index = static_cast<float>(i);
+                              float l[3], h[3];
+                              sphere_box(spheres.cx[i], spheres.cy[i], spheres.cz[i],
+                                         spheres.r2[i], l, h);
+                              refs[i].box.lo = _mm_setr_ps(l[0], l[1], l[2], index);
+                              refs[i].box.hi = _mm_setr_ps(h[0], h[1], h[2], index);
+                          }
+                      });
 
     // The binary tree: n - 1 slots for its inner nodes (leaves have none).
     std::vector<BinaryNode, UninitializedAllocator<BinaryNode, Pages::huge>> binary(n - 1);
@@ -302,6 +308,92 @@ SphereBvh build_sphere_bvh(const CompiledSpheres& spheres) {
     bvh.build_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
+}
+
+void refit_sphere_bvh(SphereBvh& bvh, const CompiledSpheres& spheres,
+                      std::span<const std::uint32_t> leaf_sphere) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::uint32_t n = bvh.sphere_count;
+    if (spheres.count != n || leaf_sphere.size() != n)
+        throw std::invalid_argument("refit_sphere_bvh: the tree holds " + std::to_string(n) +
+                                    " spheres, the scene " + std::to_string(spheres.count));
+    if (n == 0) return;
+    // The tree's copy of the spheres, in leaf order.
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, n, 4096),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) {
+                          for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                              const std::uint32_t s = leaf_sphere[i];
+                              bvh.cx[i] = spheres.cx[s], bvh.cy[i] = spheres.cy[s];
+                              bvh.cz[i] = spheres.cz[s], bvh.r2[i] = spheres.r2[s];
+                          }
+                      });
+    // Leaf boxes (independent of each other) in parallel, then the inner children's boxes
+    // from the last node to the first: a node's children come after it, so each inner
+    // child's box is the union of a node already refitted.
+    const auto count = static_cast<std::uint32_t>(bvh.nodes.size());
+    tbb::parallel_for(
+        tbb::blocked_range<std::uint32_t>(0, count, 64),
+        [&](const tbb::blocked_range<std::uint32_t>& r) {
+            for (std::uint32_t k = r.begin(); k < r.end(); ++k) {
+                BvhNode8& node = bvh.nodes[k];
+                for (std::uint32_t j = 0; j < kBvhWidth; ++j) {
+                    const std::uint32_t child = node.child[j];
+                    if (child == kBvhEmpty || (child & kBvhLeafBit) == 0) continue;
+                    const std::uint32_t first = (child & ~kBvhLeafBit) >> kBvhLeafCountBits;
+                    const std::uint32_t leaf_count =
+                        (child & ((1u << kBvhLeafCountBits) - 1)) + 1;
+                    float lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+                    for (std::uint32_t i = first; i < first + leaf_count; ++i) {
+                        float l[3], h[3];
+                        sphere_box(bvh.cx[i], bvh.cy[i], bvh.cz[i], bvh.r2[i], l, h);
+                        for (int a = 0; a < 3; ++a)
+                            lo[a] = std::min(lo[a], l[a]), hi[a] = std::max(hi[a], h[a]);
+                    }
+                    node.min_x[j] = lo[0], node.min_y[j] = lo[1], node.min_z[j] = lo[2];
+                    node.max_x[j] = hi[0], node.max_y[j] = hi[1], node.max_z[j] = hi[2];
+                }
+            }
+        });
+    const auto node_box = [&](const BvhNode8& node, float lo[3], float hi[3]) {
+        for (int a = 0; a < 3; ++a) lo[a] = kInf, hi[a] = -kInf;
+        for (std::uint32_t j = 0; j < kBvhWidth; ++j) {
+            if (node.child[j] == kBvhEmpty) continue;
+            lo[0] = std::min(lo[0], node.min_x[j]), hi[0] = std::max(hi[0], node.max_x[j]);
+            lo[1] = std::min(lo[1], node.min_y[j]), hi[1] = std::max(hi[1], node.max_y[j]);
+            lo[2] = std::min(lo[2], node.min_z[j]), hi[2] = std::max(hi[2], node.max_z[j]);
+        }
+    };
+    for (std::uint32_t k = count; k-- > 0;) {
+        BvhNode8& node = bvh.nodes[k];
+        for (std::uint32_t j = 0; j < kBvhWidth; ++j) {
+            const std::uint32_t child = node.child[j];
+            if (child == kBvhEmpty || (child & kBvhLeafBit) != 0) continue;
+            float lo[3], hi[3];
+            node_box(bvh.nodes[child], lo, hi);
+            node.min_x[j] = lo[0], node.min_y[j] = lo[1], node.min_z[j] = lo[2];
+            node.max_x[j] = hi[0], node.max_y[j] = hi[1], node.max_z[j] = hi[2];
+        }
+    }
+    node_box(bvh.nodes[0], bvh.lo, bvh.hi);
+    bvh.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double sphere_bvh_cost(const SphereBvh& bvh) {
+    const auto half_area = [](float dx, float dy, float dz) {
+        return static_cast<double>(dx) * dy + static_cast<double>(dy) * dz +
+               static_cast<double>(dz) * dx;
+    };
+    const double root =
+        half_area(bvh.hi[0] - bvh.lo[0], bvh.hi[1] - bvh.lo[1], bvh.hi[2] - bvh.lo[2]);
+    if (!(root > 0.0)) return 0.0;
+    double sum = 0.0;
+    for (const BvhNode8& node : bvh.nodes)
+        for (std::uint32_t j = 0; j < kBvhWidth; ++j)
+            if (node.child[j] != kBvhEmpty)
+                sum += half_area(node.max_x[j] - node.min_x[j], node.max_y[j] - node.min_y[j],
+                                 node.max_z[j] - node.min_z[j]);
+    return sum / root;
 }
 
 }  // namespace octray

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "core/aligned.h"
 #include "kernels/bvh_node.h"
@@ -48,5 +49,19 @@ struct SphereBvh {
 // threads limits it to N). Throws std::invalid_argument beyond 2^24 spheres (the most a
 // compiled scene holds).
 SphereBvh build_sphere_bvh(const CompiledSpheres& spheres);
+
+// Refits `bvh` (built over spheres of the same count) to spheres that moved or changed
+// size: the tree's copy of the spheres from `spheres`, where leaf slot i holds compiled
+// sphere leaf_sphere[i], and every box again the union of what it holds, rounded outwards
+// as the build does. The tree's shape stays, so its cost (sphere_bvh_cost) may grow;
+// build_seconds becomes the refit's time. Any tree that bounds its spheres finds the same
+// hits (kernels/README.md, "The BVH"). Throws std::invalid_argument when counts differ.
+void refit_sphere_bvh(SphereBvh& bvh, const CompiledSpheres& spheres,
+                      std::span<const std::uint32_t> leaf_sphere);
+
+// The tree's surface-area cost: the sum of every child box's surface area over the root
+// box's, which is the expected number of child boxes a random ray through the root box
+// enters. A refit tree whose spheres spread apart grows it.
+double sphere_bvh_cost(const SphereBvh& bvh);
 
 }  // namespace octray

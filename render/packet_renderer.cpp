@@ -715,9 +715,39 @@ RenderResult render_packet(const Scene& scene, const RenderOptions& options, Isa
 
 PreparedScene::PreparedScene(const Scene& scene, Accel accel, int threads)
     : compiled_(compile_scene(scene)),
-      use_bvh_(accel_uses_bvh(accel, compiled_.spheres.count)) {
-    if (use_bvh_)
-        run_with_threads(threads, [&] { bvh_ = build_sphere_bvh(compiled_.spheres); });
+      use_bvh_(accel_uses_bvh(accel, compiled_.spheres.count)),
+      threads_(threads) {
+    if (use_bvh_) build();
+}
+
+void PreparedScene::build() {
+    run_with_threads(threads_, [&] { bvh_ = build_sphere_bvh(compiled_.spheres); });
+    built_cost_ = sphere_bvh_cost(bvh_);
+    // Leaf slot i holds the sphere of file index bvh_.object[i]: its compiled index.
+    std::vector<std::uint32_t> compiled_index(compiled_.objects.count, 0);
+    for (std::uint32_t s = 0; s < compiled_.spheres.count; ++s)
+        compiled_index[compiled_.spheres.object[s]] = s;
+    leaf_sphere_.resize(bvh_.sphere_count);
+    for (std::uint32_t i = 0; i < bvh_.sphere_count; ++i)
+        leaf_sphere_[i] = compiled_index[bvh_.object[i]];
+}
+
+PreparedScene::Update PreparedScene::update(const Scene& posed) {
+    const auto start = std::chrono::steady_clock::now();
+    Update u;
+    run_with_threads(threads_, [&] { update_compiled_spheres(compiled_, posed); });
+    set_camera(posed.camera);
+    if (use_bvh_) {
+        run_with_threads(threads_,
+                         [&] { refit_sphere_bvh(bvh_, compiled_.spheres, leaf_sphere_); });
+        u.cost_growth = built_cost_ > 0.0 ? sphere_bvh_cost(bvh_) / built_cost_ : 1.0;
+        if (u.cost_growth > kRefitCostLimit) {
+            build();
+            u.rebuilt = true;
+        }
+    }
+    u.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return u;
 }
 
 RenderResult render_packet_blocks(const PreparedScene& prepared,

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "core/pixel_rect.h"
 #include "kernels/bvh_build.h"
@@ -50,6 +51,21 @@ class PreparedScene {
     explicit PreparedScene(const Scene& scene, Accel accel = Accel::automatic, int threads = 0);
     // The same scene seen through `camera` (valid for it: validate_scene's camera rules).
     void set_camera(const Camera& camera) { set_compiled_camera(compiled_, camera); }
+
+    // The scene posed again (an animation's frame: the same objects in the same order,
+    // validated, its spheres moved or resized, its camera moved): the compiled arrays are
+    // updated in place and the BVH refitted, or rebuilt when the refit tree's cost
+    // (sphere_bvh_cost) has grown past kRefitCostLimit times the built tree's. Renders are
+    // then the posed scene's, bit for bit (the closest hit does not depend on the tree).
+    struct Update {
+        bool rebuilt = false;
+        double cost_growth = 1.0;  // the refit tree's cost over the built tree's
+        double seconds = 0.0;      // the whole update
+    };
+    Update update(const Scene& posed);
+    // Measured (docs/performance-log.md, "Refit"): past this growth a frame traces slower
+    // through the refit tree than a rebuild costs.
+    static constexpr double kRefitCostLimit = 2.0;
     const CompiledScene& compiled() const { return compiled_; }
     // The spheres' BVH, or nullptr where the scene is traced brute force.
     const SphereBvh* bvh() const { return use_bvh_ ? &bvh_ : nullptr; }
@@ -58,9 +74,14 @@ class PreparedScene {
     double bvh_seconds() const { return use_bvh_ ? bvh_.build_seconds : 0.0; }
 
   private:
+    void build();  // bvh_ from compiled_, its cost and leaf_sphere_
+
     CompiledScene compiled_;
     bool use_bvh_ = false;
+    int threads_ = 0;
     SphereBvh bvh_;
+    double built_cost_ = 0.0;                 // sphere_bvh_cost when last built
+    std::vector<std::uint32_t> leaf_sphere_;  // leaf slot -> compiled sphere (refits)
 };
 
 // Renders a frame of a prepared scene (its camera as set_camera left it): no compile and no

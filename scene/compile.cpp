@@ -1,6 +1,7 @@
 #include "scene/compile.h"
 
 #include <math.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <chrono>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace octray {
@@ -50,6 +52,38 @@ float pow_zero_below(float n) {
 void set_compiled_camera(CompiledScene& scene, const Camera& camera) {
     scene.camera = make_camera_frame(camera, scene.width, scene.height);
     scene.background_up = normalize(camera.up);
+}
+
+namespace {
+
+// Where a sphere is and how large: compiled sphere si, file object k. compile_scene and
+// update_compiled_spheres both write them here, so an updated scene holds the bits a
+// fresh compile would.
+void write_sphere(CompiledScene& out, std::uint32_t si, std::uint32_t k, const Object& obj) {
+    CompiledSpheres& s = out.spheres;
+    s.cx[si] = obj.center.x, s.cy[si] = obj.center.y, s.cz[si] = obj.center.z;
+    s.r2[si] = obj.radius * obj.radius;
+    s.radius[si] = obj.radius;
+    CompiledObjects& o = out.objects;
+    o.cx[k] = obj.center.x, o.cy[k] = obj.center.y, o.cz[k] = obj.center.z;
+}
+
+}  // namespace
+
+void update_compiled_spheres(CompiledScene& out, const Scene& scene) {
+    if (scene.objects.size() != out.objects.count)
+        throw std::invalid_argument(
+            "update_compiled_spheres: the scene has " + std::to_string(scene.objects.size()) +
+            " objects, the compiled one " + std::to_string(out.objects.count));
+    out.epsilon = self_intersection_epsilon(scene);
+    const CompiledSpheres& s = out.spheres;
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, s.count, 1u << 14),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) {
+                          for (std::uint32_t si = r.begin(); si < r.end(); ++si) {
+                              const std::uint32_t k = s.object[si];
+                              write_sphere(out, si, k, scene.objects[k]);
+                          }
+                      });
 }
 
 CompiledScene compile_scene(const Scene& scene) {
@@ -131,13 +165,10 @@ CompiledScene compile_scene(const Scene& scene) {
                 o.t1x[k] = tb.t1.x, o.t1y[k] = tb.t1.y, o.t1z[k] = tb.t1.z;
                 o.t2x[k] = tb.t2.x, o.t2y[k] = tb.t2.y, o.t2z[k] = tb.t2.z;
             } else {
-                s.cx[si] = obj.center.x, s.cy[si] = obj.center.y, s.cz[si] = obj.center.z;
-                s.r2[si] = obj.radius * obj.radius;
-                s.radius[si] = obj.radius;
                 s.material[si] = obj.material;
                 s.object[si] = k;
+                write_sphere(out, si, k, obj);
                 ++si;
-                o.cx[k] = obj.center.x, o.cy[k] = obj.center.y, o.cz[k] = obj.center.z;
             }
         }
     });

@@ -104,6 +104,13 @@ struct CompiledScene {
 // the kernels cannot represent (more than 2^24 objects: hit ids travel as exact floats).
 CompiledScene compile_scene(const Scene& scene);
 
+// Updates `out` in place for a pose of the scene it was compiled from whose spheres moved
+// or changed size (an animation's frame: the same objects in the same order, validated):
+// the spheres' centers and radii and the self-intersection epsilon (which follows the
+// spheres' box), as compile_scene would write them; nothing else of a compiled scene
+// depends on them. Throws std::invalid_argument when the object counts differ.
+void update_compiled_spheres(CompiledScene& out, const Scene& scene);
+
 // Sets what compile_scene takes from the camera (its frame for the image's size, and the
 // gradient background's axis) from `camera`: nothing else of a compiled scene depends on
 // it, so another view of the same scene needs no new compile (octray view). The camera

@@ -278,16 +278,20 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         // the summary report each, and the rate is rays over trace time alone.
         const auto trace_started = Clock::now();
 
-        // Prepare once: the simd path renders a prepared scene (compiled, its BVH built).
-        // A scene whose objects stay still (a still, a camera-only animation) is prepared
-        // for its first frame and only takes each next frame's camera; one whose objects
-        // move is prepared for every frame.
+        // Prepare once: the simd path renders a prepared scene (compiled, its BVH built),
+        // prepared for a scene's first frame. A next frame of a scene whose objects stay
+        // still (a still, a camera-only animation) only takes its camera; one whose
+        // spheres move updates the compiled spheres in place and refits the BVH (or
+        // rebuilds it, when the refit tree has grown too costly: PreparedScene::update).
         double prepare_seconds = 0.0;
         const bool simd = settings_.path == RenderPath::simd;
-        const bool reuse =
-            simd && objects_still(scene.scene) && prepared_ && prepared_index_ == job.scene;
-        if (reuse) {
+        const bool reuse = simd && prepared_ && prepared_index_ == job.scene;
+        if (reuse && objects_still(scene.scene)) {
             prepared_->set_camera(posed.camera);
+        } else if (reuse) {
+            const PreparedScene::Update update = prepared_->update(posed);
+            out.report.bvh_seconds = update.seconds;  // the spheres' update with the refit
+            prepare_seconds = update.seconds;
         } else if (simd) {
             prepared_.reset();  // one prepared scene at a time
             prepared_.emplace(posed, options.accel, options.threads);

@@ -292,6 +292,62 @@ TEST_F(FrameLoopTest, CancelAbandonsTheFrameInProgressAndLeavesNothingBehind) {
     EXPECT_TRUE(files().empty());
 }
 
+// Refit (frame_loop.cpp, PreparedScene::update): an animation of moving and growing
+// spheres is prepared for its first frame and updated in place for the next ones (no
+// compile); every frame is, bit for bit, the frame rendered on its own.
+TEST_F(FrameLoopTest, AnAnimationOfMovingSpheresIsRefitAndEachFrameIsTheSameBits) {
+    std::string json = R"({"image": {"width": 24, "height": 16},
+        "camera": {"eye": [0, 3, 12], "lookat": [0, 0, 0], "fov": 50},
+        "materials": {"m": {"color": [0.8, 0.5, 0.3], "ks": 0.3, "reflect": 0.3}},
+        "lights": [{"type": "point", "position": [5, 9, 6], "color": 1}],
+        "objects": [{"type": "plane", "point": [0, -2, 0], "normal": [0, 1, 0], "material": "m"})";
+    std::string tracks;
+    for (int k = 0; k < 48; ++k) {
+        const std::string x = std::to_string(k % 8 - 4), y = std::to_string(k / 8 % 3),
+                          z = std::to_string(k / 24 - 1), name = "s" + std::to_string(k);
+        json += R"(, {"type": "sphere", "name": ")" + name + R"(", "center": [)" + x + ", " +
+                y + ", " + z + R"(], "radius": 0.4, "material": "m"})";
+        tracks += std::string(k == 0 ? "" : ", ") + "\"" + name +
+                  R"(": [{"frame": 0, "radius": 0.4}, {"frame": 3, "center": [)" + x + ".5, " +
+                  y + ".25, " + z + R"(], "radius": 0.45}])";
+    }
+    json += R"(], "animation": {"frames": 4, "objects": {)" + tracks + "}}}";
+    const fs::path file = dir_ / "moving.json";
+    std::ofstream(file) << json;
+    BatchRequest request;
+    request.output = (dir_ / "m.#.exr").string();
+    scenes_ = {load_batch_scene(file.string(), request)};
+    request_ = request;
+    settings_.exr.float32 = true;
+
+    RecordingObserver observer;
+    const BatchSummary summary = run(observer);
+    ASSERT_EQ(summary.rendered, 4u);
+    ASSERT_EQ(observer.finished.size(), 4u);
+    EXPECT_GT(observer.finished[0].compile_seconds, 0.0);
+    for (int f = 1; f < 4; ++f) {
+        EXPECT_EQ(observer.finished[f].compile_seconds, 0.0) << "frame " << f;
+        EXPECT_GT(observer.finished[f].prepare_seconds, 0.0) << "frame " << f;
+    }
+    for (int f = 0; f < 4; ++f) {
+        RenderOptions options;
+        options.frame = static_cast<std::uint32_t>(f);
+        const RenderResult alone =
+            render_packet(scene_at_frame(scenes_[0].scene, f), options, settings_.isa);
+        const ChannelImage file_image =
+            read_image((dir_ / ("m." + std::to_string(f) + ".exr")).string());
+        const float* r = file_image.plane(file_image.find_channel("R"));
+        const float* g = file_image.plane(file_image.find_channel("G"));
+        const float* b = file_image.plane(file_image.find_channel("B"));
+        std::size_t differ = 0;
+        for (std::size_t k = 0; k < alone.image.pixel_count(); ++k) {
+            const Rgb c = alone.image.data()[k];
+            differ += r[k] != c.r || g[k] != c.g || b[k] != c.b;
+        }
+        EXPECT_EQ(differ, 0u) << "frame " << f;
+    }
+}
+
 // Prepare once (frame_loop.cpp): a camera-only animation on the simd path compiles the
 // scene and builds its BVH for its first frame only, and every frame is, bit for bit, the
 // frame rendered on its own (the scene posed at that frame, compiled and built afresh).
