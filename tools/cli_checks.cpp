@@ -263,11 +263,18 @@ std::string mistyped_argument_hint(const CLI::App& app) {
         if (!option && !top) continue;  // a stray value, not a name
         const std::string_view word =
             std::string_view(argument).substr(0, option ? argument.find('=') : argument.npos);
-        // A wrong case first ("-v" is "-V", not "-h"), then the closest spelling.
+        // idiff's -o writes the difference image; compare names it --diff.
+        if (word == "-o" && command->get_name() == "compare")
+            return "unknown option \"-o\": idiff's -o is --diff FILE.exr here (|A - B| as "
+                   "float OpenEXR), or --heatmap FILE.png for a picture of the error";
+        // A wrong case first ("-v" is "-V", not "-h"), then the closest spelling. A
+        // one-letter option is one edit from every other one ("-o" from "-h"), so its
+        // spelling suggests nothing.
         std::optional<std::string_view> best;
         for (std::string_view candidate : candidates)
             if (lowercase(candidate) == lowercase(word) && candidate != word) best = candidate;
-        if (!best) best = closest_word(word, candidates);
+        const bool short_option = word.size() == 2 && word[0] == '-' && word[1] != '-';
+        if (!best && !short_option) best = closest_word(word, candidates);
         if (!best) continue;
         return std::string("unknown ") + (option ? "option " : "command ") + quote_value(word) +
                " (did you mean " + quote_value(*best) + "?)";
