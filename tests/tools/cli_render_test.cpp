@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_fixture.h"
+#include "render/image/image_read.h"
 
 namespace octray::testing {
 namespace {
@@ -268,6 +269,35 @@ TEST_F(CliTest, PngOutputRefusesWhatOnlyAnExrHolds) {
         EXPECT_TRUE(contains(r.output, "PNG")) << option << "\n" << r.output;
     }
     EXPECT_TRUE(entries().empty());
+}
+
+// Issue 43: verify draws the error as compare does, --diff and --heatmap, so a failure
+// comes with its picture; with several frames each gets its own files.
+TEST_F(CliTest, VerifyWritesTheDifferenceAndTheHeatmap) {
+    const RunResult r = octray({"verify", "random:8,width=16,height=12", "--threads", "2",
+                                "--diff", "d.exr", "--heatmap", "h.png"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "wrote    d.exr (|scalar - simd|, float)")) << r.output;
+    EXPECT_TRUE(contains(r.output, "wrote    h.png (error heatmap, linear")) << r.output;
+    const ChannelImage diff = read_image(path("d.exr"));
+    EXPECT_EQ(diff.width, 16);
+    EXPECT_EQ(diff.channel_names, (std::vector<std::string>{"R", "G", "B"}));
+    for (const float v : diff.planes) EXPECT_EQ(v, 0.0f);
+    EXPECT_EQ(read_image(path("h.png")).format, "PNG 8-bit");
+
+    const std::string bounce = std::string(OCTRAY_SOURCE_DIR) + "/scene/examples/bounce.json";
+    const RunResult frames = octray({"verify", bounce, "--frames", "0,20", "--width", "16",
+                                     "--height", "12", "--diff", "out/d.exr"});
+    EXPECT_EQ(frames.status, 4) << "out/ does not exist: " << frames.output;
+    fs::create_directory(path("out"));
+    const RunResult written = octray({"verify", bounce, "--frames", "0,20", "--width", "16",
+                                      "--height", "12", "--diff", "out/d.exr"});
+    EXPECT_EQ(written.status, 0) << written.output;
+    EXPECT_TRUE(fs::exists(path("out/d.0000.exr")) && fs::exists(path("out/d.0020.exr")));
+
+    const RunResult png = octray({"verify", "whitted", "--diff", "d.png"});
+    EXPECT_EQ(png.status, 2) << png.output;
+    EXPECT_TRUE(contains(png.output, "--heatmap FILE.png")) << png.output;
 }
 
 // Issue 26: the two paths promise identical bits, so verify is exact by default (a
