@@ -154,6 +154,33 @@ TEST_F(CliTest, MissingSceneFileIsASceneError) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 43: two scene files named alike in two folders collide under {scene}: the message
+// names both and says how to keep them apart.
+TEST_F(CliTest, ScenesThatShareANameSayHowToTellThemApart) {
+    const std::string text = R"({"image": {"width": 8, "height": 6},
+        "camera": {"eye": [0, 0, 5], "lookat": [0, 0, 0]}})";
+    fs::create_directories(dir_ / "a");
+    fs::create_directories(dir_ / "b");
+    { std::ofstream(dir_ / "a/shot.json") << text; }
+    { std::ofstream(dir_ / "b/shot.json") << text; }
+    const RunResult r =
+        octray({"render", "a/shot.json", "b/shot.json", "-o", "{scene}.{frame:04d}.exr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output,
+                         "two frames would write the same file shot.0000.exr: "
+                         "a/shot.json frame 0 and b/shot.json frame 0 ({scene} is "
+                         "\"shot\" for both"))
+        << r.output;
+    EXPECT_TRUE(contains(r.output,
+                         "render them in separate runs, each with an -o of its own "
+                         "(-o a/{scene}.{frame:04d}.exr)"))
+        << r.output;
+    EXPECT_FALSE(contains(r.output, "put {scene} in the pattern")) << r.output;
+    // Without {scene}, that is what is missing.
+    const RunResult plain = octray({"render", "a/shot.json", "whitted", "-o", "x.exr"});
+    EXPECT_TRUE(contains(plain.output, "(put {scene} in the pattern)")) << plain.output;
+}
+
 // A device has no end: `octray render /dev/zero` read forever, growing without bound.
 // Anything but a regular file is a scene error before the first byte is read.
 TEST_F(CliTest, DeviceAsSceneFileIsRefusedBeforeReading) {
