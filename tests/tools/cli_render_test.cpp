@@ -154,6 +154,22 @@ TEST_F(CliTest, MissingSceneFileIsASceneError) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 43: a mistyped built-in is named with the one probably meant, on every command.
+TEST_F(CliTest, AMistypedBuiltInGetsASuggestion) {
+    for (const std::string command : {"render", "verify", "scene", "info"}) {
+        const RunResult r = octray({command, "sphereflak:3,width=8"});
+        EXPECT_EQ(r.status, 3) << r.output;
+        EXPECT_TRUE(contains(r.output,
+                             "sphereflak:3,width=8: cannot open scene file: No such "
+                             "file or directory; nor is it a built-in (did you mean "
+                             "\"sphereflake:3,width=8\"?)"))
+            << command << ": " << r.output;
+    }
+    // A file name like no built-in gets no suggestion.
+    const RunResult far = octray({"render", "shot.json"});
+    EXPECT_FALSE(contains(far.output, "did you mean")) << far.output;
+}
+
 // Issue 43: two scene files named alike in two folders collide under {scene}: the message
 // names both and says how to keep them apart.
 TEST_F(CliTest, ScenesThatShareANameSayHowToTellThemApart) {
