@@ -341,7 +341,7 @@ TEST_F(CliTest, SmallFovWarnsThatFovIsInDegrees) {
     const std::string bad = scene("bad.json", R"("fov": 0.5, "fov_units": "radians")");
     const RunResult refused = octray({"render", bad, "-o", "b.exr"});
     EXPECT_EQ(refused.status, 3) << refused.output;
-    EXPECT_TRUE(contains(refused.output, bad + ": camera.fov_units: expected one of "
+    EXPECT_TRUE(contains(refused.output, bad + ":1:104: camera.fov_units: expected one of "
                                                "\"degrees\", found the string \"radians\""))
         << refused.output;
     EXPECT_FALSE(fs::exists(path("b.exr")));
