@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <sstream>
 #include <system_error>
 #include <vector>
 
@@ -234,6 +235,52 @@ ImageFormat require_image_format(std::string_view option, const std::string& pat
                                         : "only OpenEXR (.exr) here");
     if (!advice.empty()) message += "; " + std::string(advice);
     throw UsageError(message);
+}
+
+namespace {
+
+// The name a word list's validator carries; CLI11 keeps it with the option, where
+// completion_words() reads it back.
+constexpr std::string_view kWordsName = "completes:";
+
+std::string words_name(const std::vector<std::string>& words) {
+    std::string name(kWordsName);
+    for (const std::string& word : words) name += " " + word;
+    return name;
+}
+
+}  // namespace
+
+CLI::Validator one_of(const std::vector<std::string>& words) {
+    return CLI::IsMember(words).description("").name(words_name(words));
+}
+
+CLI::Validator completes(const std::vector<std::string>& words) {
+    return CLI::Validator([](const std::string&) { return std::string(); }, "",
+                          words_name(words));
+}
+
+std::vector<std::string> completion_words(const CLI::Option& option) {
+    // CLI11 2.1 lists an option's validators only through a non-const accessor.
+    auto& mutable_option = const_cast<CLI::Option&>(option);
+    for (int i = 0;; ++i) {
+        const CLI::Validator* validator = nullptr;
+        try {
+            validator = mutable_option.get_validator(i);
+        } catch (const CLI::OptionNotFound&) {
+            return {};
+        }
+        const std::string& name = validator->get_name();
+        if (name.rfind(kWordsName, 0) != 0) continue;
+        std::vector<std::string> words;
+        std::istringstream list(name.substr(kWordsName.size()));
+        for (std::string word; list >> word;) words.push_back(word);
+        return words;
+    }
+}
+
+std::vector<std::string> builtin_scene_words() {
+    return {"whitted", "random:", "sphereflake:"};
 }
 
 std::string mistyped_argument_hint(const CLI::App& app) {

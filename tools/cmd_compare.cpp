@@ -213,7 +213,7 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
                     "How --heatmap maps errors to colours: linear (0 to the top) or log\n"
                     "(the 6 decades below the top, so small errors stay visible)")
         ->type_name("linear|log")
-        ->check(CLI::IsMember({"linear", "log"}).description(""))
+        ->check(one_of({"linear", "log"}))
         ->capture_default_str();
     cmd->add_option("--scale", args->scale,
                     "Multiply the error by F before --heatmap maps it (as idiff's -scale):\n"

@@ -187,8 +187,6 @@ void run_verify(const VerifyArguments& args) {
     if (failed > 0) throw CommandExit{1};
 }
 
-CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
-
 }  // namespace
 
 void add_verify_command(CLI::App& app, CommandRunner& run) {
@@ -197,6 +195,7 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         "verify", "Render a scene with the scalar and the SIMD path and compare the images");
     cmd->add_option("scene", args->scene, "Scene: a JSON file or a built-in (as for render)")
         ->type_name("SCENE")
+        ->check(completes(builtin_scene_words()))
         ->capture_default_str();
     cmd->add_option(
            "--width", args->width,
@@ -226,7 +225,7 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option("--isa", args->isa,
                     "ISA of the simd path: auto, avx512, avx2, sse4.1, sse2")
         ->type_name("ISA")
-        ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
+        ->check(one_of({"auto", "avx512", "avx2", "sse4.1", "sse2"}))
         ->capture_default_str();
     cmd->add_option("--fail", args->fail,
                     "A pixel fails when any channel differs by more than X (" +
