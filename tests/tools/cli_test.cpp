@@ -162,7 +162,9 @@ TEST_F(CliTest, CompletionScriptsCompleteValues) {
     const RunResult zsh = octray({"completion", "zsh"});
     ASSERT_EQ(zsh.status, 0) << zsh.output;
     EXPECT_TRUE(contains(zsh.output, "]:value:(scalar simd)' \\\n")) << zsh.output;
-    EXPECT_TRUE(contains(zsh.output, "compadd -- whitted random\\: sphereflake\\:"))
+    EXPECT_TRUE(contains(zsh.output,
+                         "compadd -- whitted\n    compadd -S '' -- random\\: "
+                         "sphereflake\\:\n"))
         << zsh.output;
 }
 
