@@ -419,17 +419,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) try {
 
         RenderResult out;
         octray::RenderResult r;
-        const octray::Isa isa = options.path == Path::scalar
-                                    ? octray::Isa::automatic
-                                    : resolve_isa(to_internal(options.isa));
-        const auto run = [&] {
-            return options.path == Path::scalar ? render_reference(posed, o)
-                                                : render_packet(posed, o, isa);
+        // With a progress callback, on a thread of its own (render_reporting).
+        const auto rendered = [&](const auto& run) {
+            return options.progress ? render_reporting(run, o, posed, options) : run();
         };
-        r = options.progress ? render_reporting(run, o, posed, options) : run();
-        out.path = options.path == Path::scalar
-                       ? std::string("scalar")
-                       : std::string("simd (") + octray::isa_name(isa) + ")";
+        if (options.path == Path::scalar) {
+            r = rendered([&] { return render_reference(posed, o); });
+            out.path = "scalar";
+        } else {
+            const octray::Isa isa = resolve_isa(to_internal(options.isa));
+            r = rendered([&] { return render_packet(posed, o, isa); });
+            out.path = std::string("simd (") + octray::isa_name(isa) + ")";
+        }
         out.image = from_internal(r.image);
         out.rays = {r.rays.primary, r.rays.shadow, r.rays.reflected, r.rays.refracted};
         out.seconds = r.seconds;

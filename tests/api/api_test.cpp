@@ -171,6 +171,13 @@ TEST(Api, ProgressCallbackReportsAndCancels) {
     }
     // The same image as a render without the callback.
     EXPECT_EQ(r.image.rgb, api::render(scene, {.threads = 2}).image.rgb);
+    // The scalar path reports as well.
+    calls.clear();
+    options.path = api::Path::scalar;
+    EXPECT_EQ(api::render(scene, options).image.rgb, r.image.rgb);
+    ASSERT_GE(calls.size(), 2u);
+    EXPECT_EQ(calls.back().pixels_done, 48u * 32);
+    options.path = api::Path::simd;
 
     // Cancelled: an Error of kind cancelled, no image.
     int asked = 0;
