@@ -12,8 +12,10 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "scene/json_positions.h"
 #include "scene/load.h"
 #include "tests/scene/load_test_support.h"
 
@@ -557,3 +559,36 @@ TEST(SceneLoadError, EveryErrorInAFilePointsAtItsLineAndColumn) {
 
 }  // namespace
 }  // namespace octray
+
+namespace octray::scene_json {
+namespace {
+
+// The path lookup behind those positions: keys as child_path writes them (escapes decoded,
+// odd keys quoted), the last of duplicate keys, a missing key's parent, nothing outside.
+TEST(JsonPathPosition, FindsWhatThePathNames) {
+    const std::string text =
+        "{\"a\": {\"b\": [10, {\"c\": 1}]},\n"          // 1
+        " \"x\\u0079\": 2, \"odd key\": {\"k\": 3},\n"  // 2
+        " \"d\": 4, \"d\": 5}";                         // 3
+    const auto at = [&](std::string_view path) {
+        const std::optional<SourcePosition> p = json_path_position(text, path);
+        return p ? std::to_string(p->line) + ":" + std::to_string(p->column) : "none";
+    };
+    EXPECT_EQ(at(""), "1:1");
+    EXPECT_EQ(at("a"), "1:2");
+    EXPECT_EQ(at("a.b[0]"), "1:14");
+    EXPECT_EQ(at("a.b[1].c"), "1:19");
+    EXPECT_EQ(at("xy"), "2:2");
+    EXPECT_EQ(at("[\"odd key\"].k"), "2:28");
+    EXPECT_EQ(at("d"), "3:10") << "the last of duplicate keys";
+    EXPECT_EQ(at("a.b[1].missing"), "1:18") << "a missing key: its object";
+    EXPECT_EQ(at("a.b[7]"), "1:8") << "past the array's end: the array's key";
+    EXPECT_EQ(at("b"), "1:1") << "no such member: the root";
+    EXPECT_EQ(json_path_position("", "a"), std::nullopt);
+    // A byte order mark is not counted; a broken text stops the scan, keeping what it found.
+    EXPECT_EQ(json_path_position("\xEF\xBB\xBF{\"a\": 1}", "a").value().column, 5u);
+    EXPECT_EQ(json_path_position("{\"a\": [1, 2", "a[1]").value().column, 11u);
+}
+
+}  // namespace
+}  // namespace octray::scene_json
