@@ -487,7 +487,8 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         exit_code_help() +
         "  3  also: a frame failed with a scene error (not worth retrying)\n"
         "  4  also: frames failed only with I/O errors (worth retrying: --skip-existing)\n"
-        "130  interrupted by Ctrl-C (SIGINT); 143 by SIGTERM; finished frames stay\n");
+        "130  interrupted by Ctrl-C (SIGINT); 143 by SIGTERM; finished frames stay\n"
+        "     (resume: the same command with --skip-existing)\n");
     cmd->callback([args, &run] { run.action = [args] { run_render(*args); }; });
 }
 
