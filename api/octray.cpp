@@ -4,10 +4,16 @@
 
 #include "octray/octray.h"
 
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <exception>
+#include <mutex>
 #include <new>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include "core/version.h"
@@ -147,6 +153,80 @@ CompareResult compare_channels(const ChannelImage& a, const ChannelImage& b,
     out.nonfinite_pixels = r.overall.nonfinite_pixels;
     out.reason = r.reason;
     return out;
+}
+
+// An exception the progress callback threw, carried past translate_errors (it is no
+// std::exception) to reach the caller as it was thrown.
+struct CallbackFailure {
+    std::exception_ptr error;
+};
+
+// Runs `run` (a render with options `o`) on a thread of its own while this thread calls
+// options.progress with the pixels done, and stops it when the callback says so.
+template <typename Run>
+octray::RenderResult render_reporting(const Run& run, octray::RenderOptions& o,
+                                      const octray::Scene& scene,
+                                      const RenderOptions& options) {
+    Progress progress;
+    progress.pixels_total = static_cast<std::uint64_t>(scene.image.width) *
+                            static_cast<std::uint64_t>(scene.image.height);
+    const auto ask = [&] {
+        try {
+            return options.progress(progress);
+        } catch (...) {
+            throw CallbackFailure{std::current_exception()};
+        }
+    };
+    if (!ask()) throw Error(ErrorKind::cancelled, "render cancelled by the progress callback");
+    std::atomic<bool> cancel{false};
+    std::atomic<std::uint64_t> pixels{0};
+    o.cancel = &cancel;
+    o.pixels_done = &pixels;
+
+    std::mutex mutex;
+    std::condition_variable finished_cv;
+    bool finished = false;
+    octray::RenderResult result;
+    std::exception_ptr failure;
+    std::thread worker([&] {
+        try {
+            result = run();
+        } catch (...) {
+            failure = std::current_exception();
+        }
+        std::lock_guard lock(mutex);
+        finished = true;
+        finished_cv.notify_one();
+    });
+    std::exception_ptr callback_failure;
+    const auto interval = std::chrono::milliseconds(std::max(options.progress_interval_ms, 1));
+    {
+        std::unique_lock lock(mutex);
+        while (!finished_cv.wait_for(lock, interval, [&] { return finished; })) {
+            if (cancel.load() || callback_failure) continue;  // waiting for the stop
+            progress.pixels_done = std::min(pixels.load(), progress.pixels_total);
+            lock.unlock();
+            try {
+                if (!options.progress(progress)) cancel = true;
+            } catch (...) {
+                callback_failure = std::current_exception();
+                cancel = true;
+            }
+            lock.lock();
+        }
+    }
+    worker.join();
+    if (callback_failure) throw CallbackFailure{callback_failure};
+    if (failure) {
+        try {
+            std::rethrow_exception(failure);
+        } catch (const RenderCancelled&) {
+            throw Error(ErrorKind::cancelled, "render cancelled by the progress callback");
+        }
+    }
+    progress.pixels_done = progress.pixels_total;
+    static_cast<void>(ask());  // done: its answer changes nothing
+    return result;
 }
 
 }  // namespace
@@ -318,7 +398,7 @@ std::vector<Isa> supported_isas() {
     return out;
 }
 
-RenderResult render(const Scene& scene, const RenderOptions& options) {
+RenderResult render(const Scene& scene, const RenderOptions& options) try {
     return translate_errors([&] {
         if (options.frame < 0) throw std::invalid_argument("render: frame must be >= 0");
         octray::Scene s = SceneAccess::get(scene);
@@ -339,12 +419,16 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
 
         RenderResult out;
         octray::RenderResult r;
+        // With a progress callback, on a thread of its own (render_reporting).
+        const auto rendered = [&](const auto& run) {
+            return options.progress ? render_reporting(run, o, posed, options) : run();
+        };
         if (options.path == Path::scalar) {
-            r = render_reference(posed, o);
+            r = rendered([&] { return render_reference(posed, o); });
             out.path = "scalar";
         } else {
             const octray::Isa isa = resolve_isa(to_internal(options.isa));
-            r = render_packet(posed, o, isa);
+            r = rendered([&] { return render_packet(posed, o, isa); });
             out.path = std::string("simd (") + octray::isa_name(isa) + ")";
         }
         out.image = from_internal(r.image);
@@ -352,6 +436,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         out.seconds = r.seconds;
         return out;
     });
+} catch (const CallbackFailure& failure) {
+    std::rethrow_exception(failure.error);
 }
 
 // ---- Images ------------------------------------------------------------------------------

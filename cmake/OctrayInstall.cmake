@@ -1,5 +1,6 @@
-# `cmake --install`: the octray binary with its man pages and completions, the public API (include/octray/, liboctray.a) and
-# an exported CMake package, so that another project can
+# `cmake --install`: the octray binary with its man pages and completions, the public API (include/octray/, liboctray.a),
+# a pkg-config file (octray.pc, for builds without CMake) and an exported CMake package, so
+# that another project can
 #   find_package(octray CONFIG REQUIRED)
 #   target_link_libraries(app PRIVATE octray::octray)
 # (examples/embed/, docs/embedding.md). The internal libraries are static and linked
@@ -44,3 +45,10 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/octrayConfigVersion.cmake
 install(FILES ${PROJECT_BINARY_DIR}/octrayConfig.cmake
               ${PROJECT_BINARY_DIR}/octrayConfigVersion.cmake
         DESTINATION ${OCTRAY_INSTALL_CMAKEDIR})
+
+# octray.pc beside the CMake package: pkg-config --cflags --libs octray. It names the
+# installed static libraries in link order and the system packages they need.
+file(RELATIVE_PATH OCTRAY_PC_TO_PREFIX "/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/")
+string(REGEX REPLACE "/$" "" OCTRAY_PC_TO_PREFIX "${OCTRAY_PC_TO_PREFIX}")
+configure_file(${PROJECT_SOURCE_DIR}/cmake/octray.pc.in ${PROJECT_BINARY_DIR}/octray.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/octray.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)

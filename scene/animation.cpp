@@ -89,16 +89,7 @@ int clamp_frame(const Animation& a, int frame) {
 }
 
 // The message of a SceneError without its "file: path: " prefix.
-std::string bare_message(const SceneError& e) {
-    std::string what = e.what();
-    if (!e.file().empty() && what.rfind(e.file() + ": ", 0) == 0) {
-        what.erase(0, e.file().size() + 2);
-    }
-    if (!e.json_path().empty() && what.rfind(e.json_path() + ": ", 0) == 0) {
-        what.erase(0, e.json_path().size() + 2);
-    }
-    return what;
-}
+std::string bare_message(const SceneError& e) { return e.message(); }
 
 }  // namespace
 

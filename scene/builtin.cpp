@@ -24,6 +24,7 @@
 #include "scene/load.h"
 #include "scene/max_depth.h"
 #include "scene/scene_error.h"
+#include "scene/suggest.h"
 
 namespace octray {
 namespace {
@@ -409,6 +410,14 @@ void SplitMix64::discard(std::uint64_t n) { state_ += n * 0x9E3779B97F4A7C15ull;
 bool is_builtin_scene(const std::string& spec) {
     const std::string_view name = builtin_name(spec);
     return name == "whitted" || name == "random" || name == "sphereflake";
+}
+
+std::optional<std::string> builtin_suggestion(const std::string& spec) {
+    const std::string_view name = builtin_name(spec);
+    static constexpr std::array<std::string_view, 3> names{"whitted", "random", "sphereflake"};
+    const std::optional<std::string_view> best = closest_word(name, names);
+    if (!best) return std::nullopt;
+    return std::string(*best) + spec.substr(name.size());
 }
 
 Scene make_builtin_scene(const std::string& spec) {

@@ -12,6 +12,11 @@ namespace octray {
 // sphereflake.
 bool is_builtin_scene(const std::string& spec);
 
+// The built-in spec that `spec` is probably a typo of ("sphereflak:3" -> "sphereflake:3"):
+// its name one or two edits from a built-in's, the rest as given; nullopt when none is
+// close.
+std::optional<std::string> builtin_suggestion(const std::string& spec);
+
 // Builds "whitted", "random:N", "sphereflake:L", each optionally followed by
 // ",key=value" overrides (width, height, spp, seed, max_depth). Throws SceneError.
 Scene make_builtin_scene(const std::string& spec);

@@ -3,6 +3,7 @@
 
 #include "scene/json_dom.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "scene/json_positions.h"
 #include "scene/scene_error.h"
 
 namespace octray::scene_json {
@@ -25,6 +27,7 @@ constexpr std::size_t kMaxNesting = 64;
 struct ParseFailure {
     std::string path;
     std::string message;
+    SourcePosition at = {};  // line 0: where `path` is written (json_path_position)
 };
 
 class DomBuilder final : public nlohmann::json_sax<Json> {
@@ -40,7 +43,7 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
     }
     bool string(string_t& value) override { return add(Json(std::move(value))); }
     bool binary(binary_t& /*value*/) override {
-        failure_ = ParseFailure{current_path(), "binary values are not JSON"};
+        failure_ = ParseFailure{current_path(), "binary values are not JSON", {}};
         return false;
     }
     bool start_object(std::size_t /*elements*/) override {
@@ -50,9 +53,10 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
         Frame& frame = frames_.back();
         frame.key = name;
         if (!frame.keys.insert(name).second) {
-            failure_ =
-                ParseFailure{current_path(), "duplicate key " + quote_text(name) +
-                                                 " (each key may appear once per object)"};
+            failure_ = ParseFailure{
+                current_path(),
+                "duplicate key " + quote_text(name) + " (each key may appear once per object)",
+                {}};
             return false;
         }
         return true;
@@ -70,14 +74,15 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
     }
     bool parse_error(std::size_t position, const std::string& last_token,
                      const Json::exception& ex) override {
-        const auto [line, column] = line_and_column(position);
-        const std::string where =
-            "line " + std::to_string(line) + ", column " + std::to_string(column);
+        // nlohmann reports the number of bytes read, the offending one included.
+        const SourcePosition at =
+            text_position(text_, position == 0 ? 0 : std::min(position - 1, text_.size()));
         if (ex.id == 406) {
             // nlohmann's "number overflow": a literal such as 1e999 that is no finite double.
-            failure_ = ParseFailure{current_path(true), "expected a finite number, found " +
-                                                            last_token + " (at " + where +
-                                                            "), which overflows to infinity"};
+            failure_ = ParseFailure{current_path(true),
+                                    "expected a finite number, found " + last_token +
+                                        ", which overflows to infinity",
+                                    at};
             return false;
         }
         // Drop nlohmann's "[json.exception...] parse error at line L, column C: " prefix;
@@ -86,7 +91,7 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
         const std::size_t col = what.find("column ");
         const std::size_t colon = col == std::string::npos ? col : what.find(": ", col);
         if (colon != std::string::npos) what = what.substr(colon + 2);
-        failure_ = ParseFailure{"", "invalid JSON at " + where + ": " + what};
+        failure_ = ParseFailure{"", "invalid JSON: " + what, at};
         return false;
     }
 
@@ -123,9 +128,10 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
 
     bool open(bool is_array) {
         if (frames_.size() >= kMaxNesting) {
-            failure_ = ParseFailure{current_path(), "nesting deeper than " +
-                                                        std::to_string(kMaxNesting) +
-                                                        " levels; no scene needs that"};
+            failure_ = ParseFailure{current_path(),
+                                    "nesting deeper than " + std::to_string(kMaxNesting) +
+                                        " levels; no scene needs that",
+                                    {}};
             return false;
         }
         // The container just added stays put: its parent gains no element until it closes.
@@ -147,19 +153,6 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
         return path;
     }
 
-    // nlohmann reports the number of bytes read, the offending one included.
-    std::pair<std::size_t, std::size_t> line_and_column(std::size_t position) const {
-        const std::size_t end = std::min(position == 0 ? 0 : position - 1, text_.size());
-        std::size_t line = 1, line_start = 0;
-        for (std::size_t i = 0; i < end; ++i) {
-            if (text_[i] == '\n') {
-                ++line;
-                line_start = i + 1;
-            }
-        }
-        return {line, end - line_start + 1};
-    }
-
     std::string_view text_;
     Json root_;
     Json* current_ = nullptr;
@@ -173,26 +166,21 @@ Json parse_json_dom(std::string_view json_text, const std::string& source) {
     // The JSON library ends its input at a NUL byte, which would let anything after one
     // pass unread; strict JSON means the whole file, and JSON text never holds a NUL.
     if (const std::size_t nul = json_text.find('\0'); nul != std::string_view::npos) {
-        std::size_t line = 1, line_start = 0;
-        for (std::size_t i = 0; i < nul; ++i) {
-            if (json_text[i] == '\n') {
-                ++line;
-                line_start = i + 1;
-            }
-        }
-        throw SceneError(source, "",
-                         "invalid JSON at line " + std::to_string(line) + ", column " +
-                             std::to_string(nul - line_start + 1) +
-                             ": a NUL byte (\\0); expected JSON text, which has none (a "
-                             "NUL inside a string is written \\u0000)");
+        throw SceneError(source, text_position(json_text, nul), "",
+                         "invalid JSON: a NUL byte (\\0); expected JSON text, which has none "
+                         "(a NUL inside a string is written \\u0000)");
     }
     DomBuilder builder(json_text);
     const bool ok = Json::sax_parse(json_text, &builder, Json::input_format_t::json,
                                     /*strict=*/true, /*ignore_comments=*/false);
     if (!ok || builder.failure()) {
         const ParseFailure failure =
-            builder.failure() ? *builder.failure() : ParseFailure{"", "invalid JSON"};
-        throw SceneError(source, failure.path, failure.message);
+            builder.failure() ? *builder.failure() : ParseFailure{"", "invalid JSON", {}};
+        // A duplicate key or a too deep nesting: where its path is written.
+        SourcePosition at = failure.at;
+        if (at.line == 0)
+            at = json_path_position(json_text, failure.path).value_or(SourcePosition{});
+        throw SceneError(source, at, failure.path, failure.message);
     }
     return std::move(builder.root());
 }

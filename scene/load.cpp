@@ -38,8 +38,16 @@ std::string read_scene_file(const std::string& path,
     // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused below anyway.
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
-        throw SceneError(path, "",
-                         "cannot open scene file: " + std::generic_category().message(errno));
+        const int error = errno;
+        std::string message =
+            "cannot open scene file: " + std::generic_category().message(error);
+        // A missing file spelled like a built-in is a typo of one ("sphereflak:3").
+        if (error == ENOENT) {
+            if (const std::optional<std::string> builtin = builtin_suggestion(path))
+                message += "; nor is it a built-in (did you mean \"" + *builtin +
+                           "\"?): the built-ins are whitted, random:N and sphereflake:L";
+        }
+        throw SceneError(path, "", message);
     }
     const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(::fdopen(fd, "rb"),
                                                                &std::fclose);

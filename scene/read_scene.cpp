@@ -21,6 +21,7 @@
 
 #include "scene/camera.h"
 #include "scene/json_dom.h"
+#include "scene/json_positions.h"
 #include "scene/json_reader.h"
 #include "scene/json_rules.h"
 #include "scene/load.h"
@@ -311,9 +312,7 @@ void read_lights(const Reader& r, const Json& j, Scene& scene) {
     }
 }
 
-}  // namespace
-
-Scene parse_scene_json_diagnosing(std::string_view json_text, const std::string& source) {
+Scene read_scene_text(std::string_view json_text, const std::string& source) {
     const Json root = parse_json_dom(json_text, source);
     const Reader r(source);
     if (!root.is_object()) {
@@ -353,6 +352,21 @@ Scene parse_scene_json_diagnosing(std::string_view json_text, const std::string&
 
     validate_scene(scene);
     return scene;
+}
+
+}  // namespace
+
+Scene parse_scene_json_diagnosing(std::string_view json_text, const std::string& source) {
+    try {
+        return read_scene_text(json_text, source);
+    } catch (const SceneError& e) {
+        // Every error in the file points at where its path is written, as a compiler's
+        // "file:line:column:" does, so an editor jumps there.
+        if (e.position().line > 0 || e.file() != source) throw;
+        const std::optional<SourcePosition> at = json_path_position(json_text, e.json_path());
+        if (!at) throw;
+        throw SceneError(e.file(), *at, e.json_path(), e.message());
+    }
 }
 
 }  // namespace octray

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <sstream>
 #include <system_error>
 #include <vector>
 
@@ -236,6 +237,52 @@ ImageFormat require_image_format(std::string_view option, const std::string& pat
     throw UsageError(message);
 }
 
+namespace {
+
+// The name a word list's validator carries; CLI11 keeps it with the option, where
+// completion_words() reads it back.
+constexpr std::string_view kWordsName = "completes:";
+
+std::string words_name(const std::vector<std::string>& words) {
+    std::string name(kWordsName);
+    for (const std::string& word : words) name += " " + word;
+    return name;
+}
+
+}  // namespace
+
+CLI::Validator one_of(const std::vector<std::string>& words) {
+    return CLI::IsMember(words).description("").name(words_name(words));
+}
+
+CLI::Validator completes(const std::vector<std::string>& words) {
+    return CLI::Validator([](const std::string&) { return std::string(); }, "",
+                          words_name(words));
+}
+
+std::vector<std::string> completion_words(const CLI::Option& option) {
+    // CLI11 2.1 lists an option's validators only through a non-const accessor.
+    auto& mutable_option = const_cast<CLI::Option&>(option);
+    for (int i = 0;; ++i) {
+        const CLI::Validator* validator = nullptr;
+        try {
+            validator = mutable_option.get_validator(i);
+        } catch (const CLI::OptionNotFound&) {
+            return {};
+        }
+        const std::string& name = validator->get_name();
+        if (name.rfind(kWordsName, 0) != 0) continue;
+        std::vector<std::string> words;
+        std::istringstream list(name.substr(kWordsName.size()));
+        for (std::string word; list >> word;) words.push_back(word);
+        return words;
+    }
+}
+
+std::vector<std::string> builtin_scene_words() {
+    return {"whitted", "random:", "sphereflake:"};
+}
+
 std::string mistyped_argument_hint(const CLI::App& app) {
     // The command the arguments were given to: the deepest one that parsed.
     const CLI::App* command = &app;
@@ -263,11 +310,18 @@ std::string mistyped_argument_hint(const CLI::App& app) {
         if (!option && !top) continue;  // a stray value, not a name
         const std::string_view word =
             std::string_view(argument).substr(0, option ? argument.find('=') : argument.npos);
-        // A wrong case first ("-v" is "-V", not "-h"), then the closest spelling.
+        // idiff's -o writes the difference image; compare names it --diff.
+        if (word == "-o" && command->get_name() == "compare")
+            return "unknown option \"-o\": idiff's -o is --diff FILE.exr here (|A - B| as "
+                   "float OpenEXR), or --heatmap FILE.png for a picture of the error";
+        // A wrong case first ("-v" is "-V", not "-h"), then the closest spelling. A
+        // one-letter option is one edit from every other one ("-o" from "-h"), so its
+        // spelling suggests nothing.
         std::optional<std::string_view> best;
         for (std::string_view candidate : candidates)
             if (lowercase(candidate) == lowercase(word) && candidate != word) best = candidate;
-        if (!best) best = closest_word(word, candidates);
+        const bool short_option = word.size() == 2 && word[0] == '-' && word[1] != '-';
+        if (!best && !short_option) best = closest_word(word, candidates);
         if (!best) continue;
         return std::string("unknown ") + (option ? "option " : "command ") + quote_value(word) +
                " (did you mean " + quote_value(*best) + "?)";

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/pixel_rect.h"
 #include "render/types.h"
@@ -23,6 +24,19 @@ struct Scene;
 }
 
 namespace octray::tools {
+
+// ---- Words an option takes, and completes ----------------------------------------------
+
+// The value must be one of `words` (the check's own list stays out of --help, whose text
+// names them); the words are also what the shell completions offer for the option.
+CLI::Validator one_of(const std::vector<std::string>& words);
+// No check, only what the completions offer: the items of a list option, the built-in
+// scenes next to file names.
+CLI::Validator completes(const std::vector<std::string>& words);
+// The words one_of or completes gave `option`, for the completion scripts; empty for none.
+std::vector<std::string> completion_words(const CLI::Option& option);
+// What a SCENE argument completes to besides file names: the built-ins' names.
+std::vector<std::string> builtin_scene_words();
 
 // ---- Numbers on the command line -------------------------------------------------------
 

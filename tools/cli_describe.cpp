@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "tools/cli_checks.h"
+
 namespace octray::tools {
 namespace {
 
@@ -20,6 +22,7 @@ CommandInfo describe_one(const CLI::App& app, const std::string& name) {
         o.takes_value = option->get_expected_max() > 0;  // flags expect none
         o.required = option->get_required();
         if (!o.takes_value) o.type_name.clear();
+        o.values = completion_words(*option);
         if (o.names.empty()) {
             o.positional = option->get_name(true);
             c.positionals.push_back(std::move(o));

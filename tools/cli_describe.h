@@ -21,6 +21,9 @@ struct OptionInfo {
     std::string default_value;       // CLI11's captured default, if any
     bool takes_value = false;        // false for a flag
     bool required = false;
+    // The words the value completes to (tools/cli_checks.h, one_of and completes): the
+    // choices of --path, the built-in scenes of a SCENE argument; empty for any value.
+    std::vector<std::string> values;
 };
 
 struct CommandInfo {

@@ -216,7 +216,8 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                            "(bench/README.md)");
     cmd->add_option("scenes", a->scenes,
                     "Scenes [default: whitted random:16 random:1024 sphereflake:4]")
-        ->type_name("SCENE...");
+        ->type_name("SCENE...")
+        ->check(completes(builtin_scene_words()));
     cmd->add_option("--rays", a->rays,
                     "Workloads: primary,shadow,secondary (ray sets), whitted (whole renders) "
                     "[default: all]")
@@ -260,16 +261,19 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option("--order", a->orders,
                     "Pixel orders of the rays: rowmajor, tiled, morton [default: tiled]")
         ->delimiter(',')
-        ->type_name("LIST");
+        ->type_name("LIST")
+        ->check(completes({"rowmajor", "tiled", "morton"}));
     cmd->add_option("--isa", a->isas,
                     "octray kernel ISAs: auto, sse2, sse4.1, avx2, avx512 [default: auto]")
         ->delimiter(',')
-        ->type_name("LIST");
+        ->type_name("LIST")
+        ->check(completes({"auto", "sse2", "sse4.1", "avx2", "avx512"}));
     cmd->add_option(
            "--path", a->paths,
            "octray paths: simd (packet kernels), scalar (the reference) [default: simd]")
         ->delimiter(',')
-        ->type_name("LIST");
+        ->type_name("LIST")
+        ->check(completes({"simd", "scalar"}));
     cmd->add_option("--accel", a->accels,
                     "octray's sphere acceleration: auto (a BVH from " +
                         std::to_string(kBvhAutoMinSpheres) +
@@ -277,7 +281,8 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                         std::to_string(bench::BenchOptions{}.brute_force_max_spheres) +
                         " spheres) [default: auto]")
         ->delimiter(',')
-        ->type_name("LIST");
+        ->type_name("LIST")
+        ->check(completes({"auto", "bvh", "none"}));
     cmd->add_option("--packet-lanes", a->packet_lanes,
                     "With the BVH: packets with fewer live lanes go on ray by ray, each " +
                         integer_range_text(0, kMaxPacketLanes) + "; 0 packets only, " +

@@ -124,6 +124,8 @@ std::string compare_exit_code_help() {
 
 // The largest finite threshold: any double.
 constexpr double kMaxThreshold = std::numeric_limits<double>::max();
+// More pixels than any image has (65536 x 65536).
+constexpr std::uint64_t kMaxAllowFailures = std::uint64_t{1} << 32;
 
 }  // namespace
 
@@ -173,6 +175,27 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
         ->type_name("H")
         ->transform(real_number(0.0, kMaxThreshold, true))
         ->capture_default_str();
+    cmd->add_option("--failrelative", o.fail_relative,
+                    "A pixel over --fail fails only when its error is also over R times the\n"
+                    "mean of |A| and |B| (idiff's relative threshold; " +
+                        real_range_text(0.0, kMaxThreshold, true) + ", 0 = off)")
+        ->type_name("R")
+        ->transform(real_number(0.0, kMaxThreshold, true))
+        ->capture_default_str();
+    cmd->add_option("--warnrelative", o.warn_relative,
+                    "A pixel over --warn warns only when its error is also over R times the\n"
+                    "mean of |A| and |B| (" +
+                        real_range_text(0.0, kMaxThreshold, true) + ", 0 = off)")
+        ->type_name("R")
+        ->transform(real_number(0.0, kMaxThreshold, true))
+        ->capture_default_str();
+    cmd->add_option("--allowfailures", o.allow_failures,
+                    "N pixels may fail by any amount, over --fail and --hardfail, on top of\n"
+                    "--failpercent (as idiff's; " +
+                        integer_range_text(0, kMaxAllowFailures) + ")")
+        ->type_name("N")
+        ->transform(decimal_integer(0, kMaxAllowFailures))
+        ->capture_default_str();
     cmd->add_option("--channels", o.channels,
                     "Compare only these channels, by name (e.g. R,G,B or diffuse.R);\n"
                     "default: all, and both images must have the same channel names")
@@ -190,7 +213,7 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
                     "How --heatmap maps errors to colours: linear (0 to the top) or log\n"
                     "(the 6 decades below the top, so small errors stay visible)")
         ->type_name("linear|log")
-        ->check(CLI::IsMember({"linear", "log"}).description(""))
+        ->check(one_of({"linear", "log"}))
         ->capture_default_str();
     cmd->add_option("--scale", args->scale,
                     "Multiply the error by F before --heatmap maps it (as idiff's -scale):\n"
@@ -208,6 +231,8 @@ void add_compare_command(CLI::App& app, CommandRunner& run) {
         "Examples:\n"
         "  octray compare ref.exr out.exr\n"
         "  octray compare ref.exr out.exr --fail 0.004 --failpercent 0.1 --warn 0.001\n"
+        "  octray compare half.exr float.exr --failrelative 0.001  # half's rounding only\n"
+        "  octray compare ref.exr out.exr --allowfailures 3  # 3 pixels may differ at all\n"
         "  octray compare ref.exr out.exr --channels R,G,B --heatmap err.png --diff err.exr\n"
         "  octray compare ref.exr out.exr --heatmap err.png --heatmapscale log --scale 100\n"
         "  octray compare ref.png out.png --json\n\n" +

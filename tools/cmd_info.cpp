@@ -82,7 +82,8 @@ void add_info_command(CLI::App& app, CommandRunner& run) {
         "scene, its object counts, compile time and sphere BVH (build time, bytes per "
         "sphere)");
     cmd->add_option("scene", *scene, "Optional scene: a JSON file or a built-in")
-        ->type_name("SCENE");
+        ->type_name("SCENE")
+        ->check(completes(builtin_scene_words()));
     cmd->footer(
         "Examples:\n"
         "  octray info                      # the CPU and the kernels --isa auto picks\n"

@@ -304,10 +304,6 @@ void run_render(const RenderArguments& args) {
     if (status != kExitSuccess) throw CommandExit{status};
 }
 
-// A validator whose range or set is already spelled out in the option's help text, so
-// CLI11 does not append it to the type name a second time.
-CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
-
 }  // namespace
 
 void add_render_command(CLI::App& app, CommandRunner& run) {
@@ -320,6 +316,7 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                     "with optional ,width=W,height=H,spp=N,seed=S,max_depth=D); several are\n"
                     "rendered one after another")
         ->type_name("SCENE...")
+        ->check(completes(builtin_scene_words()))
         ->capture_default_str();
     cmd->add_option("-o,--output", args->output,
                     "Output file or pattern: # runs or {frame:04d} become the frame\n"
@@ -369,12 +366,13 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
            "Extra channels from each pixel's first camera ray: depth (Z), normal\n"
            "(N.X N.Y N.Z), albedo (albedo.R albedo.G albedo.B), id (UINT, object index\n"
            "+ 1, 0 = background); comma-separated")
-        ->type_name("LIST");
+        ->type_name("LIST")
+        ->check(completes({"depth", "normal", "albedo", "id"}));
     cmd->add_option("--progress", args->progress,
                     "auto (bar on a terminal, else lines), bar, lines (one line per frame and\n"
                     "'Progress: NN%' lines), json (one JSON object per line), none")
         ->type_name("MODE")
-        ->check(quiet(CLI::IsMember({"auto", "bar", "lines", "json", "none"})))
+        ->check(one_of({"auto", "bar", "lines", "json", "none"}))
         ->capture_default_str();
     cmd->add_flag("--progressive", args->progressive,
                   "Render each frame in passes of 1, 2, 4, ... samples per pixel, rewriting\n"
@@ -428,21 +426,21 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                     "Render path: simd (8-ray packets) or scalar (the reference renderer);\n"
                     "both give the same image")
         ->type_name("PATH")
-        ->check(quiet(CLI::IsMember({"scalar", "simd"})))
+        ->check(one_of({"scalar", "simd"}))
         ->capture_default_str();
     cmd->add_option(
            "--isa", args->isa,
            "Instruction set of the simd path: auto (the best this CPU has), avx512,\n"
            "avx2, sse4.1 or sse2 (`octray info` lists them; the image does not depend on it)")
         ->type_name("ISA")
-        ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
+        ->check(one_of({"auto", "avx512", "avx2", "sse4.1", "sse2"}))
         ->capture_default_str();
     cmd->add_option("--accel", args->accel,
                     "Sphere acceleration: auto (simd: a BVH above a measured sphere count;\n"
                     "scalar: its own BVH), bvh, or none (every ray against every object: the\n"
                     "scalar reference at its most literal); the image does not depend on it")
         ->type_name("MODE")
-        ->check(quiet(CLI::IsMember({"auto", "bvh", "none"})))
+        ->check(one_of({"auto", "bvh", "none"}))
         ->capture_default_str();
     cmd->add_option("--png", args->png,
                     "Also write an 8-bit sRGB PNG preview (clamped to [0,1]) next to an\n"
@@ -455,8 +453,8 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
                         "EXR codec: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab\n"
                         "(pxr24 is lossy for --float; b44*, dwa* are lossy)")
             ->type_name("C")
-            ->check(quiet(CLI::IsMember(
-                {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})))
+            ->check(one_of(
+                {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"}))
             ->capture_default_str();
     cmd->add_option("--tile", args->tile,
                     "Tile size WxH (or N for NxN), sides " +
@@ -489,7 +487,8 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         exit_code_help() +
         "  3  also: a frame failed with a scene error (not worth retrying)\n"
         "  4  also: frames failed only with I/O errors (worth retrying: --skip-existing)\n"
-        "130  interrupted by Ctrl-C (SIGINT); 143 by SIGTERM; finished frames stay\n");
+        "130  interrupted by Ctrl-C (SIGINT); 143 by SIGTERM; finished frames stay\n"
+        "     (resume: the same command with --skip-existing)\n");
     cmd->callback([args, &run] { run.action = [args] { run_render(*args); }; });
 }
 

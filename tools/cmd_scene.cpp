@@ -60,6 +60,7 @@ void add_scene_command(CLI::App& app, CommandRunner& run) {
                     "Scene: a built-in (whitted, random:N, sphereflake:L, with optional\n"
                     ",width=W,height=H,spp=N,seed=S,max_depth=D) or a JSON file")
         ->type_name("SCENE")
+        ->check(completes(builtin_scene_words()))
         ->required();
     cmd->add_option("-o,--output", args->output,
                     "Output JSON file, written atomically [default: standard output]")

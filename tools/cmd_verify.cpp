@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "kernels/dispatch.h"
+#include "render/batch/output_paths.h"
 #include "render/batch/spec.h"
+#include "render/image/error_heatmap.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_read.h"
 #include "render/memory_estimate.h"
@@ -37,7 +39,22 @@ struct VerifyArguments {
     double fail_percent = 0.0;  // ... and at most this % of the pixels may
     double hard_fail = 0.0;     // no value may be off by more
     bool quiet = false;
+    std::string diff;     // --diff FILE.exr: |scalar - simd|, as compare writes it
+    std::string heatmap;  // --heatmap FILE.png: the error picture, as compare draws it
 };
+
+// The file of `frame` when several frames are verified: "diff.exr" -> "diff.0012.exr".
+std::string frame_file(const std::string& path, int frame, bool several) {
+    if (!several) return path;
+    const std::size_t slash = path.rfind('/');
+    std::size_t dot = path.rfind('.');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash) ||
+        dot == (slash == std::string::npos ? 0 : slash + 1))
+        dot = path.size();
+    char number[16];
+    std::snprintf(number, sizeof number, ".%04d", frame);
+    return path.substr(0, dot) + number + path.substr(dot);
+}
 
 ChannelImage to_channels(const Image& image) {
     ChannelImage out(image.width(), image.height(), {"R", "G", "B"});
@@ -50,8 +67,10 @@ ChannelImage to_channels(const Image& image) {
     return out;
 }
 
-// Renders one frame with both paths and reports; true when they agree.
-bool verify_frame(const VerifyArguments& args, const Scene& scene, Isa isa) {
+// Renders one frame with both paths and reports; true when they agree. `diff` and
+// `heatmap` name the pictures of this frame, or are empty.
+bool verify_frame(const VerifyArguments& args, const Scene& scene, Isa isa,
+                  const std::string& diff, const std::string& heatmap) {
     RenderOptions options;
     options.threads = args.threads;
     const RenderResult ref = render_reference(scene, options);
@@ -66,9 +85,21 @@ bool verify_frame(const VerifyArguments& args, const Scene& scene, Isa isa) {
     compare.fail_threshold = compare.warn_threshold = args.fail;
     compare.fail_percent = compare.warn_percent = args.fail_percent;
     compare.hard_fail = compare.hard_warn = args.hard_fail;
-    const CompareResult r =
-        compare_images(to_channels(ref.image), to_channels(simd.image), compare);
+    const ChannelImage scalar_channels = to_channels(ref.image);
+    const ChannelImage simd_channels = to_channels(simd.image);
+    const CompareResult r = compare_images(scalar_channels, simd_channels, compare);
     const ErrorStats& all = r.overall;
+    // The pictures compare writes, A the scalar image and B the simd one.
+    if (!diff.empty()) {
+        write_channel_exr(diff, difference_image(scalar_channels, simd_channels, r));
+        std::printf("wrote    %s (|scalar - simd|, float)\n", diff.c_str());
+    }
+    if (!heatmap.empty()) {
+        const ErrorHeatmap map =
+            write_error_heatmap(heatmap, scalar_channels, simd_channels, r);
+        std::printf("wrote    %s (error heatmap, %s: %g to %g)\n", heatmap.c_str(),
+                    map.legend.c_str(), map.scale_min, map.scale_max);
+    }
 
     std::size_t identical = 0;
     for (std::size_t k = 0; k < ref.image.pixel_count(); ++k)
@@ -107,6 +138,14 @@ void run_verify(const VerifyArguments& args) {
             throw UsageError(std::string("--frames: ") + e.what());
         }
     }
+    if (!args.diff.empty())
+        require_image_format("--diff", args.diff, /*png_accepted=*/false,
+                             "--diff is |scalar - simd| in float; for a PNG picture of the "
+                             "error use --heatmap FILE.png");
+    if (!args.diff.empty() && !args.heatmap.empty() &&
+        batch::output_identity(args.diff) == batch::output_identity(args.heatmap))
+        throw UsageError("--diff and --heatmap name the same file: " + args.diff + " and " +
+                         args.heatmap);
     Scene scene = load_scene(args.scene);
     print_scene_warnings(scene, args.quiet);
     if (args.width > 0) scene.image.width = args.width;
@@ -129,10 +168,14 @@ void run_verify(const VerifyArguments& args) {
     std::size_t failed = 0;
     for (const int frame : frames) {
         if (!args.frames.empty()) std::printf("frame    %d\n", frame);
-        failed +=
-            verify_frame(args, args.frames.empty() ? scene : scene_at_frame(scene, frame), isa)
-                ? 0
-                : 1;
+        const bool several = frames.size() > 1;
+        const std::string diff = args.diff.empty() ? "" : frame_file(args.diff, frame, several);
+        const std::string heatmap =
+            args.heatmap.empty() ? "" : frame_file(args.heatmap, frame, several);
+        failed += verify_frame(args, args.frames.empty() ? scene : scene_at_frame(scene, frame),
+                               isa, diff, heatmap)
+                      ? 0
+                      : 1;
     }
     if (frames.size() > 1) {
         if (failed == 0)
@@ -144,8 +187,6 @@ void run_verify(const VerifyArguments& args) {
     if (failed > 0) throw CommandExit{1};
 }
 
-CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
-
 }  // namespace
 
 void add_verify_command(CLI::App& app, CommandRunner& run) {
@@ -154,6 +195,7 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         "verify", "Render a scene with the scalar and the SIMD path and compare the images");
     cmd->add_option("scene", args->scene, "Scene: a JSON file or a built-in (as for render)")
         ->type_name("SCENE")
+        ->check(completes(builtin_scene_words()))
         ->capture_default_str();
     cmd->add_option(
            "--width", args->width,
@@ -183,7 +225,7 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
     cmd->add_option("--isa", args->isa,
                     "ISA of the simd path: auto, avx512, avx2, sse4.1, sse2")
         ->type_name("ISA")
-        ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
+        ->check(one_of({"auto", "avx512", "avx2", "sse4.1", "sse2"}))
         ->capture_default_str();
     cmd->add_option("--fail", args->fail,
                     "A pixel fails when any channel differs by more than X (" +
@@ -204,13 +246,23 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         ->type_name("H")
         ->transform(real_number(0.0, std::numeric_limits<double>::max(), true))
         ->capture_default_str();
+    cmd->add_option("--diff", args->diff,
+                    "Write |scalar - simd| as float OpenEXR, as compare --diff does; FILE\n"
+                    "must end in .exr (any case). With several --frames, each frame's\n"
+                    "number goes before the extension (diff.0012.exr)")
+        ->type_name("FILE.exr");
+    cmd->add_option("--heatmap", args->heatmap,
+                    "Write a PNG heatmap of the largest channel error per pixel, as compare\n"
+                    "--heatmap draws it (magma, 0 to the max error; NaN/Inf in green)")
+        ->type_name("FILE");
     cmd->add_flag("-q,--quiet", args->quiet, kQuietHelp);
     cmd->footer(
         "Examples:\n"
         "  octray verify whitted\n"
         "  octray verify random:64,width=320,height=180 --isa sse2\n"
         "  octray verify scene/examples/bounce.json --frames 0-47:8\n"
-        "  octray verify scene.json --spp 4 --fail 1e-5 --failpercent 0.1  # a tolerance\n\n"
+        "  octray verify scene.json --spp 4 --fail 1e-5 --failpercent 0.1  # a tolerance\n"
+        "  octray verify scene.json --diff diff.exr --heatmap diff.png  # the error, drawn\n\n"
         "The two paths promise identical bits: by default every value must be equal\n"
         "(--fail 0 --failpercent 0 --hardfail 0).\n\n"
         "Exit codes: 0 within the thresholds (and equal ray counts) for every frame,\n"

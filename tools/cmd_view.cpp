@@ -46,8 +46,6 @@ struct ViewArguments {
     std::string order{"tiled"};
 };
 
-CLI::Validator quiet(CLI::Validator validator) { return validator.description(""); }
-
 // SIGINT and SIGTERM are blocked in every thread (the mask is inherited by the threads
 // made after it) and taken by one thread with sigwait(), which then stops the server:
 // stopping it from a signal handler would not be async-signal-safe.
@@ -206,6 +204,7 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
                     "Scene file (JSON) or built-in spec, as for render (default whitted);\n"
                     "or two images A B (OpenEXR or PNG) to compare as octray compare does")
         ->type_name("SCENE | A B")
+        ->check(completes(builtin_scene_words()))
         ->expected(1, 2);
     cmd->add_option("--bind", args->bind,
                     "Address to listen on; the default serves this machine only (use an\n"
@@ -264,17 +263,17 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
                     "blocks re-rendered in a fixed random order and shown as they land, no\n"
                     "frame boundaries; Bishop et al. 1994); the page can switch it")
         ->type_name("ORDER")
-        ->check(quiet(CLI::IsMember({"tiled", "rows", "frameless"})))
+        ->check(one_of({"tiled", "rows", "frameless"}))
         ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer)")
         ->type_name("PATH")
-        ->check(quiet(CLI::IsMember({"scalar", "simd"})))
+        ->check(one_of({"scalar", "simd"}))
         ->capture_default_str();
     cmd->add_option("--isa", args->isa,
                     "Instruction set of the simd path: auto, avx512, avx2, sse4.1 or sse2")
         ->type_name("ISA")
-        ->check(quiet(CLI::IsMember({"auto", "avx512", "avx2", "sse4.1", "sse2"})))
+        ->check(one_of({"auto", "avx512", "avx2", "sse4.1", "sse2"}))
         ->capture_default_str();
     cmd->footer(
         "The command prints a URL such as http://127.0.0.1:8090/?token=3f9c...: open it in a\n"

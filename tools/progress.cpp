@@ -306,6 +306,7 @@ void ProgressReporter::run_finished(const BatchSummary& summary) {
                                 {"rendered", summary.rendered},
                                 {"skipped", summary.skipped},
                                 {"failed", summary.failed},
+                                {"interrupted_frames", summary.interrupted_frames},
                                 {"not_started", summary.not_started},
                                 {"interrupted", summary.interrupted},
                                 {"seconds", summary.seconds},
@@ -322,6 +323,8 @@ void ProgressReporter::run_finished(const BatchSummary& summary) {
                     summary.interrupted ? "interrupted: " : "done: ", frame_count_,
                     frame_count_ == 1 ? "" : "s", summary.rendered, summary.skipped,
                     summary.failed);
+        if (summary.interrupted_frames > 0)
+            std::printf(", %zu interrupted", summary.interrupted_frames);
         if (summary.not_started > 0) std::printf(", %zu not started", summary.not_started);
         // The phases of short runs in milliseconds' precision: "0.0s" says nothing.
         const auto phase = [](double seconds) {
@@ -334,6 +337,12 @@ void ProgressReporter::run_finished(const BatchSummary& summary) {
             " in %s: prepare %s, trace %s (%.2f Mrays/s), write %s\n",
             format_duration(summary.seconds).c_str(), phase(summary.prepare_seconds).c_str(),
             phase(summary.trace_seconds).c_str(), mrays, phase(summary.write_seconds).c_str());
+        // What to do next: the finished frames stay, so the same command with
+        // --skip-existing renders only the rest.
+        if (summary.interrupted && summary.interrupted_frames + summary.not_started > 0)
+            std::printf(
+                "resume with --skip-existing: the same command renders only the "
+                "frames not finished\n");
     }
     std::fflush(stdout);
 }

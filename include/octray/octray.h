@@ -17,6 +17,7 @@
 // Every function reports failure by throwing octray::api::Error.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,7 @@ enum class ErrorKind {
     scene,             // a scene that cannot be loaded or is invalid (the CLI's exit code 3)
     io,                // a file that cannot be read or written (exit code 4)
     invalid_argument,  // a bad option: an ISA the CPU lacks, images of different sizes, ...
+    cancelled,         // RenderOptions::progress returned false: the render was stopped
 };
 
 class Error : public std::runtime_error {
@@ -157,6 +159,15 @@ const char* isa_name(Isa isa);
 // The ISAs this CPU can run, best last (never Isa::automatic).
 std::vector<Isa> supported_isas();
 
+// How far a render is: pixels of the image finished (tile by tile) of all of them.
+struct Progress {
+    std::uint64_t pixels_done = 0;
+    std::uint64_t pixels_total = 0;
+    double fraction() const {
+        return pixels_total ? static_cast<double>(pixels_done) / pixels_total : 1.0;
+    }
+};
+
 struct RenderOptions {
     Path path = Path::simd;
     Isa isa = Isa::automatic;  // simd path only; a forced ISA the CPU lacks is an Error
@@ -168,6 +179,13 @@ struct RenderOptions {
     // Threads, tile size and ISA never change the image: only its speed.
     int tile_width = 16;
     int tile_height = 16;
+    // Called on the thread that called render(): once before the render starts, then about
+    // every progress_interval_ms while it runs, and once at the end (all pixels done; its
+    // answer then changes nothing). Returning false stops the render at its next tile (it
+    // waits for the tiles in flight, milliseconds): render() then throws
+    // Error(ErrorKind::cancelled) and returns no image. Empty: no calls.
+    std::function<bool(const Progress&)> progress = nullptr;
+    int progress_interval_ms = 100;
 };
 
 // Linear RGB floats, row 0 on top: pixel (x, y) is rgb[3 * (y * width + x) + {0, 1, 2}].

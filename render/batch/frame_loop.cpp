@@ -428,7 +428,8 @@ BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<
                 break;
             case FrameOutcome::failed:
                 if (result.failure == FailureKind::interrupted) {
-                    summary.not_started = jobs.size() - k;  // this one included: not done
+                    summary.interrupted_frames = 1;  // abandoned mid-render
+                    summary.not_started = jobs.size() - k - 1;
                     k = jobs.size();
                 } else {
                     ++summary.failed;

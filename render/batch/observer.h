@@ -39,6 +39,8 @@ struct FrameReport {
 
 struct BatchSummary {
     std::size_t rendered = 0, skipped = 0, failed = 0, not_started = 0;
+    // The frame the cancel flag stopped mid-render (0 or 1): abandoned, nothing written.
+    std::size_t interrupted_frames = 0;
     double seconds = 0.0;  // wall time of the run, and of loading its scenes before it
     double prepare_seconds = 0.0, trace_seconds = 0.0, write_seconds = 0.0;  // rendered frames
     std::uint64_t rays = 0;
@@ -73,7 +75,7 @@ class BatchObserver {
         (void)index, (void)scene, (void)frame, (void)work, (void)spp;
     }
     // Every frame of the run ends here once, whatever its outcome, except the one the cancel
-    // flag stops (the summary counts it as not started). `work`: its pixel samples.
+    // flag stops (the summary counts it as interrupted). `work`: its pixel samples.
     virtual void frame_finished(const FrameReport& report, std::uint64_t work) {
         (void)report, (void)work;
     }

@@ -37,6 +37,24 @@ std::string default_pattern(bool sequence) {
     return sequence ? "{scene}.####.exr" : "{scene}.exr";
 }
 
+// How to keep two jobs that would write one file apart: what the pattern lacks, or, when
+// it has {scene}, which scenes share a name (scene files named alike in two folders).
+std::string collision_advice(const BatchScene& a, const BatchScene& b,
+                             const std::string& pattern, bool different_frames) {
+    if (&a == &b)
+        return different_frames ? "put #### or {frame:04d} in the pattern"
+                                : "the frame is listed twice";
+    if (a.spec == b.spec) return "the scene " + a.spec + " is given twice";
+    if (pattern.find("{scene}") == std::string::npos) return "put {scene} in the pattern";
+    if (a.name == b.name)
+        return "{scene} is \"" + a.name + "\" for both: it is a scene file's name without " +
+               "its folder and extension, so " + a.spec + " and " + b.spec +
+               " cannot be told apart by it; render them in separate runs, each with an -o " +
+               "of its own (-o " + (fs::path(a.spec).parent_path() / "{scene}").string() +
+               ".{frame:04d}.exr), or rename one of the files";
+    return "{scene} is \"" + a.name + "\" and \"" + b.name +
+           "\", and the rest of the pattern makes the names equal";
+}
 }  // namespace
 
 // The scene's identity for the EXR: hashing a built-in's spec costs nothing where
@@ -152,13 +170,14 @@ std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
             const auto [it, inserted] = owner.emplace(key, j);
             if (!inserted) {
                 const BatchJob& other = jobs[it->second];
-                throw RequestError(
-                    "two frames would write the same file " + *file + ": " +
-                    scenes[other.scene].spec + " frame " + std::to_string(other.frame) +
-                    " and " + scenes[jobs[j].scene].spec + " frame " +
-                    std::to_string(jobs[j].frame) +
-                    (scenes.size() > 1 ? " (put {scene} in the pattern)"
-                                       : " (put #### or {frame:04d} in the pattern)"));
+                throw RequestError("two frames would write the same file " + *file + ": " +
+                                   scenes[other.scene].spec + " frame " +
+                                   std::to_string(other.frame) + " and " +
+                                   scenes[jobs[j].scene].spec + " frame " +
+                                   std::to_string(jobs[j].frame) + " (" +
+                                   collision_advice(scenes[other.scene], scenes[jobs[j].scene],
+                                                    pattern, other.frame != jobs[j].frame) +
+                                   ")");
             }
         }
     }

@@ -105,6 +105,18 @@ std::string where(const PixelSample& s) {
     return "(" + std::to_string(s.x) + ", " + std::to_string(s.y) + ") " + s.channel;
 }
 
+// " and 0.01 relative" when a relative threshold is given.
+std::string relative_note(double relative) {
+    return relative > 0.0 ? " and " + number(relative) + " relative" : "";
+}
+
+// " + 3 pixels" when --allowfailures is given.
+std::string allowed_failures_note(const CompareOptions& options) {
+    if (options.allow_failures == 0) return "";
+    return " + " + std::to_string(options.allow_failures) +
+           (options.allow_failures == 1 ? " pixel" : " pixels");
+}
+
 // idiff's decision: FAIL when more than fail_percent of the pixels fail or any error is
 // over hard_fail; else WARN likewise; else PASS. A NaN or Inf counts as an infinite error.
 void judge(CompareResult& result, const CompareOptions& options) {
@@ -114,15 +126,18 @@ void judge(CompareResult& result, const CompareOptions& options) {
                                   " pixels (" + percent(all.fail_percent) + ")";
     const bool infinite_error = all.nonfinite_pixels > 0;
 
-    if (static_cast<double>(all.fail_pixels) > options.fail_percent / 100.0 * pixels) {
+    const std::string allowed = percent(options.fail_percent) + allowed_failures_note(options);
+    const std::string over_fail =
+        number(options.fail_threshold) + relative_note(options.fail_relative);
+    if (static_cast<double>(all.fail_pixels) >
+        options.fail_percent / 100.0 * pixels + static_cast<double>(options.allow_failures)) {
         result.verdict = Verdict::fail;
         result.reason = "FAIL: " + std::to_string(all.fail_pixels) + of_pixels +
-                        " differ by more than " + number(options.fail_threshold) +
-                        nonfinite_note(all) + "; allowed " + percent(options.fail_percent);
+                        " differ by more than " + over_fail + nonfinite_note(all) +
+                        "; allowed " + allowed;
         return;
     }
-    if (all.max_abs_error > options.hard_fail ||
-        (infinite_error && options.hard_fail < infinity)) {
+    if (result.hard_fail_pixels > options.allow_failures) {
         result.verdict = Verdict::fail;
         result.reason = infinite_error && !(all.max_abs_error > options.hard_fail)
                             ? "FAIL: " + std::to_string(all.nonfinite_pixels) +
@@ -139,7 +154,8 @@ void judge(CompareResult& result, const CompareOptions& options) {
         result.verdict = Verdict::warn;
         result.reason = "WARN: " + std::to_string(all.warn_pixels) + warn_of_pixels +
                         " differ by more than " + number(options.warn_threshold) +
-                        nonfinite_note(all) + "; allowed " + percent(options.warn_percent);
+                        relative_note(options.warn_relative) + nonfinite_note(all) +
+                        "; allowed " + percent(options.warn_percent);
         return;
     }
     if (all.max_abs_error > options.hard_warn ||
@@ -160,12 +176,41 @@ void judge(CompareResult& result, const CompareOptions& options) {
         result.reason = "PASS: images are identical";
     else
         result.reason = "PASS: max error " + number(all.max_abs_error) + "; " +
-                        std::to_string(all.fail_pixels) + of_pixels + " over " +
-                        number(options.fail_threshold) + nonfinite_note(all) + ", within the " +
-                        percent(options.fail_percent) + " allowed";
+                        std::to_string(all.fail_pixels) + of_pixels + " over " + over_fail +
+                        nonfinite_note(all) + ", within the " + allowed + " allowed";
 }
 
 }  // namespace
+
+std::vector<std::string> format_notes(std::string_view format_a, std::string_view format_b) {
+    std::vector<std::string> notes;
+    if (format_a.empty() || format_b.empty() || format_a == format_b) return notes;
+    const std::string formats =
+        "A is " + std::string(format_a) + ", B is " + std::string(format_b);
+    const auto is_png = [](std::string_view f) { return f.starts_with("PNG"); };
+    const auto is_exr = [](std::string_view f) { return f.starts_with("OpenEXR"); };
+    const auto has = [](std::string_view f, std::string_view type) {
+        return f.find(type) != std::string_view::npos;
+    };
+    if (is_png(format_a) != is_png(format_b) && (is_exr(format_a) || is_exr(format_b))) {
+        notes.push_back(formats +
+                        ": a PNG holds display-referred sRGB-encoded values in [0, 1], an "
+                        "OpenEXR linear ones, and both are compared as stored, without "
+                        "converting, so the encoding counts as error; compare a PNG with a "
+                        "PNG (render --png) or an OpenEXR with an OpenEXR");
+    } else if (is_exr(format_a) && is_exr(format_b) &&
+               has(format_a, " half") != has(format_b, " half")) {
+        notes.push_back(formats +
+                        ": half keeps 11 significant bits, so the same image stored as half "
+                        "and as float differs by up to 2^-11 (4.9e-4) of each value; "
+                        "--failrelative 0.001 passes that rounding and nothing larger");
+    } else {
+        notes.push_back(formats +
+                        ": the channel formats differ, and the figures include "
+                        "what converting between them rounds");
+    }
+    return notes;
+}
 
 CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                              const CompareOptions& options) {
@@ -189,7 +234,7 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
     const std::size_t pixels = a.pixel_count();
     // Per pixel, over all compared channels: which thresholds it is over, and whether it
     // holds a NaN or Inf. One byte a pixel keeps "any channel" counting exact.
-    enum : std::uint8_t { over_fail = 1, over_warn = 2, nonfinite = 4 };
+    enum : std::uint8_t { over_fail = 1, over_warn = 2, nonfinite = 4, over_hard = 8 };
     std::vector<std::uint8_t> flags(pixels, 0);
 
     ErrorStats& all = result.overall;
@@ -236,7 +281,8 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                     all_first_nonfinite = i;
                     all.first_nonfinite = sample_at(i, stats.channel, va, vb);
                 }
-                flags[i] |= over_fail | over_warn | nonfinite;
+                flags[i] |= over_fail | over_warn | nonfinite |
+                            (options.hard_fail < infinity ? over_hard : 0);
                 continue;
             }
             // In double, so neither the difference nor its square loses the float's bits.
@@ -252,14 +298,20 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                 stats.max_abs_error = error;
                 worst_index = i;
             }
-            if (error > options.fail_threshold) {
+            // idiff's rule: over the absolute threshold and over the relative one times
+            // the mean magnitude (a relative threshold of 0 adds nothing, as error > 0).
+            const double mean_magnitude = 0.5 * (std::fabs(da) + std::fabs(db));
+            if (error > options.fail_threshold &&
+                error > options.fail_relative * mean_magnitude) {
                 ++stats.fail_pixels;
                 flags[i] |= over_fail;
             }
-            if (error > options.warn_threshold) {
+            if (error > options.warn_threshold &&
+                error > options.warn_relative * mean_magnitude) {
                 ++stats.warn_pixels;
                 flags[i] |= over_warn;
             }
+            if (error > options.hard_fail) flags[i] |= over_hard;
         }
         stats.worst =
             sample_at(worst_index, stats.channel, plane_a[worst_index], plane_b[worst_index]);
@@ -289,7 +341,9 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
         all.fail_pixels += (f & over_fail) != 0;
         all.warn_pixels += (f & over_warn) != 0;
         all.nonfinite_pixels += (f & nonfinite) != 0;
+        result.hard_fail_pixels += (f & over_hard) != 0;
     }
+    result.notes = format_notes(a.format, b.format);
     finish(all, all_sums, pixels);
     judge(result, options);
     return result;
@@ -368,9 +422,9 @@ std::string format_compare_report(const CompareResult& result, const CompareOpti
     out << "\n  max error " << number(all.max_abs_error) << " at " << where(all.worst)
         << ": A = " << number(all.worst.a) << ", B = " << number(all.worst.b) << "\n";
     out << "  " << all.warn_pixels << " pixels (" << percent(all.warn_percent) << ") over warn "
-        << number(options.warn_threshold) << "\n";
+        << number(options.warn_threshold) << relative_note(options.warn_relative) << "\n";
     out << "  " << all.fail_pixels << " pixels (" << percent(all.fail_percent) << ") over fail "
-        << number(options.fail_threshold) << "\n";
+        << number(options.fail_threshold) << relative_note(options.fail_relative) << "\n";
     if (all.nonfinite_pixels > 0) {
         out << "  " << all.nonfinite_pixels << " pixels hold NaN or Inf (A: " << all.nan_a
             << " NaN, " << all.inf_a << " Inf; B: " << all.nan_b << " NaN, " << all.inf_b
@@ -378,6 +432,7 @@ std::string format_compare_report(const CompareResult& result, const CompareOpti
             << ": A = " << number(all.first_nonfinite->a)
             << ", B = " << number(all.first_nonfinite->b) << "\n";
     }
+    for (const std::string& note : result.notes) out << "  note: " << note << "\n";
     out << result.reason << "\n";
     return out.str();
 }
@@ -445,9 +500,13 @@ std::string format_compare_json(const CompareResult& result, const CompareOption
           {"hardfail", threshold_json(options.hard_fail)},
           {"warn", options.warn_threshold},
           {"warnpercent", options.warn_percent},
-          {"hardwarn", threshold_json(options.hard_warn)}}},
+          {"hardwarn", threshold_json(options.hard_warn)},
+          {"failrelative", options.fail_relative},
+          {"warnrelative", options.warn_relative},
+          {"allowfailures", options.allow_failures}}},
         {"channels", channels},
         {"overall", stats_json(result.overall)},
+        {"notes", result.notes},
         {"verdict", std::string(to_string(result.verdict))},
         {"exit_code", static_cast<int>(result.verdict)},
         {"reason", result.reason},

@@ -24,6 +24,14 @@ struct CompareOptions {
     double warn_threshold = 1e-6;
     double warn_percent = 0.0;
     double hard_warn = std::numeric_limits<double>::infinity();
+    // idiff's relative thresholds: a value pair is over `fail` only when its error is also
+    // over fail_relative times the mean of |A| and |B| (idiff's symmetric relative error);
+    // 0, the default, leaves the absolute threshold alone. Likewise warn_relative.
+    double fail_relative = 0.0;
+    double warn_relative = 0.0;
+    // idiff's --allowfailures: this many pixels may fail by any amount (over `fail` and over
+    // `hard_fail`) on top of fail_percent, and the verdict is still not FAIL.
+    std::uint64_t allow_failures = 0;
     // Channels to compare, by name; both images must have them. Empty: every channel, and
     // the two images must have the same set of names.
     std::vector<std::string> channels;
@@ -87,9 +95,19 @@ struct CompareResult {
     // For each compared channel, its index in A and in B.
     std::vector<std::pair<int, int>> channel_indices;
     ErrorStats overall;
+    // Pixels over `hard_fail` (NaN and Inf included when it is finite), for allow_failures.
+    std::uint64_t hard_fail_pixels = 0;
+    // What the reader should know before trusting the figures: the two files store their
+    // channels differently (half against float), or a display-referred PNG meets a linear
+    // OpenEXR. Each a sentence; empty for images of the same format.
+    std::vector<std::string> notes;
     Verdict verdict = Verdict::pass;
     std::string reason;  // one line: the verdict and why
 };
+
+// The notes of CompareResult for images in these formats (ChannelImage::format): empty when
+// they are the same or unknown.
+std::vector<std::string> format_notes(std::string_view format_a, std::string_view format_b);
 
 // Compares B against A. Throws ImageMismatch when they cannot be compared.
 CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,

@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "octray/octray.h"
 
@@ -138,4 +141,65 @@ TEST(Api, FailuresAreErrorsOfTheRightKind) {
     EXPECT_EQ(kind_of([] { api::render(small_scene(), {.threads = -1}); }),
               api::ErrorKind::invalid_argument);
     EXPECT_STREQ(api::version(), "0.1.0");
+}
+
+// Issue 43: a long render through the API reports its progress on the caller's thread and
+// can be cancelled from the callback; a cancelled render returns no image.
+TEST(Api, ProgressCallbackReportsAndCancels) {
+    const api::Scene scene = small_scene();
+    std::vector<api::Progress> calls;
+    const std::thread::id caller = std::this_thread::get_id();
+    bool other_thread = false;
+    api::RenderOptions options{.threads = 2};
+    options.progress_interval_ms = 1;
+    options.progress = [&](const api::Progress& p) {
+        calls.push_back(p);
+        other_thread |= std::this_thread::get_id() != caller;
+        return true;
+    };
+    const api::RenderResult r = api::render(scene, options);
+    ASSERT_GE(calls.size(), 2u);
+    EXPECT_FALSE(other_thread) << "the callback ran on another thread";
+    EXPECT_EQ(calls.front().pixels_done, 0u);
+    EXPECT_EQ(calls.back().pixels_done, 48u * 32);
+    EXPECT_EQ(calls.back().fraction(), 1.0);
+    for (std::size_t i = 0; i < calls.size(); ++i) {
+        EXPECT_EQ(calls[i].pixels_total, 48u * 32);
+        if (i > 0) {
+            EXPECT_GE(calls[i].pixels_done, calls[i - 1].pixels_done);
+        }
+    }
+    // The same image as a render without the callback.
+    EXPECT_EQ(r.image.rgb, api::render(scene, {.threads = 2}).image.rgb);
+    // The scalar path reports as well.
+    calls.clear();
+    options.path = api::Path::scalar;
+    EXPECT_EQ(api::render(scene, options).image.rgb, r.image.rgb);
+    ASSERT_GE(calls.size(), 2u);
+    EXPECT_EQ(calls.back().pixels_done, 48u * 32);
+    options.path = api::Path::simd;
+
+    // Cancelled: an Error of kind cancelled, no image.
+    int asked = 0;
+    options.progress = [&](const api::Progress&) { return ++asked < 1; };
+    try {
+        (void)api::render(scene, options);
+        ADD_FAILURE() << "a cancelled render returned";
+    } catch (const api::Error& e) {
+        EXPECT_EQ(e.kind(), api::ErrorKind::cancelled) << e.what();
+    }
+    EXPECT_EQ(asked, 1);
+    // An exception from the callback stops the render and reaches the caller.
+    options.progress = [](const api::Progress& p) -> bool {
+        if (p.pixels_done > 0 || p.pixels_total == 0) return true;
+        throw std::runtime_error("from the callback");
+    };
+    try {
+        (void)api::render(scene, options);
+        ADD_FAILURE() << "the callback's exception was lost";
+    } catch (const api::Error& e) {
+        ADD_FAILURE() << "the callback's exception became an api::Error: " << e.what();
+    } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "from the callback");
+    }
 }

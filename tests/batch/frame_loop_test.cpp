@@ -277,7 +277,8 @@ TEST_F(FrameLoopTest, CancelAbandonsTheFrameInProgressAndLeavesNothingBehind) {
     EXPECT_TRUE(observer.finished.empty()) << "the abandoned frame was reported finished";
     EXPECT_EQ(observer.runs_finished, 1);
     EXPECT_TRUE(summary.interrupted);
-    EXPECT_EQ(summary.not_started, 3u) << "the abandoned frame is not done";
+    EXPECT_EQ(summary.interrupted_frames, 1u) << "the abandoned frame is interrupted";
+    EXPECT_EQ(summary.not_started, 2u) << "the abandoned frame was started";
     EXPECT_EQ(summary.rendered + summary.skipped + summary.failed, 0u);
     EXPECT_FALSE(summary.scene_failure || summary.io_failure || summary.internal_failure);
     EXPECT_TRUE(files().empty()) << "a file, a claim or a temporary was left: "
@@ -289,6 +290,7 @@ TEST_F(FrameLoopTest, CancelAbandonsTheFrameInProgressAndLeavesNothingBehind) {
     EXPECT_TRUE(idle.started.empty());
     EXPECT_TRUE(none.interrupted);
     EXPECT_EQ(none.not_started, 3u);
+    EXPECT_EQ(none.interrupted_frames, 0u);
     EXPECT_TRUE(files().empty());
 }
 

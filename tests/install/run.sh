@@ -2,7 +2,8 @@
 # CI stage (tools/test.sh, after the release stage): install a build into a temporary
 # prefix, check its man pages and shell completions, build examples/embed against the
 # installed package alone, run it, and check its EXR: readable, and equal to what the
-# installed `octray` renders from the same scene.
+# installed `octray` renders from the same scene; then build it again with the compiler
+# alone and the installed pkg-config file (octray.pc).
 #   tests/install/run.sh [BUILD_DIR]     (default build/release, already built)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -49,4 +50,14 @@ test -s "$tmp/embed.exr"
 "$tmp/prefix/bin/octray" render "$tmp/embed.json" --float --threads 2 -o "$tmp/cli.exr" \
   --progress none
 "$tmp/prefix/bin/octray" compare "$tmp/embed.exr" "$tmp/cli.exr"
+
+# The same example built without CMake, through the installed octray.pc; it renders the
+# same image.
+export PKG_CONFIG_PATH="$prefix/lib/pkgconfig${PKG_CONFIG_PATH:+:$PKG_CONFIG_PATH}"
+test "$(pkg-config --modversion octray)" = "$("$prefix/bin/octray" --version | awk '{print $2}')"
+# shellcheck disable=SC2046  # pkg-config's flags are words
+c++ -std=c++20 -Wall -Wextra -Werror -O2 examples/embed/main.cpp -o "$tmp/embed-pc" \
+  $(pkg-config --cflags --libs octray)
+"$tmp/embed-pc" "$tmp/embed-pc.exr"
+"$prefix/bin/octray" compare "$tmp/embed.exr" "$tmp/embed-pc.exr"
 echo "tests/install/run.sh: passed"

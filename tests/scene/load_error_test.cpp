@@ -12,8 +12,10 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "scene/json_positions.h"
 #include "scene/load.h"
 #include "tests/scene/load_test_support.h"
 
@@ -28,12 +30,10 @@ using namespace load_test;
 TEST(SceneLoadError, InvalidJsonGivesLineAndColumn) {
     const std::string text = "{\n  \"image\": { \"width\": 640,, \"height\": 480 }\n}";
     // The second ',' is line 2, column 27.
-    expect_text_error(text, "", {"invalid JSON at line 2, column 27", "expected"});
-    expect_text_error("", "", {"invalid JSON at line 1, column 1"});
-    expect_text_error("{\"camera\": {\"eye\": [0, 0, 5]", "",
-                      {"invalid JSON at line 1, column 29"});
-    expect_text_error("{ \"a\": tru }", "",
-                      {"invalid JSON at line 1, column", "invalid literal"});
+    expect_text_error(text, "", {":2:27: invalid JSON", "expected"});
+    expect_text_error("", "", {":1:1: invalid JSON"});
+    expect_text_error("{\"camera\": {\"eye\": [0, 0, 5]", "", {":1:29: invalid JSON"});
+    expect_text_error("{ \"a\": tru }", "", {":1:", "invalid JSON", "invalid literal"});
 }
 
 TEST(SceneLoadError, TopLevelMustBeAnObject) {
@@ -45,7 +45,7 @@ TEST(SceneLoadError, NonFiniteNumbers) {
     std::string text = kFullScene;
     text.replace(text.find("\"radius\": 1,"), 12, "\"radius\": 1e999,");
     expect_text_error(text, "objects[0].radius",
-                      {"expected a finite number", "1e999", "line 15, column 60"});
+                      {"expected a finite number", "1e999", ":15:60: "});
     text = kFullScene;
     text.replace(text.find("[-1, -1, -0.5]"), 14, "[-1, -1e400, -0.5]");
     expect_text_error(text, "lights[1].direction[1]", {"expected a finite number", "-1e400"});
@@ -379,15 +379,14 @@ TEST(SceneLoadError, ThinLensHasStatedLimits) {
 TEST(SceneLoadError, NulBytesAreErrorsWithTheirPosition) {
     const std::string valid = "{\n  \"camera\": {\"eye\": [0, 0, 5], \"lookat\": [0, 0, 0]}\n}";
     ASSERT_NO_THROW(parse_scene_json(valid, kFile));
-    expect_text_error(valid + std::string("\0{\"garbage\":", 12), "",
-                      {"NUL byte", "line 3, column 2"});
-    expect_text_error(valid + std::string(1, '\0'), "", {"NUL byte", "line 3, column 2"});
+    expect_text_error(valid + std::string("\0{\"garbage\":", 12), "", {"NUL byte", ":3:2: "});
+    expect_text_error(valid + std::string(1, '\0'), "", {"NUL byte", ":3:2: "});
     std::string middle = valid;
     middle[13] = '\0';  // the blank after "camera":
-    expect_text_error(middle, "", {"NUL byte", "line 2, column 12"});
+    expect_text_error(middle, "", {"NUL byte", ":2:12: "});
     std::string in_string = valid;
     in_string.replace(in_string.find("eye"), 1, std::string(1, '\0'));
-    expect_text_error(in_string, "", {"NUL byte", "line 2, column 15"});
+    expect_text_error(in_string, "", {"NUL byte", ":2:15: "});
 }
 
 TEST(SceneLoadError, OrthographicWidth) {
@@ -502,3 +501,94 @@ TEST(SceneLoadError, ErrorsInAFileNameTheFile) {
 
 }  // namespace
 }  // namespace octray
+
+namespace octray {
+namespace {
+
+// Issue 43: every error in a scene file, not only a syntax error, says where it is as
+// "file:line:column:", the form editors jump to: the key of the member it concerns, the
+// first byte of the element, or the object a missing key belongs in.
+TEST(SceneLoadError, EveryErrorInAFilePointsAtItsLineAndColumn) {
+    const std::string text =
+        "{\n"                                                                  // 1
+        "  \"camera\": {\"eye\": [0, 0, 5], \"lookat\": [0, 0, 0]},\n"         // 2
+        "  \"objects\": [\n"                                                   // 3
+        "    {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1},\n"  // 4
+        "    {\"type\": \"sphere\", \"center\": [1, 0, 0],\n"                  // 5
+        "      \"raduis\": 2}\n"                                               // 6
+        "  ]\n"                                                                // 7
+        "}\n";
+    const auto what_of = [](const std::string& scene) {
+        try {
+            (void)parse_scene_json(scene, "shot.json");
+        } catch (const SceneError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(
+        what_of(text).rfind("shot.json:6:7: objects[1].raduis: unknown key \"raduis\"", 0), 0u)
+        << what_of(text);
+
+    // A value the validator refuses: at its key.
+    std::string negative = text;
+    negative.replace(negative.find("\"raduis\": 2"), 11, "\"radius\": -2");
+    EXPECT_EQ(what_of(negative).rfind("shot.json:6:7: objects[1].radius: ", 0), 0u)
+        << what_of(negative);
+
+    // A value of the wrong type inside an array: at the element.
+    std::string element = text;
+    element.replace(element.find("[1, 0, 0]"), 9, "[1, \"x\", 0]");
+    element.replace(element.find("\"raduis\""), 8, "\"radius\"");
+    EXPECT_EQ(
+        what_of(element).rfind("shot.json:5:38: objects[1].center[1]: expected a number", 0),
+        0u)
+        << what_of(element);
+
+    // A missing key: at the object that lacks it.
+    std::string missing = text;
+    missing.replace(missing.find("\"raduis\": 2"), 11, "\"name\": \"b\"");
+    EXPECT_EQ(
+        what_of(missing).rfind("shot.json:5:5: objects[1].radius: missing required key", 0), 0u)
+        << what_of(missing);
+
+    // A syntax error: at the offending byte.
+    EXPECT_EQ(what_of("{\n  \"camera\": {,}\n}").rfind("shot.json:2:14: invalid JSON: ", 0), 0u)
+        << what_of("{\n  \"camera\": {,}\n}");
+}
+
+}  // namespace
+}  // namespace octray
+
+namespace octray::scene_json {
+namespace {
+
+// The path lookup behind those positions: keys as child_path writes them (escapes decoded,
+// odd keys quoted), the last of duplicate keys, a missing key's parent, nothing outside.
+TEST(JsonPathPosition, FindsWhatThePathNames) {
+    const std::string text =
+        "{\"a\": {\"b\": [10, {\"c\": 1}]},\n"          // 1
+        " \"x\\u0079\": 2, \"odd key\": {\"k\": 3},\n"  // 2
+        " \"d\": 4, \"d\": 5}";                         // 3
+    const auto at = [&](std::string_view path) {
+        const std::optional<SourcePosition> p = json_path_position(text, path);
+        return p ? std::to_string(p->line) + ":" + std::to_string(p->column) : "none";
+    };
+    EXPECT_EQ(at(""), "1:1");
+    EXPECT_EQ(at("a"), "1:2");
+    EXPECT_EQ(at("a.b[0]"), "1:14");
+    EXPECT_EQ(at("a.b[1].c"), "1:19");
+    EXPECT_EQ(at("xy"), "2:2");
+    EXPECT_EQ(at("[\"odd key\"].k"), "2:28");
+    EXPECT_EQ(at("d"), "3:10") << "the last of duplicate keys";
+    EXPECT_EQ(at("a.b[1].missing"), "1:18") << "a missing key: its object";
+    EXPECT_EQ(at("a.b[7]"), "1:8") << "past the array's end: the array's key";
+    EXPECT_EQ(at("b"), "1:1") << "no such member: the root";
+    EXPECT_EQ(json_path_position("", "a"), std::nullopt);
+    // A byte order mark is not counted; a broken text stops the scan, keeping what it found.
+    EXPECT_EQ(json_path_position("\xEF\xBB\xBF{\"a\": 1}", "a").value().column, 5u);
+    EXPECT_EQ(json_path_position("{\"a\": [1, 2", "a[1]").value().column, 11u);
+}
+
+}  // namespace
+}  // namespace octray::scene_json

@@ -60,7 +60,12 @@ inline void expect_error(const std::function<void()>& f, const std::string& file
         const std::string what = e.what();
         EXPECT_EQ(e.file(), file) << what;
         EXPECT_EQ(e.json_path(), path) << what;
-        EXPECT_EQ(what.rfind(file + ": ", 0), 0u) << what;
+        // "file: " or, for an error in a file's text, "file:line:column: ".
+        const SourcePosition at = e.position();
+        const std::string prefix = file + (at.line > 0 ? ":" + std::to_string(at.line) + ":" +
+                                                             std::to_string(at.column) + ": "
+                                                       : ": ");
+        EXPECT_EQ(what.rfind(prefix, 0), 0u) << what;
         if (!path.empty()) {
             EXPECT_NE(what.find(": " + path + ": "), std::string::npos) << what;
         }

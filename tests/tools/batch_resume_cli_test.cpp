@@ -79,6 +79,7 @@ TEST_F(BatchCliTest, InterruptStopsCleanlyWithASummary) {
     const std::string log((std::istreambuf_iterator<char>(log_file)), {});
     EXPECT_TRUE(contains(log, "interrupted")) << log;
     EXPECT_TRUE(contains(log, "not started")) << log;
+    EXPECT_TRUE(contains(log, "resume with --skip-existing")) << log;
     EXPECT_TRUE(temporaries("out").empty());
     EXPECT_TRUE(fs::file_size(dir_ / "out/i.00.exr") > 0);
     EXPECT_LT(files_in("out").size(), 6u);

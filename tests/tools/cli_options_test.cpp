@@ -67,6 +67,11 @@ ParseOutcome parse(const IntegerOption& o, const std::string& value) {
     CommandRunner run;
     const std::unique_ptr<CLI::App> app = make_octray_app(run);
     std::vector<std::string> args = {"octray", o.command, o.name, value};
+    // A placeholder for each required argument (compare's A and B).
+    for (const CLI::Option* option : app->get_subcommand(o.command)->get_options())
+        if (option->get_required() && option->get_lnames().empty() &&
+            option->get_snames().empty())
+            args.push_back("x.exr");
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     ParseOutcome out;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_fixture.h"
+#include "render/image/image_read.h"
 
 namespace octray::testing {
 namespace {
@@ -153,6 +154,49 @@ TEST_F(CliTest, MissingSceneFileIsASceneError) {
     EXPECT_TRUE(entries().empty());
 }
 
+// Issue 43: a mistyped built-in is named with the one probably meant, on every command.
+TEST_F(CliTest, AMistypedBuiltInGetsASuggestion) {
+    for (const std::string command : {"render", "verify", "scene", "info"}) {
+        const RunResult r = octray({command, "sphereflak:3,width=8"});
+        EXPECT_EQ(r.status, 3) << r.output;
+        EXPECT_TRUE(contains(r.output,
+                             "sphereflak:3,width=8: cannot open scene file: No such "
+                             "file or directory; nor is it a built-in (did you mean "
+                             "\"sphereflake:3,width=8\"?)"))
+            << command << ": " << r.output;
+    }
+    // A file name like no built-in gets no suggestion.
+    const RunResult far = octray({"render", "shot.json"});
+    EXPECT_FALSE(contains(far.output, "did you mean")) << far.output;
+}
+
+// Issue 43: two scene files named alike in two folders collide under {scene}: the message
+// names both and says how to keep them apart.
+TEST_F(CliTest, ScenesThatShareANameSayHowToTellThemApart) {
+    const std::string text = R"({"image": {"width": 8, "height": 6},
+        "camera": {"eye": [0, 0, 5], "lookat": [0, 0, 0]}})";
+    fs::create_directories(dir_ / "a");
+    fs::create_directories(dir_ / "b");
+    { std::ofstream(dir_ / "a/shot.json") << text; }
+    { std::ofstream(dir_ / "b/shot.json") << text; }
+    const RunResult r =
+        octray({"render", "a/shot.json", "b/shot.json", "-o", "{scene}.{frame:04d}.exr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output,
+                         "two frames would write the same file shot.0000.exr: "
+                         "a/shot.json frame 0 and b/shot.json frame 0 ({scene} is "
+                         "\"shot\" for both"))
+        << r.output;
+    EXPECT_TRUE(contains(r.output,
+                         "render them in separate runs, each with an -o of its own "
+                         "(-o a/{scene}.{frame:04d}.exr)"))
+        << r.output;
+    EXPECT_FALSE(contains(r.output, "put {scene} in the pattern")) << r.output;
+    // Without {scene}, that is what is missing.
+    const RunResult plain = octray({"render", "a/shot.json", "whitted", "-o", "x.exr"});
+    EXPECT_TRUE(contains(plain.output, "(put {scene} in the pattern)")) << plain.output;
+}
+
 // A device has no end: `octray render /dev/zero` read forever, growing without bound.
 // Anything but a regular file is a scene error before the first byte is read.
 TEST_F(CliTest, DeviceAsSceneFileIsRefusedBeforeReading) {
@@ -268,6 +312,35 @@ TEST_F(CliTest, PngOutputRefusesWhatOnlyAnExrHolds) {
         EXPECT_TRUE(contains(r.output, "PNG")) << option << "\n" << r.output;
     }
     EXPECT_TRUE(entries().empty());
+}
+
+// Issue 43: verify draws the error as compare does, --diff and --heatmap, so a failure
+// comes with its picture; with several frames each gets its own files.
+TEST_F(CliTest, VerifyWritesTheDifferenceAndTheHeatmap) {
+    const RunResult r = octray({"verify", "random:8,width=16,height=12", "--threads", "2",
+                                "--diff", "d.exr", "--heatmap", "h.png"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "wrote    d.exr (|scalar - simd|, float)")) << r.output;
+    EXPECT_TRUE(contains(r.output, "wrote    h.png (error heatmap, linear")) << r.output;
+    const ChannelImage diff = read_image(path("d.exr"));
+    EXPECT_EQ(diff.width, 16);
+    EXPECT_EQ(diff.channel_names, (std::vector<std::string>{"R", "G", "B"}));
+    for (const float v : diff.planes) EXPECT_EQ(v, 0.0f);
+    EXPECT_EQ(read_image(path("h.png")).format, "PNG 8-bit");
+
+    const std::string bounce = std::string(OCTRAY_SOURCE_DIR) + "/scene/examples/bounce.json";
+    const RunResult frames = octray({"verify", bounce, "--frames", "0,20", "--width", "16",
+                                     "--height", "12", "--diff", "out/d.exr"});
+    EXPECT_EQ(frames.status, 4) << "out/ does not exist: " << frames.output;
+    fs::create_directory(path("out"));
+    const RunResult written = octray({"verify", bounce, "--frames", "0,20", "--width", "16",
+                                      "--height", "12", "--diff", "out/d.exr"});
+    EXPECT_EQ(written.status, 0) << written.output;
+    EXPECT_TRUE(fs::exists(path("out/d.0000.exr")) && fs::exists(path("out/d.0020.exr")));
+
+    const RunResult png = octray({"verify", "whitted", "--diff", "d.png"});
+    EXPECT_EQ(png.status, 2) << png.output;
+    EXPECT_TRUE(contains(png.output, "--heatmap FILE.png")) << png.output;
 }
 
 // Issue 26: the two paths promise identical bits, so verify is exact by default (a

@@ -124,6 +124,50 @@ TEST_F(CliTest, CompletionScriptsCoverEveryCommandAndOption) {
     EXPECT_EQ(fish.status, 2) << fish.output;
 }
 
+// Issue 43: the completions complete values too: the words an option takes and the
+// built-in scenes next to file names.
+TEST_F(CliTest, CompletionScriptsCompleteValues) {
+    const RunResult bash = octray({"completion", "bash"});
+    ASSERT_EQ(bash.status, 0) << bash.output;
+    { std::ofstream(path("octray.bash")) << bash.output; }
+    { std::ofstream(path("shot.json")) << "{}"; }
+    const auto complete = [&](const std::string& words, int cword) {
+        const std::string script = "source octray.bash && COMP_WORDS=(" + words +
+                                   ") COMP_CWORD=" + std::to_string(cword) +
+                                   " && _octray && echo \"[${COMPREPLY[*]}]\"";
+        const std::string command = "cd " + octray::testing::shell_quote(dir_.string()) +
+                                    " && bash -c " + octray::testing::shell_quote(script);
+        FILE* pipe = ::popen(command.c_str(), "r");
+        std::string out;
+        char buffer[256];
+        while (pipe != nullptr && std::fgets(buffer, sizeof buffer, pipe) != nullptr)
+            out += buffer;
+        if (pipe != nullptr) ::pclose(pipe);
+        return out;
+    };
+    EXPECT_EQ(complete("octray render --path ''", 3), "[scalar simd]\n");
+    EXPECT_EQ(complete("octray render --progress l", 3), "[lines]\n");
+    EXPECT_EQ(complete("octray render --isa avx", 3), "[avx512 avx2]\n");
+    EXPECT_EQ(complete("octray render --compression dw", 3), "[dwaa dwab]\n");
+    EXPECT_EQ(complete("octray render --aov ''", 3), "[depth normal albedo id]\n");
+    EXPECT_EQ(complete("octray view --order f", 3), "[frameless]\n");
+    EXPECT_EQ(complete("octray bench --order m", 3), "[morton]\n");
+    EXPECT_EQ(complete("octray compare a.exr b.exr --heatmapscale l", 5), "[linear log]\n");
+    // A SCENE argument: the built-ins and the files.
+    EXPECT_EQ(complete("octray render sphere", 2), "[sphereflake:]\n");
+    EXPECT_EQ(complete("octray verify s", 2), "[sphereflake: shot.json]\n");
+    // A value that is no scene: files only.
+    EXPECT_EQ(complete("octray render -o s", 3), "[shot.json]\n");
+
+    const RunResult zsh = octray({"completion", "zsh"});
+    ASSERT_EQ(zsh.status, 0) << zsh.output;
+    EXPECT_TRUE(contains(zsh.output, "]:value:(scalar simd)' \\\n")) << zsh.output;
+    EXPECT_TRUE(contains(zsh.output,
+                         "compadd -- whitted\n    compadd -S '' -- random\\: "
+                         "sphereflake\\:\n"))
+        << zsh.output;
+}
+
 // Issue 26: every usage error names the help of the command it was given to, whether the
 // parser or the command found it.
 TEST_F(CliTest, UsageErrorsNameTheCommandsOwnHelp) {
@@ -341,7 +385,7 @@ TEST_F(CliTest, SmallFovWarnsThatFovIsInDegrees) {
     const std::string bad = scene("bad.json", R"("fov": 0.5, "fov_units": "radians")");
     const RunResult refused = octray({"render", bad, "-o", "b.exr"});
     EXPECT_EQ(refused.status, 3) << refused.output;
-    EXPECT_TRUE(contains(refused.output, bad + ": camera.fov_units: expected one of "
+    EXPECT_TRUE(contains(refused.output, bad + ":1:104: camera.fov_units: expected one of "
                                                "\"degrees\", found the string \"radians\""))
         << refused.output;
     EXPECT_FALSE(fs::exists(path("b.exr")));

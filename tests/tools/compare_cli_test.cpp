@@ -372,5 +372,86 @@ TEST_F(CompareCliTest, BadHeatmapScalesAreUsageErrors) {
         << none.output;
 }
 
+// Issue 43: the report says when the two files store their values differently: half
+// against float (the same image differs by half's rounding) and a display-referred PNG
+// against a linear OpenEXR.
+TEST_F(CompareCliTest, TheReportNotesFormatsThatDiffer) {
+    ChannelImage image = make_image(8, 8, {"R", "G", "B"});
+    for (std::size_t i = 0; i < image.planes.size(); ++i)
+        image.planes[i] = 0.1f + 0.731f * static_cast<float>(i % 64) / 64.0f;
+    write_test_exr(path("half.exr"), image, Imf::HALF);
+    write_test_exr(path("float.exr"), image, Imf::FLOAT);
+    RunResult r = compare({"half.exr", "float.exr"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("note: A is OpenEXR half, B is OpenEXR float: half keeps 11 "
+                            "significant bits"),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(last_line(r.output).rfind("FAIL: ", 0), 0u) << "the reason stays last";
+    // What the note advises passes half's rounding.
+    r = compare(
+        {"half.exr", "float.exr", "--failrelative", "0.001", "--warnrelative", "0.001"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    r = compare({"half.exr", "float.exr", "--json"});
+    const nlohmann::json j = nlohmann::json::parse(r.output);
+    ASSERT_EQ(j["notes"].size(), 1u) << r.output;
+
+    testing::write_test_png(path("preview.png"), 8, 8, 3, 8,
+                            std::vector<std::uint16_t>(8 * 8 * 3, 128));
+    r = compare({"preview.png", "float.exr"});
+    EXPECT_NE(r.output.find("note: A is PNG 8-bit, B is OpenEXR float: a PNG holds "
+                            "display-referred sRGB-encoded values"),
+              std::string::npos)
+        << r.output;
+    // Files of one format: no note.
+    r = compare({"float.exr", "float.exr"});
+    EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
+}
+
+// Issue 43: idiff's --failrelative, --warnrelative and --allowfailures.
+TEST_F(CompareCliTest, RelativeThresholdsAndAllowedFailuresAsIdiffs) {
+    write_pair(0.125f);  // G of (5, 3): 29/64 against 29/64 + 0.125, relative error 0.24
+    EXPECT_EQ(compare({"a.exr", "b.exr", "--fail", "0.5", "--warnrelative", "0.3"}).status, 0);
+    RunResult r = compare({"a.exr", "b.exr", "--fail", "0.5", "--warnrelative", "0.2"});
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_EQ(last_line(r.output),
+              "WARN: 1 of 64 pixels (1.562%) differ by more than 1e-06 and 0.2 relative; "
+              "allowed 0%");
+    EXPECT_EQ(compare({"a.exr", "b.exr", "--failrelative", "0.3", "--warn", "0.5"}).status, 0);
+    EXPECT_EQ(compare({"a.exr", "b.exr", "--failrelative", "0.2", "--warn", "0.5"}).status, 2);
+
+    // One pixel may fail by any amount, over --hardfail too; it still warns.
+    r = compare({"a.exr", "b.exr", "--allowfailures", "1", "--hardfail", "0.01"});
+    EXPECT_EQ(r.status, 1) << r.output;
+    r = compare({"a.exr", "b.exr", "--allowfailures", "1", "--warnpercent", "2"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(last_line(r.output),
+              "PASS: max error 0.125; 1 of 64 pixels (1.562%) over 1e-06, within the 0% + 1 "
+              "pixel allowed");
+    // Two failing pixels are one too many.
+    ChannelImage b = make_image(8, 8, {"R", "G", "B"});
+    for (std::size_t i = 0; i < b.planes.size(); ++i)
+        b.planes[i] = static_cast<float>(i % 64) / 64.0f;
+    b.at(0, 1, 1) += 0.5f;
+    b.at(0, 2, 2) += 0.5f;
+    write_test_exr(path("b2.exr"), b);
+    r = compare({"a.exr", "b2.exr", "--allowfailures", "1"});
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(last_line(r.output).find("allowed 0% + 1 pixel"), std::string::npos) << r.output;
+    r = compare({"a.exr", "b2.exr", "--allowfailures", "2", "--json", "--warnpercent", "100"});
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(nlohmann::json::parse(r.output)["options"]["allowfailures"], 2) << r.output;
+}
+
+// Issue 43: idiff's -o (the difference image) is named, not "corrected" to -h.
+TEST_F(CompareCliTest, IdiffsDashOIsNamedNotCorrected) {
+    write_pair(0.0f);
+    const RunResult r = compare({"a.exr", "b.exr", "-o", "diff.exr"});
+    EXPECT_EQ(r.status, 5) << r.output;
+    EXPECT_NE(r.output.find("idiff's -o is --diff FILE.exr here"), std::string::npos)
+        << r.output;
+    EXPECT_EQ(r.output.find("did you mean \"-h\""), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace octray
