@@ -75,6 +75,9 @@ void run_compare(const CompareArguments& args) {
     ChannelImage a, b;
     CompareResult result;
     try {
+        // A device or FIFO as --diff or --heatmap is refused before any reading (exit 4).
+        for (const std::string* out : {&args.diff, &args.heatmap})
+            if (!out->empty()) check_output_target(*out);
         a = read_image(args.a);
         b = read_image(args.b);
         result = compare_images(a, b, args.options);

@@ -90,6 +90,7 @@ std::vector<std::string> prepare_output_directories(const std::vector<BatchJob>&
     for (const BatchJob& job : jobs) {
         for (const std::string* file : {&job.output, &job.png}) {
             if (file->empty()) continue;
+            check_output_target(*file);  // a device or FIFO would be replaced: refused
             const fs::path path(*file);
             if (directories.insert(path.parent_path().string()).second)
                 prepare_output_directory(path, created);

@@ -1,0 +1,92 @@
+// Hostile input against the executable (issue 38): outputs that are device nodes or FIFOs,
+// signals in the middle of a long tile, thread counts the machine cannot start, stray
+// directories, the viewer's size limit.
+
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#include <cstdlib>
+
+#include "cli_fixture.h"
+
+namespace octray::testing {
+namespace {
+
+class HostileCliTest : public CliTest {
+  protected:
+    // Runs a shell command line in the test directory; returns its exit status.
+    int shell(const std::string& command) const {
+        const std::string line = "cd " + shell_quote(dir_.string()) + " || exit 99; " + command;
+        const int status = std::system(line.c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+
+    bool is_fifo(const std::string& name) const {
+        struct stat info {};
+        return ::lstat(path(name).c_str(), &info) == 0 && S_ISFIFO(info.st_mode);
+    }
+
+    // No hidden temporary of a write was left in the directory.
+    bool no_temporaries() const {
+        for (const std::string& name : entries())
+            if (name.rfind('.', 0) == 0) return false;
+        return true;
+    }
+};
+
+// Every writer renames a new file over its target, which turned a FIFO or a device node
+// (as root: /dev/full) into a regular file. Each command refuses such a target with exit 4
+// before doing the work, names it and what it is, and leaves it as it was.
+TEST_F(HostileCliTest, DeviceAndFifoOutputsAreRefusedAndLeftAlone) {
+    ASSERT_EQ(::mkfifo(path("n.png").c_str(), 0666), 0);
+    ASSERT_EQ(::mkfifo(path("n.exr").c_str(), 0666), 0);
+    ASSERT_EQ(::mkfifo(path("n.json").c_str(), 0666), 0);
+    fs::create_symlink("/dev/null", dir_ / "null.png");
+
+    RunResult r = octray({"render", "whitted,width=32,height=18", "-o", "ok.exr", "--png",
+                          "n.png", "--progress", "none"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "n.png")) << r.output;
+    EXPECT_TRUE(contains(r.output, "FIFO")) << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "ok.exr")) << "refused only after rendering";
+    EXPECT_TRUE(is_fifo("n.png"));
+
+    r = octray({"render", "whitted,width=32,height=18", "-o", "n.exr", "--progress", "none"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(is_fifo("n.exr"));
+
+    // A symlink to a device is the device: refused, and the link stays a link to it.
+    r = octray({"render", "whitted,width=32,height=18", "-o", "ok.exr", "--png", "null.png",
+                "--progress", "none"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "character device")) << r.output;
+    EXPECT_TRUE(fs::is_symlink(dir_ / "null.png"));
+    EXPECT_EQ(fs::read_symlink(dir_ / "null.png"), fs::path("/dev/null"));
+
+    r = octray({"scene", "whitted", "-o", "n.json"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(is_fifo("n.json"));
+
+    // compare and assemble: a.exr is a real image to read.
+    r = octray({"render", "whitted,width=32,height=18", "-o", "a.exr", "--progress", "none"});
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = octray({"compare", "a.exr", "a.exr", "--diff", "n.exr"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(is_fifo("n.exr"));
+    r = octray({"compare", "a.exr", "a.exr", "--heatmap", "n.png"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(is_fifo("n.png"));
+    r = octray({"assemble", "a.exr", "-o", "n.exr"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(is_fifo("n.exr"));
+    EXPECT_TRUE(no_temporaries());
+
+    // A symlink to a regular file is written as before.
+    fs::create_symlink("a.exr", dir_ / "link.exr");
+    r = octray(
+        {"render", "whitted,width=32,height=18", "-o", "link.exr", "--progress", "none"});
+    EXPECT_EQ(r.status, 0) << r.output;
+}
+
+}  // namespace
+}  // namespace octray::testing
