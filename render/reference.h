@@ -3,6 +3,7 @@
 // docs/rendering-model.md literally and is the oracle the SIMD path is judged by.
 // It is built on core/ and scene/ only, never on kernels/, so it stays an independent check.
 
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -24,8 +25,10 @@ struct SurfaceHit {
 
 class ReferenceTracer {
   public:
-    // The scene must have passed validate_scene().
-    explicit ReferenceTracer(const Scene& scene);
+    // The scene must have passed validate_scene(). Once *cancel is true (a render being
+    // stopped, RenderOptions::cancel), trace() returns black at once, so that a pixel of
+    // any spp and depth ends within a ray of it; the render then throws RenderCancelled.
+    explicit ReferenceTracer(const Scene& scene, const std::atomic<bool>* cancel = nullptr);
 
     // The camera ray of sample `sample` of pixel (i, j) in frame `frame`. A fisheye
     // sample outside the image circle has no ray (it is black).
@@ -63,6 +66,7 @@ class ReferenceTracer {
     Rgb background(Vec3 direction) const;
 
     const Scene& scene_;
+    const std::atomic<bool>* cancel_;
     CameraFrame camera_;
     Vec3 background_up_;  // the camera's up as given, normalised (gradient background)
     float epsilon_;

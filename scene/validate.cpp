@@ -104,9 +104,9 @@ class Validator {
         const ImageSettings& im = scene_.image;
         int_range(im.width, "image.width", 1, kMaxIntValue);
         int_range(im.height, "image.height", 1, kMaxIntValue);
-        int_range(im.spp, "image.spp", 1, kMaxIntValue);
+        int_range(im.spp, "image.spp", 1, json_rules::kMaxSpp);
         // Both factors are below 2^31, so neither product overflows 64 bits (nor does the
-        // sample count width * height * spp, which stays below 2^62).
+        // sample count width * height * spp, which stays below 2^51).
         const std::int64_t pixels = static_cast<std::int64_t>(im.width) * im.height;
         const std::string size = std::to_string(im.width) + " x " + std::to_string(im.height);
         if (pixels > kMaxPixels) {

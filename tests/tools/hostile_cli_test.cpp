@@ -88,5 +88,33 @@ TEST_F(HostileCliTest, DeviceAndFifoOutputsAreRefusedAndLeftAlone) {
     EXPECT_EQ(r.status, 0) << r.output;
 }
 
+// SIGTERM in the middle of a tile stops the frame within a chunk of packets (the simd
+// path) or a ray (the scalar one), not at the end of the tile: one 64x64 tile at 2^20 spp
+// is hours of work, so a render that finished its tile first would not end before the
+// watchdog's SIGKILL. The exit status and the summary are those of an interrupted run.
+TEST_F(HostileCliTest, TermInTheMiddleOfATileStopsTheFrameOnBothPaths) {
+    for (const char* render_path : {"simd", "scalar"}) {
+        SCOPED_TRACE(render_path);
+        const std::string log = std::string("log-") + render_path + ".txt";
+        const int status = shell(
+            shell_quote(OCTRAY_EXE) +
+            " render whitted,width=64,height=64 --tile 64 --spp 1048576 --threads 1 --path " +
+            render_path + " --progress lines -o s.exr >" + log +
+            " 2>&1 </dev/null & pid=$!; "
+            // The header is printed once the signal handlers are in place.
+            "i=0; while ! grep -q '^render ' " +
+            log +
+            " && [ $i -lt 6000 ]; do sleep 0.01; i=$((i+1)); done; sleep 0.3; "
+            "kill -TERM $pid; (sleep 120; kill -KILL $pid) >/dev/null 2>&1 </dev/null & "
+            "watchdog=$!; wait $pid; echo $? > status.txt; pkill -P $watchdog sleep; "
+            "kill $watchdog 2>/dev/null; exit 0");
+        ASSERT_EQ(status, 0);
+        EXPECT_EQ(file_bytes(dir_ / "status.txt"), "143\n") << file_bytes(dir_ / log);
+        EXPECT_TRUE(contains(file_bytes(dir_ / log), "interrupted")) << file_bytes(dir_ / log);
+        EXPECT_FALSE(fs::exists(dir_ / "s.exr"));
+        EXPECT_TRUE(no_temporaries());
+    }
+}
+
 }  // namespace
 }  // namespace octray::testing
