@@ -595,7 +595,9 @@ RenderResult render_packet(const CompiledScene& scene, const RenderOptions& opti
         target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
         target.sums = &result.sample_sums;
     }
-    const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
+    // A tile larger than the rectangle is the rectangle (and tiles_x cannot overflow).
+    const int tw = std::clamp(options.tile_width, 1, rect.width());
+    const int th = std::clamp(options.tile_height, 1, rect.height());
     const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
     TileTallies tallies;
     TileControl control(options);

@@ -123,6 +123,11 @@ class Validator {
         finite(c.lookat, "camera.lookat");
         finite(c.up, "camera.up");
         if (c.up == Vec3{}) fail("camera.up", "expected a non-zero up vector, found [0, 0, 0]");
+        // Only a scene built in code (the API) can hold another value.
+        if (static_cast<unsigned>(c.type) > static_cast<unsigned>(CameraType::fisheye))
+            fail("camera.type",
+                 "expected pinhole, orthographic, thinlens or fisheye, found the value " +
+                     std::to_string(static_cast<int>(c.type)));
         switch (c.type) {
             case CameraType::orthographic:
                 positive(c.width, "camera.width", "a film width");

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/thread_check.h"
 #include "kernels/dispatch.h"
 #include "render/batch/frame_loop.h"
 #include "render/batch/plan.h"
@@ -156,6 +157,7 @@ void run_view(const ViewArguments& args) {
     }
     std::optional<StopOnSignal> stop_on_signal;
     if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
+    check_threads_can_start(args.threads);          // before oneTBB starts a worker (ulimit -v)
     const std::string spec = args.inputs.empty() ? std::string("whitted") : args.inputs[0];
     // The digest names the scene in the header of a saved picture, as in `octray render`'s.
     // An animation is shown at frame 0; the page's slider poses the others.

@@ -116,5 +116,30 @@ TEST_F(HostileCliTest, TermInTheMiddleOfATileStopsTheFrameOnBothPaths) {
     }
 }
 
+// oneTBB aborts (exit 134, "pthread_create has failed") when it cannot start a worker;
+// under an address-space limit, --threads 64 and 4096 did. They are refused first: exit 1
+// (the machine's limits, as out of memory), naming the count and the limit.
+TEST_F(HostileCliTest, ThreadsTheAddressSpaceLimitCannotHoldAreRefused) {
+    const std::string limited = "ulimit -v 1000000 && " + shell_quote(OCTRAY_EXE);
+    // A sanitizer build reserves terabytes of shadow memory and cannot run under the limit.
+    if (shell(limited + " --version >/dev/null 2>&1") != 0)
+        GTEST_SKIP() << "octray does not start under ulimit -v 1000000 (a sanitizer build)";
+    for (const char* threads : {"64", "4096"}) {
+        SCOPED_TRACE(threads);
+        const int status = shell(limited + " render whitted,width=32,height=18 --threads " +
+                                 threads + " -o x.exr --progress none >log.txt 2>&1");
+        const std::string log = file_bytes(dir_ / "log.txt");
+        EXPECT_EQ(status, 1) << log;
+        EXPECT_TRUE(contains(log, std::string("cannot start ") + threads + " threads")) << log;
+        EXPECT_TRUE(contains(log, "ulimit -v")) << log;
+        EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+    }
+    // Two threads fit.
+    EXPECT_EQ(shell(limited + " render whitted,width=32,height=18 --threads 2 -o x.exr "
+                              "--progress none >log.txt 2>&1"),
+              0)
+        << file_bytes(dir_ / "log.txt");
+}
+
 }  // namespace
 }  // namespace octray::testing
