@@ -11,6 +11,7 @@
 #include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/view/http_error.h"
+#include "render/view/request_json.h"
 #include "render/view/view_switches.h"
 #include "scene/load.h"
 
@@ -69,7 +70,7 @@ bool same_camera(const Camera& a, const Camera& b) {
 // POST /api/save: the refined picture as `octray render` writes it (render/view/README.md).
 nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
                          const std::string& body) {
-    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    const json request = parse_request_json(body, "save");
     if (request.is_discarded() || !request.is_object() || !request.contains("name") ||
         !request["name"].is_string())
         throw BadRequest(400, "save: expected {\"name\": \"view.exr\", \"overwrite\": false}");

@@ -2,24 +2,29 @@
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
 #include <utility>
 
+#include "core/decimal.h"
 #include "render/image/image_io.h"
 #include "render/view/http_error.h"
 #include "render/view/page.h"
+#include "render/view/request_json.h"
 #include "render/view/token.h"
 #include "render/view/tone_map.h"
 #include "render/view/view_save.h"
@@ -80,7 +85,7 @@ Vec3 vec3_from(const json& value, const std::string& what) {
 // The body of POST /api/camera: {"eye": [x, y, z], "lookat": [...], "up": [...],
 // "fov": degrees, "moving": bool}, every key optional (the current camera's value).
 std::pair<Camera, bool> parse_camera_request(const std::string& body, Camera camera) {
-    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    const json request = parse_request_json(body, "camera");
     if (request.is_discarded() || !request.is_object())
         throw BadRequest(400, "camera: expected a JSON object such as {\"eye\": [0, 1, 5]}");
     bool moving = false;
@@ -125,14 +130,14 @@ int integer_param(const httplib::Request& req, const std::string& name, int lo, 
     if (!req.has_param(name))
         throw BadRequest(400, name + ": missing (expected an integer in [" +
                                   std::to_string(lo) + ", " + std::to_string(hi) + "])");
+    // Decimal digits only, as the command line and scene files: no sign, blank or prefix.
     const std::string text = req.get_param_value(name);
-    char* end = nullptr;
-    errno = 0;
-    const long value = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || errno != 0 || value < lo || value > hi)
+    const std::optional<std::uint64_t> value = parse_decimal_digits(text);
+    if (!value || *value < static_cast<std::uint64_t>(std::max(lo, 0)) ||
+        *value > static_cast<std::uint64_t>(hi) || hi < 0)
         throw BadRequest(400, name + ": expected an integer in [" + std::to_string(lo) + ", " +
                                   std::to_string(hi) + "], found \"" + text + "\"");
-    return static_cast<int>(value);
+    return static_cast<int>(*value);
 }
 
 // The `exposure` query parameter: stops in [-64, 64], default 0.

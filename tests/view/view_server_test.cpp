@@ -169,7 +169,9 @@ TEST_F(ViewServerTest, BadCameraRequestsAre400AndChangeNothing) {
           std::string(R"({"fov": 180})"), std::string(R"({"moving": 1})"),
           std::string(R"({"zoom": 2})"),
           std::string(R"({"eye": [0, 0, 0], "lookat": [0, 0, 0]})"),
-          std::string(R"({"up": [0, 0, 0]})")}) {
+          std::string(R"({"up": [0, 0, 0]})"),
+          // Issue 38: a duplicate key, as a scene file's, is refused.
+          std::string(R"({"eye": [0, 1, 5], "eye": [0, 1, 6]})")}) {
         const auto result = client_->Post(with_token("/api/camera"), body, "application/json");
         ASSERT_TRUE(result) << body;
         EXPECT_EQ(result->status, 400) << body << " -> " << result->body;
@@ -447,8 +449,10 @@ TEST_F(ViewServerTest, ThePixelEndpointReadsTheLatestPicture) {
     EXPECT_EQ(answer["width"], scene_.image.width);
     EXPECT_EQ(answer["height"], scene_.image.height);
     for (int c = 0; c < 3; ++c) EXPECT_EQ(answer["rgb"][c].get<float>(), expected[c]) << c;
-    for (const char* query : {"x=64&y=0", "x=0&y=36", "x=-1&y=0", "x=0", "y=0", "x=1e1&y=0",
-                              "x=&y=0", "x=0x1&y=0"}) {
+    // Decimal digits only, as the command line's integers (issue 38: "+1" and " 1" passed).
+    for (const char* query :
+         {"x=64&y=0", "x=0&y=36", "x=-1&y=0", "x=0", "y=0", "x=1e1&y=0", "x=&y=0", "x=0x1&y=0",
+          "x=%2B1&y=0", "x=%201&y=0", "x=1%20&y=0"}) {
         const auto bad = client_->Get(with_token(std::string("/api/pixel?") + query));
         ASSERT_TRUE(bad) << query;
         EXPECT_EQ(bad->status, 400) << query << " -> " << bad->body;
