@@ -141,5 +141,15 @@ TEST_F(HostileCliTest, ThreadsTheAddressSpaceLimitCannotHoldAreRefused) {
         << file_bytes(dir_ / "log.txt");
 }
 
+// "x.exr/../y.exr" created x.exr/ to write y.exr through it, and left it behind.
+TEST_F(HostileCliTest, AnOutputThatGoesUpOutOfAMissingDirectoryLeavesNoStrayDirectory) {
+    const RunResult r = octray(
+        {"render", "whitted,width=32,height=18", "-o", "x.exr/../y.exr", "--progress", "none"});
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "x.exr does not exist")) << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+    EXPECT_FALSE(fs::exists(dir_ / "y.exr"));
+}
+
 }  // namespace
 }  // namespace octray::testing
