@@ -172,20 +172,8 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
 Json parse_json_dom(std::string_view json_text, const std::string& source) {
     // The JSON library ends its input at a NUL byte, which would let anything after one
     // pass unread; strict JSON means the whole file, and JSON text never holds a NUL.
-    if (const std::size_t nul = json_text.find('\0'); nul != std::string_view::npos) {
-        std::size_t line = 1, line_start = 0;
-        for (std::size_t i = 0; i < nul; ++i) {
-            if (json_text[i] == '\n') {
-                ++line;
-                line_start = i + 1;
-            }
-        }
-        throw SceneError(source, "",
-                         "invalid JSON at line " + std::to_string(line) + ", column " +
-                             std::to_string(nul - line_start + 1) +
-                             ": a NUL byte (\\0); expected JSON text, which has none (a "
-                             "NUL inside a string is written \\u0000)");
-    }
+    if (const std::size_t nul = json_text.find('\0'); nul != std::string_view::npos)
+        throw SceneError(source, "", nul_byte_message(json_text, nul));
     DomBuilder builder(json_text);
     const bool ok = Json::sax_parse(json_text, &builder, Json::input_format_t::json,
                                     /*strict=*/true, /*ignore_comments=*/false);

@@ -28,6 +28,20 @@ std::string format_rgb(Rgb c) {
     return "[" + format_float(c.r) + ", " + format_float(c.g) + ", " + format_float(c.b) + "]";
 }
 
+std::string nul_byte_message(std::string_view json_text, std::size_t offset) {
+    std::size_t line = 1, line_start = 0;
+    for (std::size_t i = 0; i < offset; ++i) {
+        if (json_text[i] == '\n') {
+            ++line;
+            line_start = i + 1;
+        }
+    }
+    return "invalid JSON at line " + std::to_string(line) + ", column " +
+           std::to_string(offset - line_start + 1) +
+           ": a NUL byte (\\0); expected JSON text, which has none (a NUL inside a string is "
+           "written \\u0000)";
+}
+
 std::string abbreviated(std::string_view s) {
     if (s.size() <= kMaxQuotedLength) return std::string(s);
     return std::string(s.substr(0, kMaxQuotedLength - 3)) + "...";
