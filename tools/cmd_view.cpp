@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -142,7 +143,11 @@ void run_compare_view(const ViewArguments& args) {
     try {
         images = view::load_compare_view(a, b);
     } catch (const ImageMismatch& e) {
-        std::cerr << "octray: view: " << e.what() << " (A = " << a << ", B = " << b << ")\n";
+        std::cerr << "octray: view: " << e.what() << " (A = " << a << ", B = " << b << ")";
+        if (std::string_view(e.what()).starts_with("channel mismatch"))
+            std::cerr << "; the viewer compares every channel: compare common ones with "
+                         "octray compare A B --channels LIST";
+        std::cerr << '\n';
         throw CommandExit{3};  // as `octray compare`
     }
     const auto server = make_server(args, images);

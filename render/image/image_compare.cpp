@@ -59,8 +59,7 @@ std::vector<std::pair<int, int>> match_channels(const ChannelImage& a, const Cha
         std::sort(names_b.begin(), names_b.end());
         if (names_a != names_b)
             throw ImageMismatch("channel mismatch: A has " + join(a.channel_names) +
-                                ", B has " + join(b.channel_names) +
-                                " (pick common ones with --channels)");
+                                ", B has " + join(b.channel_names));
         for (int c = 0; c < a.channel_count(); ++c)
             pairs.emplace_back(c, b.find_channel(a.channel_names[static_cast<std::size_t>(c)]));
         return pairs;

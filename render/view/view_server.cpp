@@ -402,8 +402,13 @@ void ViewServer::Impl::compare_routes() {
         if (name == "a") return view.rgb_a;
         if (name == "b") return view.rgb_b;
         if (name == "diff") return view.rgb_diff;
-        throw BadRequest(400,
-                         "picture: expected a, b, diff or heatmap, found \"" + name + "\"");
+        // (The heatmap is answered before this, and only as a PNG.)
+        if (name == "heatmap")
+            throw BadRequest(400,
+                             "picture: the heatmap is a PNG picture only (/api/image.png?"
+                             "picture=heatmap); here expected a, b or diff");
+        throw BadRequest(
+            400, "picture: expected a, b, diff or heatmap (PNG only), found \"" + name + "\"");
     };
     server.Get("/api/image.png", [&view, picture](const httplib::Request& req,
                                                   httplib::Response& res) {

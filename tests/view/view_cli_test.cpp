@@ -110,6 +110,28 @@ TEST(ViewCli, TwoImagesFailAsCompareFails) {
     std::filesystem::remove_all(dir);
 }
 
+// Issue 38: the viewer has no --channels; a channel mismatch suggested it. It names
+// `octray compare --channels` instead.
+TEST(ViewCli, AChannelMismatchPointsToCompareChannels) {
+    const std::filesystem::path dir =
+        kCwd / ("octray_view_cli_channels_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    RunResult r = run_octray({"render", "whitted,width=8,height=8", "-o", "a.exr"}, dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run_octray({"render", "whitted,width=8,height=8", "--aov", "depth", "-o", "b.exr"},
+                   dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run_octray({"view", "a.exr", "b.exr", "--port", "0"}, dir);
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "channel mismatch")) << r.output;
+    EXPECT_TRUE(contains(r.output, "octray compare A B --channels")) << r.output;
+    EXPECT_FALSE(contains(r.output, "(pick common ones with --channels)")) << r.output;
+    r = run_octray({"compare", "a.exr", "b.exr"}, dir);
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "pick common channels with --channels")) << r.output;
+    std::filesystem::remove_all(dir);
+}
+
 // Issue 38: `view --width 65536 --height 32767` started and failed on its first picture
 // with std::bad_alloc; it is refused up front by render's memory estimate (exit 2). The
 // watchdog ends a viewer that started serving instead.
