@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
@@ -193,6 +194,14 @@ struct ViewServer::Impl {
     httplib::Server server;
     std::thread listener;
     std::atomic<bool> stopping{false};
+    // Event streams open now. Each holds one of the http_threads workers for as long as it
+    // is open, so at most half of them may: the rest answer the page and the API however
+    // many tabs or clients open streams (past the cap, 503 says why).
+    // A stream whose reader left is noticed at its next heartbeat and frees its slot, so a
+    // new stream waits a little for one (a page reloading) before it is refused.
+    int open_streams = 0;
+    std::mutex streams_mutex;
+    std::condition_variable stream_closed;
     std::atomic<bool> listener_done{false};
     std::mutex stop_mutex;
 
@@ -284,31 +293,50 @@ void ViewServer::Impl::scene_routes() {
         res.set_content(status.dump(), "application/json");
     });
 
-    server.Get(
-        "/api/events", [this, &session](const httplib::Request&, httplib::Response& res) {
-            res.set_chunked_content_provider(
-                "text/event-stream",
-                [this, &session, last = std::uint64_t{0}, last_error = std::string()](
-                    std::size_t, httplib::DataSink& sink) mutable {
-                    const auto frame = session.wait_newer(last, kHeartbeat);
-                    if (stopping || session.stopped()) {
-                        sink.done();
-                        return true;
+    server.Get("/api/events", [this, &session](const httplib::Request&,
+                                               httplib::Response& res) {
+        const int max_streams = std::max(1, options.http_threads / 2);
+        {
+            std::unique_lock<std::mutex> lock(streams_mutex);
+            if (!stream_closed.wait_for(lock, 4 * kHeartbeat,
+                                        [&] { return open_streams < max_streams; }))
+                throw BadRequest(503, "too many event streams: " + std::to_string(max_streams) +
+                                          " are open, the most this viewer serves at once "
+                                          "(close a tab, or poll /api/status)");
+            ++open_streams;
+        }
+        res.set_chunked_content_provider(
+            "text/event-stream",
+            [this, &session, last = std::uint64_t{0}, last_error = std::string()](
+                std::size_t, httplib::DataSink& sink) mutable {
+                const auto frame = session.wait_newer(last, kHeartbeat);
+                if (stopping || session.stopped()) {
+                    sink.done();
+                    return true;
+                }
+                std::string message = ": heartbeat\n\n";
+                if (std::string error = session.error(); error != last_error) {
+                    last_error = error;
+                    if (!error.empty()) {
+                        message =
+                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
+                            "\n\n";
                     }
-                    std::string message = ": heartbeat\n\n";
-                    if (std::string error = session.error(); error != last_error) {
-                        last_error = error;
-                        if (!error.empty()) {
-                            message = "event: render-error\ndata: " +
-                                      json{{"message", error}}.dump() + "\n\n";
-                        }
-                    } else if (frame && frame->generation > last) {
-                        last = frame->generation;
-                        message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
-                    }
-                    return sink.write(message.data(), message.size());
-                });
-        });
+                } else if (frame && frame->generation > last) {
+                    last = frame->generation;
+                    message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                }
+                return sink.write(message.data(), message.size());
+            },
+            // Called when the stream ends, however it ends.
+            [this](bool) {
+                {
+                    const std::lock_guard<std::mutex> lock(streams_mutex);
+                    --open_streams;
+                }
+                stream_closed.notify_one();
+            });
+    });
 
     const auto image_headers = [](httplib::Response& res, const ViewFrame& frame) {
         res.set_header("X-Octray-Generation", std::to_string(frame.generation));
