@@ -13,6 +13,7 @@
 #include <mutex>
 #include <new>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <utility>
 
@@ -401,6 +402,16 @@ std::vector<Isa> supported_isas() {
 RenderResult render(const Scene& scene, const RenderOptions& options) try {
     return translate_errors([&] {
         if (options.frame < 0) throw std::invalid_argument("render: frame must be >= 0");
+        // The command line's limits (render --help): a thread count beyond them would ask
+        // the OS for that many threads (INT_MAX crashed TBB), a negative size or spp was
+        // silently ignored.
+        if (options.threads < 0 || options.threads > kMaxRenderThreads)
+            throw std::invalid_argument("render: threads must be from 0 to " +
+                                        std::to_string(kMaxRenderThreads) + ", not " +
+                                        std::to_string(options.threads));
+        if (options.width < 0 || options.height < 0 || options.spp < 0)
+            throw std::invalid_argument(
+                "render: width, height and spp must be >= 0 (0 keeps the scene's)");
         octray::Scene s = SceneAccess::get(scene);
         if (options.width > 0) s.image.width = options.width;
         if (options.height > 0) s.image.height = options.height;
@@ -413,8 +424,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) try {
         o.frame = static_cast<std::uint32_t>(options.frame);
         o.tile_width = options.tile_width;
         o.tile_height = options.tile_height;
-        if (o.threads < 0 || o.tile_width < 1 || o.tile_height < 1) {
-            throw std::invalid_argument("render: threads must be >= 0 and tiles at least 1x1");
+        if (o.tile_width < 1 || o.tile_height < 1) {
+            throw std::invalid_argument("render: tiles must be at least 1x1");
         }
 
         RenderResult out;

@@ -326,8 +326,11 @@ class PacketTracer {
             center_y_.push_back(film_y(j, 0.5f, scene.height));
     }
 
-    void render_tile(const Tile& tile, TileScratch& s, const RenderTarget& target,
-                     RayCounts& counts) const {
+    // Traces the tile into `target`; false, leaving it unfinished, when `control` says to
+    // stop: it is asked between chunks of camera samples and of each generation's rays, so
+    // a tile of any spp and depth stops within a chunk's work (RenderOptions::cancel).
+    bool render_tile(const Tile& tile, TileScratch& s, const RenderTarget& target,
+                     RayCounts& counts, TileControl& control) const {
         const int first_sample = target.samples.begin, end_sample = target.samples.end;
         const auto per_pixel = static_cast<std::uint32_t>(end_sample - first_sample);
         const std::size_t pixels = static_cast<std::size_t>(tile.width) * tile.height;
@@ -360,6 +363,7 @@ class PacketTracer {
 
         // Camera samples, primary rays and their trees, a chunk of samples at a time.
         for (std::size_t first = 0; first < samples; first += ray_chunk_) {
+            if (!control.proceed()) return false;
             const std::size_t n = std::min<std::size_t>(ray_chunk_, samples - first);
             camera_samples(tile, s, first, n, first_sample, per_pixel);
             s.primary.reserve(n);
@@ -367,11 +371,12 @@ class PacketTracer {
                 view_, s.samples.view(), static_cast<std::uint32_t>(n), s.primary.view());
             counts.primary += count;
             if (count == 0) continue;
-            trace_generation(0, s.primary.view(), count, s, counts);
+            trace_generation(0, s.primary.view(), count, s, counts, control);
             // Primary rays into their pixels, sample after sample.
             accumulate_primary(s.levels[0].color.view(), s.primary.pixel.data(), count, s);
         }
 
+        if (!control.proceed()) return false;  // stopped inside the last chunk's trees
         // The mean of the samples so far: all spp of them, unless a progressive pass.
         const auto samples_so_far = static_cast<float>(end_sample);
         for (int y = 0; y < tile.height; ++y) {
@@ -385,6 +390,7 @@ class PacketTracer {
             stream_row(&target.image.at(ox, oy + y), r, g, b, tile.width, samples_so_far);
         }
         finish_streaming();
+        return true;
     }
 
     // The closest hit of each pixel's sample-0 camera ray (the AOVs' hits: FirstHits in
@@ -507,7 +513,7 @@ class PacketTracer {
     // depth first, the trees below them; leaves their colors in s.levels[depth].color.
     // Primary rays live on (ε_s, inf), secondary ones on (0, inf).
     void trace_generation(int depth, const kernels::RayStream& rays, std::uint32_t count,
-                          TileScratch& s, RayCounts& counts) const {
+                          TileScratch& s, RayCounts& counts, TileControl& control) const {
         Level& level = s.levels[static_cast<std::size_t>(depth)];
         s.hits.reserve(count);
         s.shadows.reserve(static_cast<std::size_t>(count) * scene_.lights.count);
@@ -534,8 +540,9 @@ class PacketTracer {
         const kernels::RayStream next = level.next.view();
         const kernels::ChildLinks links = level.next_links.view();
         for (std::uint32_t first = 0; first < shaded.next; first += ray_chunk_) {
+            if (!control.proceed()) return;  // the render throws the colors away
             const std::uint32_t n = std::min(ray_chunk_, shaded.next - first);
-            trace_generation(depth + 1, offset(next, first), n, s, counts);
+            trace_generation(depth + 1, offset(next, first), n, s, counts, control);
             resolve_into_parents(s.levels[static_cast<std::size_t>(depth) + 1].color.view(),
                                  offset(links, first), n, level.color.view());
         }
@@ -574,7 +581,7 @@ void trace_tiles(const PacketTracer& tracer, const RenderTarget& target, int cou
             for (int t = range.begin(); t < range.end(); ++t) {
                 if (!control.proceed()) return;
                 const Tile tile = tile_at(t);
-                tracer.render_tile(tile, s, target, c);
+                if (!tracer.render_tile(tile, s, target, c, control)) break;
                 control.done(static_cast<std::uint64_t>(tile.width) *
                              static_cast<std::uint64_t>(tile.height));
             }
@@ -623,7 +630,9 @@ RenderResult render_frame(const CompiledScene& scene, FrameTree tree,
         target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
         target.sums = &result.sample_sums;
     }
-    const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
+    // A tile larger than the rectangle is the rectangle (and tiles_x cannot overflow).
+    const int tw = std::clamp(options.tile_width, 1, rect.width());
+    const int th = std::clamp(options.tile_height, 1, rect.height());
     const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
     TileTallies tallies;
     TileControl control(options);

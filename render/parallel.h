@@ -7,13 +7,16 @@
 #include <atomic>
 #include <cstdint>
 
+#include "core/thread_check.h"
 #include "render/types.h"
 
 namespace octray {
 
-// Runs f() on `threads` worker threads (0: every core TBB sees).
+// Runs f() on `threads` worker threads (0: every core TBB sees). Throws ThreadStartError
+// (core/thread_check.h) rather than let oneTBB abort when they cannot be started.
 template <class F>
 void run_with_threads(int threads, const F& f) {
+    check_threads_can_start(threads);
     if (threads > 0)
         tbb::task_arena(threads).execute(f);
     else

@@ -88,8 +88,10 @@ float floor_parity(float x) {
 
 }  // namespace
 
-ReferenceTracer::ReferenceTracer(const Scene& scene, ReferenceAccel accel)
+ReferenceTracer::ReferenceTracer(const Scene& scene, ReferenceAccel accel,
+                                 const std::atomic<bool>* cancel)
     : scene_(scene),
+      cancel_(cancel),
       camera_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)),
       background_up_(normalize(scene.camera.up)),
       epsilon_(self_intersection_epsilon(scene)) {
@@ -210,6 +212,9 @@ Rgb ReferenceTracer::background(Vec3 direction) const {
 }
 
 Rgb ReferenceTracer::trace(const Ray& ray, int depth, Rgb weight, RayCounts& counts) const {
+    // A render being stopped: black, and no rays below (a pixel of 2^20 samples at depth 64
+    // would otherwise run for minutes after the signal). The image is thrown away.
+    if (cancel_ != nullptr && cancel_->load(std::memory_order_relaxed)) return Rgb();
     const std::optional<SurfaceHit> hit = intersect(ray);
     if (!hit) return background(ray.direction);
     return shade(ray, *hit, depth, weight, counts);
@@ -336,7 +341,7 @@ Rgb ReferenceTracer::render_pixel(int i, int j, std::uint32_t frame, RayCounts& 
 
 RenderResult render_reference(const Scene& scene, const RenderOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    const ReferenceTracer tracer(scene, reference_accel(options.accel));
+    const ReferenceTracer tracer(scene, reference_accel(options.accel), options.cancel);
     RenderResult result;
     // The crop and the sample range (render/crop.h): pixel (i, j) of the full image lands
     // at (i - rect.x0, j - rect.y0); its value does not depend on either.
@@ -366,6 +371,8 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
                 RayCounts& local = counts.local();
                 for (int j = tile.rows().begin(); j < tile.rows().end(); ++j)
                     for (int i = tile.cols().begin(); i < tile.cols().end(); ++i) {
+                        // Also pixel by pixel: the tracer returns at once when cancelled.
+                        if (!control.proceed()) return;
                         const int x = i - rect.x0, y = j - rect.y0;
                         if (!partial_samples) {
                             result.image.at(x, y) =
@@ -396,7 +403,7 @@ RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRe
                                      Image& target, const RenderOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     check_block_render(blocks, target, scene.image.width, scene.image.height, options);
-    const ReferenceTracer tracer(scene, reference_accel(options.accel));
+    const ReferenceTracer tracer(scene, reference_accel(options.accel), options.cancel);
     RenderResult result;
     result.full_width = scene.image.width;
     result.full_height = scene.image.height;
@@ -411,8 +418,13 @@ RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRe
                     if (!control.proceed()) return;
                     const PixelRect& r = blocks[b];
                     for (int j = r.y0; j < r.y1; ++j)
-                        for (int i = r.x0; i < r.x1; ++i)
-                            target.at(i, j) = tracer.render_pixel(i, j, options.frame, local);
+                        for (int i = r.x0; i < r.x1; ++i) {
+                            const Rgb value = tracer.render_pixel(i, j, options.frame, local);
+                            // A pixel the cancel flag cut short never reaches the caller's
+                            // image.
+                            if (!control.proceed()) return;
+                            target.at(i, j) = value;
+                        }
                     control.done(static_cast<std::uint64_t>(r.width()) *
                                  static_cast<std::uint64_t>(r.height()));
                 }

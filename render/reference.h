@@ -5,6 +5,7 @@
 // Its spheres are found through a plain binary BVH of its own (reference_bvh.h), or by
 // testing every object (ReferenceAccel::brute_force): the same hits, bit for bit.
 
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -37,8 +38,12 @@ constexpr ReferenceAccel reference_accel(Accel accel) {
 
 class ReferenceTracer {
   public:
-    // The scene must have passed validate_scene(), and outlive the tracer.
-    explicit ReferenceTracer(const Scene& scene, ReferenceAccel accel = ReferenceAccel::bvh);
+    // The scene must have passed validate_scene(), and outlive the tracer. Once *cancel is
+    // true (a render being stopped, RenderOptions::cancel), trace() returns black at once,
+    // so that a pixel of any spp and depth ends within a ray of it; the render then throws
+    // RenderCancelled.
+    explicit ReferenceTracer(const Scene& scene, ReferenceAccel accel = ReferenceAccel::bvh,
+                             const std::atomic<bool>* cancel = nullptr);
 
     // The camera ray of sample `sample` of pixel (i, j) in frame `frame`. A fisheye
     // sample outside the image circle has no ray (it is black).
@@ -84,6 +89,7 @@ class ReferenceTracer {
     const Scene& scene_;
     std::optional<ReferenceBvh> bvh_;    // ReferenceAccel::bvh
     std::vector<std::uint32_t> planes_;  // with a BVH: the planes' object indices
+    const std::atomic<bool>* cancel_;
     CameraFrame camera_;
     Vec3 background_up_;  // the camera's up as given, normalised (gradient background)
     float epsilon_;

@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "core/pixel_rect.h"
 #include "render/accel.h"
+#include "scene/json_rules.h"
 
 namespace octray {
 
@@ -31,8 +32,9 @@ inline std::optional<RenderPath> parse_render_path(std::string_view name) {
 
 // The most samples per pixel and worker threads a render takes from its user: `octray
 // render --spp/--threads`, `octray view`'s switches (tools/cli_checks.h builds the options'
-// checks and help from these).
-inline constexpr int kMaxSamplesPerPixel = 1 << 20;
+// checks and help from these). The spp limit is the scene format's (a scene file's
+// image.spp, a built-in's spp=, the API's RenderOptions::spp): one limit wherever it is set.
+inline constexpr int kMaxSamplesPerPixel = json_rules::kMaxSpp;
 inline constexpr int kMaxRenderThreads = 4096;
 
 struct RayCounts {
@@ -63,7 +65,9 @@ struct RenderOptions {
     int tile_width = 16;
     int tile_height = 16;
     // Batch rendering (render/batch/frame_loop.h), both optional: the renderers poll *cancel
-    // between tiles and, once it is true, stop and throw RenderCancelled; they add each
+    // between tiles and inside them (the simd path between chunks of packets, the scalar
+    // one before each ray), so a frame of any size, spp and depth stops within a few
+    // milliseconds of work once it is true, and throw RenderCancelled; they add each
     // finished tile's pixel count to *pixels_done (progress).
     const std::atomic<bool>* cancel = nullptr;
     std::atomic<std::uint64_t>* pixels_done = nullptr;

@@ -165,11 +165,8 @@ class DomBuilder final : public nlohmann::json_sax<Json> {
 Json parse_json_dom(std::string_view json_text, const std::string& source) {
     // The JSON library ends its input at a NUL byte, which would let anything after one
     // pass unread; strict JSON means the whole file, and JSON text never holds a NUL.
-    if (const std::size_t nul = json_text.find('\0'); nul != std::string_view::npos) {
-        throw SceneError(source, text_position(json_text, nul), "",
-                         "invalid JSON: a NUL byte (\\0); expected JSON text, which has none "
-                         "(a NUL inside a string is written \\u0000)");
-    }
+    if (const std::size_t nul = json_text.find('\0'); nul != std::string_view::npos)
+        throw SceneError(source, text_position(json_text, nul), "", nul_byte_message());
     DomBuilder builder(json_text);
     const bool ok = Json::sax_parse(json_text, &builder, Json::input_format_t::json,
                                     /*strict=*/true, /*ignore_comments=*/false);

@@ -28,6 +28,11 @@ std::string format_rgb(Rgb c) {
     return "[" + format_float(c.r) + ", " + format_float(c.g) + ", " + format_float(c.b) + "]";
 }
 
+std::string nul_byte_message() {
+    return "invalid JSON: a NUL byte (\\0); expected JSON text, which has none (a NUL inside a "
+           "string is written \\u0000)";
+}
+
 std::string abbreviated(std::string_view s) {
     if (s.size() <= kMaxQuotedLength) return std::string(s);
     return std::string(s.substr(0, kMaxQuotedLength - 3)) + "...";

@@ -28,6 +28,11 @@ std::string format_rgb(Rgb c);
 // not make a 100 MB message.
 inline constexpr std::size_t kMaxQuotedLength = 64;
 
+// The message for a NUL byte ("invalid JSON: a NUL byte ..."; the SceneError carries its
+// line and column): the diagnosing reader's, and the file reader's, which stops at the
+// first one rather than reading a sparse 2 GB file to its end.
+std::string nul_byte_message();
+
 std::string abbreviated(std::string_view s);
 std::string quote_text(std::string_view s);
 

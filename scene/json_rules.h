@@ -13,6 +13,11 @@ namespace octray::json_rules {
 
 // Integers the scene stores in an int (image size, spp, key frame numbers).
 inline constexpr int kMaxIntValue = std::numeric_limits<int>::max();
+// Samples per pixel, wherever they are set (a scene file's image.spp, a built-in's spp=,
+// `--spp`, the viewer, the API): 2^20. A 1x1 frame at the limit is 2^20 camera rays, a
+// second or so of work; a render checks its cancel flag inside tiles, so any spp stops
+// promptly on a signal.
+inline constexpr int kMaxSpp = 1 << 20;
 // Deeper than this, the kr/kt weight cut-off has long ended every real path; the cap
 // keeps the renderers' recursion (or ray queues) bounded.
 inline constexpr int kMaxDepthLimit = 64;

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,6 +21,8 @@
 
 #include "core/aligned.h"
 #include "scene/builtin.h"
+#include "scene/json_messages.h"
+#include "scene/json_positions.h"
 
 namespace octray {
 
@@ -102,6 +105,14 @@ std::string read_scene_file(const std::string& path,
         const std::size_t want = std::min(kChunk, room);
         text.resize(size + want);
         const std::size_t n = std::fread(text.data() + size, 1, want, file.get());
+        // JSON text never holds a NUL byte: the first one is the error, whatever follows
+        // (a sparse 2 GB file of them is not read to its end first).
+        if (const void* nul = std::memchr(text.data() + size, '\0', n)) {
+            const auto offset =
+                static_cast<std::size_t>(static_cast<const char*>(nul) - text.data());
+            throw SceneError(path, scene_json::text_position(text, offset), "",
+                             scene_json::nul_byte_message());
+        }
         if (on_chunk && n > 0) on_chunk(std::string_view(text.data() + size, n));
         size += n;
         text.resize(size);

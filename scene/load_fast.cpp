@@ -46,7 +46,8 @@ void read_image(od::value& v, ImageSettings& image) {
     for (auto f : take(v.get_object())) {
         od::field field = take(std::move(f));
         const std::size_t key = seen.see(key_of(field));
-        const int n = static_cast<int>(integer_of(field.value(), 1, kMaxIntValue));
+        const int n = static_cast<int>(
+            integer_of(field.value(), 1, key == 2 ? json_rules::kMaxSpp : kMaxIntValue));
         switch (key) {
             case 0:
                 image.width = n;

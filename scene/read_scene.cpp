@@ -48,7 +48,7 @@ void read_image(const Reader& r, const Json& j, ImageSettings& image) {
         image.height =
             static_cast<int>(r.integer(j["height"], "image.height", 1, kMaxIntValue));
     if (j.contains("spp"))
-        image.spp = static_cast<int>(r.integer(j["spp"], "image.spp", 1, kMaxIntValue));
+        image.spp = static_cast<int>(r.integer(j["spp"], "image.spp", 1, json_rules::kMaxSpp));
 }
 
 void read_camera(const Reader& r, const Json& j, Camera& camera) {

@@ -88,6 +88,19 @@ CameraFrame make_camera_frame(const Camera& camera, int width, int height) {
     f.aspect = static_cast<float>(width) / static_cast<float>(height);
     const Vec3 view = camera.lookat - camera.eye;
     if (!(length(view) > 0.0f)) throw std::invalid_argument("eye and lookat coincide");
+    // Lengths are float: a vector longer than sqrt(FLT_MAX) (about 1.8e19) has a length of
+    // infinity, normalises to zero and so would read as "parallel" below. Say what it is.
+    const auto overflow = [](const char* what, Vec3 v) {
+        const double x = v.x, y = v.y, z = v.z;
+        char length_text[32];
+        std::snprintf(length_text, sizeof length_text, "%g", std::sqrt(x * x + y * y + z * z));
+        return std::invalid_argument(
+            std::string(what) + " has a length of " + length_text +
+            ", whose square overflows float: the camera's vectors must be shorter than about "
+            "1.8e19 (move the scene nearer the origin, or scale it down)");
+    };
+    if (!std::isfinite(length(view))) throw overflow("the view direction lookat - eye", view);
+    if (!std::isfinite(length(camera.up))) throw overflow("the up vector", camera.up);
     f.ln = normalize(view);
     const Vec3 side = cross(f.ln, camera.up);
     if (!(length(side) > 1e-6f * length(camera.up)) || !(length(camera.up) > 0.0f))

@@ -104,9 +104,9 @@ class Validator {
         const ImageSettings& im = scene_.image;
         int_range(im.width, "image.width", 1, kMaxIntValue);
         int_range(im.height, "image.height", 1, kMaxIntValue);
-        int_range(im.spp, "image.spp", 1, kMaxIntValue);
+        int_range(im.spp, "image.spp", 1, json_rules::kMaxSpp);
         // Both factors are below 2^31, so neither product overflows 64 bits (nor does the
-        // sample count width * height * spp, which stays below 2^62).
+        // sample count width * height * spp, which stays below 2^51).
         const std::int64_t pixels = static_cast<std::int64_t>(im.width) * im.height;
         const std::string size = std::to_string(im.width) + " x " + std::to_string(im.height);
         if (pixels > kMaxPixels) {
@@ -123,6 +123,11 @@ class Validator {
         finite(c.lookat, "camera.lookat");
         finite(c.up, "camera.up");
         if (c.up == Vec3{}) fail("camera.up", "expected a non-zero up vector, found [0, 0, 0]");
+        // Only a scene built in code (the API) can hold another value.
+        if (static_cast<unsigned>(c.type) > static_cast<unsigned>(CameraType::fisheye))
+            fail("camera.type",
+                 "expected pinhole, orthographic, thinlens or fisheye, found the value " +
+                     std::to_string(static_cast<int>(c.type)));
         switch (c.type) {
             case CameraType::orthographic:
                 positive(c.width, "camera.width", "a film width");

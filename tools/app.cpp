@@ -7,6 +7,7 @@
 #include <new>
 #include <string>
 
+#include "core/thread_check.h"
 #include "core/version.h"
 #include "render/image/image_io.h"
 #include "scene/scene_error.h"
@@ -17,7 +18,8 @@ namespace octray::tools {
 std::string exit_code_help() {
     return "Exit codes:\n"
            "  0  success\n"
-           "  1  unexpected internal error (a bug, or out of memory)\n"
+           "  1  unexpected internal error (a bug, or out of memory; also too little memory\n"
+           "     or too many processes allowed to start the worker threads)\n"
            "  2  usage error: unknown option, bad value, bad combination of options\n"
            "     (octray compare: 5, as 2 is its FAIL verdict; see its --help)\n"
            "  3  scene error: the scene file or built-in spec cannot be loaded or is invalid\n"
@@ -48,6 +50,10 @@ int run_command(const std::function<void()>& action, const std::string& command,
         return kExitIo;
     } catch (const std::bad_alloc&) {
         std::cerr << "octray: out of memory\n";
+        return kExitInternal;
+    } catch (const ThreadStartError& e) {
+        // As out of memory: the machine's limits, not the command line, are in the way.
+        std::cerr << "octray: error: " << e.what() << "; use fewer --threads\n";
         return kExitInternal;
     } catch (const std::exception& e) {
         std::cerr << "octray: internal error: " << e.what() << '\n';

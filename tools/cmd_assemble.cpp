@@ -58,6 +58,7 @@ void run_assemble(const AssembleArguments& args) {
     const ImageFormat format =
         require_image_format("-o", args.output, /*png_accepted=*/true,
                              "a .png is the 8-bit sRGB preview of the assembled R, G, B");
+    check_output_target(args.output);  // a device or FIFO: refused before reading the parts
     batch::AssembleSummary summary;
     try {
         summary = format == ImageFormat::png ? assemble_png(args.parts, args.output)

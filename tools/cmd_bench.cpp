@@ -14,6 +14,7 @@
 
 #include "bench/bench_runner.h"
 #include "bench/embree_baseline.h"
+#include "core/thread_check.h"
 #include "kernels/dispatch.h"
 #include "render/image/image_io.h"
 #include "tools/cli_checks.h"
@@ -145,6 +146,9 @@ std::vector<T> parse_list(const std::vector<std::string>& items, const char* opt
 }
 
 void run_bench_command(const BenchArguments& a) {
+    // Before oneTBB starts a worker: it would abort where they cannot start (ulimit -v).
+    for (const int n : a.threads) check_threads_can_start(n);
+    if (a.threads.empty()) check_threads_can_start(0);
     bench::BenchOptions o;
     if (!a.scenes.empty()) o.scenes = a.scenes;
     o.workloads =

@@ -75,12 +75,17 @@ void run_compare(const CompareArguments& args) {
     ChannelImage a, b;
     CompareResult result;
     try {
+        // A device or FIFO as --diff or --heatmap is refused before any reading (exit 4).
+        for (const std::string* out : {&args.diff, &args.heatmap})
+            if (!out->empty()) check_output_target(*out);
         a = read_image(args.a);
         b = read_image(args.b);
         result = compare_images(a, b, args.options);
     } catch (const ImageMismatch& e) {
-        const std::string reason =
+        std::string reason =
             std::string(e.what()) + " (A = " + args.a + ", B = " + args.b + ")";
+        if (args.options.channels.empty() && reason.rfind("channel mismatch", 0) == 0)
+            reason += "; pick common channels with --channels";
         if (args.json) print_json_outcome(args, "MISMATCH", kCompareMismatch, reason);
         std::cerr << "octray: compare: " << reason << '\n';
         throw CommandExit{kCompareMismatch};

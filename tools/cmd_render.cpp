@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/thread_check.h"
 #include "kernels/dispatch.h"
 #include "render/aov.h"
 #include "render/batch/frame_loop.h"
@@ -244,6 +245,9 @@ void run_render(const RenderArguments& args) {
         }
     }
 
+    // Before oneTBB starts a worker (loading a scene file may): it would abort where they
+    // cannot all start (ulimit -v); this says so instead, exit 1.
+    check_threads_can_start(args.threads);
     const batch::BatchRequest request = batch_request(args);
     std::vector<batch::BatchScene> scenes;
     for (const std::string& spec : args.scenes) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/thread_check.h"
 #include "kernels/dispatch.h"
 #include "render/batch/output_paths.h"
 #include "render/batch/spec.h"
@@ -124,6 +125,7 @@ bool verify_frame(const VerifyArguments& args, const Scene& scene, Isa isa,
 }
 
 void run_verify(const VerifyArguments& args) {
+    check_threads_can_start(args.threads);  // before oneTBB starts a worker (ulimit -v)
     Isa isa = Isa::automatic;
     try {
         isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));

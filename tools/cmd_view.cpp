@@ -6,21 +6,25 @@
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <utility>
 #include <vector>
 
+#include "core/thread_check.h"
 #include "kernels/dispatch.h"
 #include "render/batch/frame_loop.h"
 #include "render/batch/plan.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
+#include "render/memory_estimate.h"
 #include "render/view/compare_view.h"
 #include "render/view/view_bench.h"
 #include "render/view/view_server.h"
@@ -44,6 +48,7 @@ struct ViewArguments {
     std::string path{"simd"};
     std::string isa{"auto"};
     std::string order{"tiled"};
+    std::string max_memory;  // empty: this machine's memory
 };
 
 // SIGINT and SIGTERM are blocked in every thread (the mask is inherited by the threads
@@ -136,7 +141,11 @@ void run_compare_view(const ViewArguments& args) {
     try {
         images = view::load_compare_view(a, b);
     } catch (const ImageMismatch& e) {
-        std::cerr << "octray: view: " << e.what() << " (A = " << a << ", B = " << b << ")\n";
+        std::cerr << "octray: view: " << e.what() << " (A = " << a << ", B = " << b << ")";
+        if (std::string_view(e.what()).starts_with("channel mismatch"))
+            std::cerr << "; the viewer compares every channel: compare common ones with "
+                         "octray compare A B --channels LIST";
+        std::cerr << '\n';
         throw CommandExit{3};  // as `octray compare`
     }
     const auto server = make_server(args, images);
@@ -147,6 +156,35 @@ void run_compare_view(const ViewArguments& args) {
     std::cout << "octray view: stopped\n" << std::flush;
 }
 
+// The viewer holds what a progressive `render --png` holds (the picture, the sums of its
+// passes, a PNG of it) and more threads' scratch: refused by the same estimate as `render`
+// when it exceeds the limit (--max-memory, else this machine's memory), rather than
+// starting and failing on its first picture with std::bad_alloc.
+void check_view_memory(const Scene& scene, const ViewArguments& args) {
+    std::uint64_t limit = machine_memory_bytes();  // 0 if unknown: no limit
+    if (!args.max_memory.empty()) {
+        const auto parsed = parse_memory_size(args.max_memory);
+        if (!parsed)
+            throw UsageError("--max-memory: expected a size such as 512M, 4G or 1T, not " +
+                             args.max_memory);
+        limit = *parsed;
+    }
+    if (limit == 0) return;
+    RenderMemoryParams memory;
+    memory.threads = args.threads;
+    memory.packet_path = args.path == "simd";
+    memory.progressive = true;
+    memory.png_preview = true;
+    try {
+        check_memory_limit(scene, limit, memory);
+    } catch (const SceneError& e) {
+        throw UsageError(e.what() + (args.max_memory.empty()
+                                         ? std::string(" (the limit is this machine's memory; "
+                                                       "--max-memory sets another)")
+                                         : " (--max-memory " + args.max_memory + ")"));
+    }
+}
+
 void run_view(const ViewArguments& args) {
     if (args.inputs.size() == 2) {
         run_compare_view(args);
@@ -154,6 +192,7 @@ void run_view(const ViewArguments& args) {
     }
     std::optional<StopOnSignal> stop_on_signal;
     if (args.bench == 0) stop_on_signal.emplace();  // before any thread is made (TBB's too)
+    check_threads_can_start(args.threads);          // before oneTBB starts a worker (ulimit -v)
     const std::string spec = args.inputs.empty() ? std::string("whitted") : args.inputs[0];
     // The digest names the scene in the header of a saved picture, as in `octray render`'s.
     // An animation is shown at frame 0; the page's slider poses the others.
@@ -163,6 +202,7 @@ void run_view(const ViewArguments& args) {
     if (args.spp > 0) scene.image.spp = args.spp;
     if (args.max_depth > 0) scene.render.max_depth = args.max_depth;
     validate_scene(scene);
+    check_view_memory(scene, args);
 
     view::ViewSettings settings;
     settings.path = *parse_render_path(args.path);
@@ -243,6 +283,11 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->type_name("N")
         ->transform(decimal_integer(0, kMaxThreadCount))
         ->capture_default_str();
+    cmd->add_option("--max-memory", args->max_memory,
+                    "Refuse a scene whose memory estimate (as octray render's, for a\n"
+                    "progressive render with a PNG) exceeds this (512M, 4G, ...)\n"
+                    "[default: this machine's physical memory]")
+        ->type_name("SIZE");
     cmd->add_option("--preview-divisor", args->preview_divisor,
                     "While the camera moves, render width/D x height/D at 1 spp, " +
                         integer_range_text(1, 64))

@@ -31,6 +31,14 @@ void prepare_output_directory(const fs::path& file, std::vector<std::string>& cr
             missing.push_back(up);
             if (up == up.parent_path()) break;
         }
+        // "x.exr/../y.exr": creating x.exr only to leave it again would leave a stray
+        // directory behind (and what ".." means then depends on symlinks): refused.
+        for (const fs::path& up : missing)
+            if (up.filename() == "..")
+                throw IoError("cannot write " + file.string() + ": " +
+                              up.parent_path().string() +
+                              " does not exist, and the path goes up (..) out of it; name "
+                              "the output without the missing directory");
         for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
             if (::mkdir(it->c_str(), 0777) == 0) {
                 created.push_back(it->string());
@@ -90,6 +98,7 @@ std::vector<std::string> prepare_output_directories(const std::vector<BatchJob>&
     for (const BatchJob& job : jobs) {
         for (const std::string* file : {&job.output, &job.png}) {
             if (file->empty()) continue;
+            check_output_target(*file);  // a device or FIFO would be replaced: refused
             const fs::path path(*file);
             if (directories.insert(path.parent_path().string()).second)
                 prepare_output_directory(path, created);

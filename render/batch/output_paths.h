@@ -24,8 +24,10 @@ std::string directory_identity(const std::string& dir);
 // Creates the missing directories above every output and preview of `jobs` (as Blender
 // does), top down, and returns those it created, in order; fails before the render when
 // one cannot be created or a directory clearly cannot be written, rather than after hours
-// of rendering (the writes themselves still report anything this misses). Another run
-// creating one at the same time is no error. Throws IoError naming the file and why.
+// of rendering (the writes themselves still report anything this misses); refuses an
+// output that exists and is not a regular file (check_output_target: a device node, a
+// FIFO). Another run creating one at the same time is no error. Throws IoError naming the
+// file and why.
 std::vector<std::string> prepare_output_directories(const std::vector<BatchJob>& jobs);
 
 }  // namespace octray::batch

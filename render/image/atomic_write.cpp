@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -80,10 +81,33 @@ void create_temporary_file(const fs::path& target, HeldTemporary& held) {
     throw std::runtime_error("could not create a unique temporary file next to it");
 }
 
+// What a file of this mode is, for a message: "a character device".
+const char* file_kind(mode_t mode) {
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+    if (S_ISSOCK(mode)) return "a socket";
+    return "not a regular file";
+}
+
 }  // namespace
+
+void check_output_target(const std::string& path) {
+    // stat follows symlinks: a symlink to a regular file is written as before (the link is
+    // replaced by the new file), one to a device is refused like the device. A directory
+    // is left to the rename, which cannot replace it (EISDIR): a batch fails that frame
+    // alone and renders the others.
+    struct stat info {};
+    if (::stat(path.c_str(), &info) != 0 || S_ISREG(info.st_mode) || S_ISDIR(info.st_mode))
+        return;
+    throw IoError("cannot write " + path + ": it exists and is " + file_kind(info.st_mode) +
+                  ", not a regular file; octray writes a new file and renames it over the "
+                  "target, which would replace it, so it leaves it alone");
+}
 
 void write_file_atomically(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write) {
+    check_output_target(path);
     HeldTemporary tmp;
     try {
         create_temporary_file(fs::path(path), tmp);

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "render/image/image_io.h"
 
@@ -57,8 +59,7 @@ std::vector<std::pair<int, int>> match_channels(const ChannelImage& a, const Cha
         std::sort(names_b.begin(), names_b.end());
         if (names_a != names_b)
             throw ImageMismatch("channel mismatch: A has " + join(a.channel_names) +
-                                ", B has " + join(b.channel_names) +
-                                " (pick common ones with --channels)");
+                                ", B has " + join(b.channel_names));
         for (int c = 0; c < a.channel_count(); ++c)
             pairs.emplace_back(c, b.find_channel(a.channel_names[static_cast<std::size_t>(c)]));
         return pairs;
@@ -180,6 +181,34 @@ void judge(CompareResult& result, const CompareOptions& options) {
                         nonfinite_note(all) + ", within the " + allowed + " allowed";
 }
 
+// The options as `octray compare` takes them: thresholds from 0 to infinity, percentages
+// from 0 to 100, a positive finite floor. A NaN would compare false with every error, and
+// so pass images that differ: std::invalid_argument naming the option, as for the rest.
+void check_compare_options(const CompareOptions& o) {
+    const auto threshold = [](double v, const char* name) {
+        if (!(v >= 0.0))
+            throw std::invalid_argument(std::string("compare: ") + name +
+                                        " must be a number from 0 to infinity, not " +
+                                        number(v));
+    };
+    const auto percent_of = [](double v, const char* name) {
+        if (!(v >= 0.0 && v <= 100.0))
+            throw std::invalid_argument(std::string("compare: ") + name +
+                                        " must be a percentage from 0 to 100, not " +
+                                        number(v));
+    };
+    threshold(o.fail_threshold, "fail_threshold");
+    threshold(o.hard_fail, "hard_fail");
+    threshold(o.warn_threshold, "warn_threshold");
+    threshold(o.hard_warn, "hard_warn");
+    percent_of(o.fail_percent, "fail_percent");
+    percent_of(o.warn_percent, "warn_percent");
+    if (!(o.relative_error_floor > 0.0 && std::isfinite(o.relative_error_floor)))
+        throw std::invalid_argument(
+            "compare: relative_error_floor must be positive and finite, not " +
+            number(o.relative_error_floor));
+}
+
 }  // namespace
 
 std::vector<std::string> format_notes(std::string_view format_a, std::string_view format_b) {
@@ -214,6 +243,11 @@ std::vector<std::string> format_notes(std::string_view format_a, std::string_vie
 
 CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
                              const CompareOptions& options) {
+    check_compare_options(options);
+    if (a.pixel_count() == 0 || b.pixel_count() == 0)
+        throw ImageMismatch("an image without pixels: A is " + std::to_string(a.width) + "x" +
+                            std::to_string(a.height) + ", B is " + std::to_string(b.width) +
+                            "x" + std::to_string(b.height) + "; expected at least 1x1");
     if (a.width != b.width || a.height != b.height)
         throw ImageMismatch("size mismatch: A is " + std::to_string(a.width) + "x" +
                             std::to_string(a.height) + ", B is " + std::to_string(b.width) +

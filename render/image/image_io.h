@@ -26,9 +26,18 @@ class IoError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// Throws IoError naming `path` and what it is when an existing `path` is a device node
+// (/dev/null, /dev/full), a FIFO or a socket, or a symlink to one. A write renames a new
+// file over its target, which would replace such a node with a regular file (as root,
+// /dev/full itself), so such targets are refused, before rendering by the commands (they
+// call this on every output first) and again by write_file_atomically. A path that does
+// not exist yet, a regular file and a directory (which a rename cannot replace) pass.
+void check_output_target(const std::string& path);
+
 // Calls write(tmp_path) with a fresh temporary path in the target's directory, then
 // renames it over `path` (atomic on POSIX). On any exception the temporary is removed
-// and the exception passes on as an IoError naming `path`.
+// and the exception passes on as an IoError naming `path`. Refuses a device, FIFO or
+// socket as the target first (check_output_target).
 void write_file_atomically(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write);
 

@@ -13,6 +13,7 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfMatrixAttribute.h>
+#include <ImfMultiPartInputFile.h>
 #include <ImfRationalAttribute.h>
 #include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
@@ -349,6 +350,14 @@ template <class Use>
 auto read_exr(const std::string& path, bool check_pixel_data, Use&& use) {
     try {
         Imf::InputFile file(path.c_str());
+        // InputFile reads part 0 of a multi-part file as if it were the whole file: a
+        // compare or an assemble would silently use one part of several.
+        if (Imf::isMultiPart(file.version())) {
+            const int parts = Imf::MultiPartInputFile(path.c_str()).parts();
+            fail(path, "a multi-part OpenEXR file (" + std::to_string(parts) +
+                           " parts); octray reads single-part files only, and would see part "
+                           "0 alone (split it first, e.g. with exrmultipart -separate)");
+        }
         if (check_pixel_data) {
             checked_data_window(path, file.header());
             check_exr_chunks(path, file);

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string_view>
+#include <system_error>
+#include <vector>
 
 #include "kernels/dispatch.h"
 #include "render/batch/digest.h"
@@ -11,7 +13,9 @@
 #include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/view/http_error.h"
+#include "render/view/request_json.h"
 #include "render/view/view_switches.h"
+#include "scene/builtin.h"
 #include "scene/load.h"
 
 namespace octray::view {
@@ -69,7 +73,7 @@ bool same_camera(const Camera& a, const Camera& b) {
 // POST /api/save: the refined picture as `octray render` writes it (render/view/README.md).
 nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
                          const std::string& body) {
-    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    const json request = parse_request_json(body, "save");
     if (request.is_discarded() || !request.is_object() || !request.contains("name") ||
         !request["name"].is_string())
         throw BadRequest(400, "save: expected {\"name\": \"view.exr\", \"overwrite\": false}");
@@ -98,14 +102,35 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
         throw BadRequest(409, "save: needs the tiled order (frameless pictures are not saved)");
     namespace fs = std::filesystem;
     const fs::path directory(settings.directory);
-    const auto refuse_existing = [&](const std::string& file) {
-        if (!overwrite && fs::exists(directory / file))
-            throw BadRequest(
-                409, "save: " + file + " exists; ask to overwrite it (\"overwrite\": true)");
-    };
-    refuse_existing(name);
-
+    // A moved camera is a new scene: written beside the image as JSON (`octray scene`'s
+    // writer), named in the header and the command line instead of the original.
     const Camera scene_camera = posed.camera;
+    const bool moved = !same_camera(frame->camera, scene_camera);
+    const std::string scene_file = moved ? name.substr(0, name.size() - 4) + ".json" : "";
+    std::vector<std::string> files{name};
+    if (moved) files.push_back(scene_file);
+    // The scene being viewed is never replaced, overwrite or not (an animated scene would
+    // lose its animation to the frame's still pose); every other existing file is named.
+    std::vector<std::string> existing;
+    for (const std::string& file : files) {
+        std::error_code error;
+        if (!is_builtin_scene(settings.spec) &&
+            fs::equivalent(directory / file, settings.spec, error) && !error)
+            throw BadRequest(409, "save: " + file + " is the scene being viewed (" +
+                                      settings.spec +
+                                      "), which a save never overwrites; choose another name");
+        if (fs::exists(directory / file, error)) existing.push_back(file);
+    }
+    if (!overwrite && !existing.empty()) {
+        std::string names;
+        for (std::size_t i = 0; i < existing.size(); ++i)
+            names += (i == 0 ? "" : " and ") + existing[i];
+        throw BadRequest(409, "save: " + names + (existing.size() == 1 ? " exists" : " exist") +
+                                  "; ask to overwrite " +
+                                  (existing.size() == 1 ? "it" : "them") +
+                                  " (\"overwrite\": true)");
+    }
+
     posed.camera = frame->camera;
     batch::BatchScene identity;
     identity.spec = settings.spec;
@@ -118,13 +143,7 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
         identity.scene.animation->frames = session.frame_count();
         identity.scene.animation->fps = session.frames_per_second();
     }
-    // A moved camera is a new scene: written beside the image as JSON (`octray scene`'s
-    // writer), named in the header and the command line instead of the original.
-    const bool moved = !same_camera(frame->camera, scene_camera);
-    std::string scene_file;
     if (moved) {
-        scene_file = name.substr(0, name.size() - 4) + ".json";
-        refuse_existing(scene_file);
         const std::string text = scene_to_json(posed);
         write_file_atomically((directory / scene_file).string(), [&](const std::string& tmp) {
             std::ofstream out(tmp, std::ios::binary);

@@ -13,8 +13,9 @@ namespace octray::view {
 // Writes the session's latest picture as settings.directory/NAME, NAME from the JSON
 // body {"name": "view.exr", "overwrite": false}; a moved camera's scene goes beside it as
 // NAME.json. Answers {"file", "command", "camera_moved", "scene_file"}. Throws BadRequest
-// (http_error.h): 400 for a bad body or name, 409 for an existing file or a picture that
-// is still refining or frameless; IoError when the file cannot be written.
+// (http_error.h): 400 for a bad body or name, 409 for existing files (naming each) unless
+// overwrite, for a file that is the scene being viewed (never overwritten), or for a
+// picture that is still refining or frameless; IoError when a file cannot be written.
 nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
                          const std::string& body);
 

@@ -2,24 +2,30 @@
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
 #include <utility>
 
+#include "core/decimal.h"
 #include "render/image/image_io.h"
 #include "render/view/http_error.h"
 #include "render/view/page.h"
+#include "render/view/request_json.h"
 #include "render/view/token.h"
 #include "render/view/tone_map.h"
 #include "render/view/view_save.h"
@@ -80,7 +86,7 @@ Vec3 vec3_from(const json& value, const std::string& what) {
 // The body of POST /api/camera: {"eye": [x, y, z], "lookat": [...], "up": [...],
 // "fov": degrees, "moving": bool}, every key optional (the current camera's value).
 std::pair<Camera, bool> parse_camera_request(const std::string& body, Camera camera) {
-    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    const json request = parse_request_json(body, "camera");
     if (request.is_discarded() || !request.is_object())
         throw BadRequest(400, "camera: expected a JSON object such as {\"eye\": [0, 1, 5]}");
     bool moving = false;
@@ -125,14 +131,14 @@ int integer_param(const httplib::Request& req, const std::string& name, int lo, 
     if (!req.has_param(name))
         throw BadRequest(400, name + ": missing (expected an integer in [" +
                                   std::to_string(lo) + ", " + std::to_string(hi) + "])");
+    // Decimal digits only, as the command line and scene files: no sign, blank or prefix.
     const std::string text = req.get_param_value(name);
-    char* end = nullptr;
-    errno = 0;
-    const long value = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || errno != 0 || value < lo || value > hi)
+    const std::optional<std::uint64_t> value = parse_decimal_digits(text);
+    if (!value || *value < static_cast<std::uint64_t>(std::max(lo, 0)) ||
+        *value > static_cast<std::uint64_t>(hi) || hi < 0)
         throw BadRequest(400, name + ": expected an integer in [" + std::to_string(lo) + ", " +
                                   std::to_string(hi) + "], found \"" + text + "\"");
-    return static_cast<int>(value);
+    return static_cast<int>(*value);
 }
 
 // The `exposure` query parameter: stops in [-64, 64], default 0.
@@ -188,6 +194,14 @@ struct ViewServer::Impl {
     httplib::Server server;
     std::thread listener;
     std::atomic<bool> stopping{false};
+    // Event streams open now. Each holds one of the http_threads workers for as long as it
+    // is open, so at most half of them may: the rest answer the page and the API however
+    // many tabs or clients open streams (past the cap, 503 says why).
+    // A stream whose reader left is noticed at its next heartbeat and frees its slot, so a
+    // new stream waits a little for one (a page reloading) before it is refused.
+    int open_streams = 0;
+    std::mutex streams_mutex;
+    std::condition_variable stream_closed;
     std::atomic<bool> listener_done{false};
     std::mutex stop_mutex;
 
@@ -279,31 +293,50 @@ void ViewServer::Impl::scene_routes() {
         res.set_content(status.dump(), "application/json");
     });
 
-    server.Get(
-        "/api/events", [this, &session](const httplib::Request&, httplib::Response& res) {
-            res.set_chunked_content_provider(
-                "text/event-stream",
-                [this, &session, last = std::uint64_t{0}, last_error = std::string()](
-                    std::size_t, httplib::DataSink& sink) mutable {
-                    const auto frame = session.wait_newer(last, kHeartbeat);
-                    if (stopping || session.stopped()) {
-                        sink.done();
-                        return true;
+    server.Get("/api/events", [this, &session](const httplib::Request&,
+                                               httplib::Response& res) {
+        const int max_streams = std::max(1, options.http_threads / 2);
+        {
+            std::unique_lock<std::mutex> lock(streams_mutex);
+            if (!stream_closed.wait_for(lock, 4 * kHeartbeat,
+                                        [&] { return open_streams < max_streams; }))
+                throw BadRequest(503, "too many event streams: " + std::to_string(max_streams) +
+                                          " are open, the most this viewer serves at once "
+                                          "(close a tab, or poll /api/status)");
+            ++open_streams;
+        }
+        res.set_chunked_content_provider(
+            "text/event-stream",
+            [this, &session, last = std::uint64_t{0}, last_error = std::string()](
+                std::size_t, httplib::DataSink& sink) mutable {
+                const auto frame = session.wait_newer(last, kHeartbeat);
+                if (stopping || session.stopped()) {
+                    sink.done();
+                    return true;
+                }
+                std::string message = ": heartbeat\n\n";
+                if (std::string error = session.error(); error != last_error) {
+                    last_error = error;
+                    if (!error.empty()) {
+                        message =
+                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
+                            "\n\n";
                     }
-                    std::string message = ": heartbeat\n\n";
-                    if (std::string error = session.error(); error != last_error) {
-                        last_error = error;
-                        if (!error.empty()) {
-                            message = "event: render-error\ndata: " +
-                                      json{{"message", error}}.dump() + "\n\n";
-                        }
-                    } else if (frame && frame->generation > last) {
-                        last = frame->generation;
-                        message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
-                    }
-                    return sink.write(message.data(), message.size());
-                });
-        });
+                } else if (frame && frame->generation > last) {
+                    last = frame->generation;
+                    message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                }
+                return sink.write(message.data(), message.size());
+            },
+            // Called when the stream ends, however it ends.
+            [this](bool) {
+                {
+                    const std::lock_guard<std::mutex> lock(streams_mutex);
+                    --open_streams;
+                }
+                stream_closed.notify_one();
+            });
+    });
 
     const auto image_headers = [](httplib::Response& res, const ViewFrame& frame) {
         res.set_header("X-Octray-Generation", std::to_string(frame.generation));
@@ -397,8 +430,13 @@ void ViewServer::Impl::compare_routes() {
         if (name == "a") return view.rgb_a;
         if (name == "b") return view.rgb_b;
         if (name == "diff") return view.rgb_diff;
-        throw BadRequest(400,
-                         "picture: expected a, b, diff or heatmap, found \"" + name + "\"");
+        // (The heatmap is answered before this, and only as a PNG.)
+        if (name == "heatmap")
+            throw BadRequest(400,
+                             "picture: the heatmap is a PNG picture only (/api/image.png?"
+                             "picture=heatmap); here expected a, b or diff");
+        throw BadRequest(
+            400, "picture: expected a, b, diff or heatmap (PNG only), found \"" + name + "\"");
     };
     server.Get("/api/image.png", [&view, picture](const httplib::Request& req,
                                                   httplib::Response& res) {

@@ -26,7 +26,8 @@ struct ServerOptions {
     int port = 0;                      // 0: a free port, chosen by the kernel
     std::string token;                 // empty: random_token()
     std::size_t max_body = 4096;       // bytes; a longer request body gets 413
-    int http_threads = 16;             // requests served at once (an event stream holds one)
+    int http_threads = 16;             // requests served at once (an event stream holds one;
+                                       // at most half of them are streams, 503 past that)
     std::optional<SaveSettings> save;  // absent: no /api/save
 };
 

@@ -6,6 +6,7 @@
 #include "render/batch/frame_loop.h"
 #include "render/types.h"
 #include "render/view/http_error.h"
+#include "render/view/request_json.h"
 #include "scene/max_depth.h"
 
 namespace octray::view {
@@ -56,7 +57,7 @@ std::vector<std::string> isa_choices(const SwitchLimits& limits) {
 
 RenderSwitches parse_switches(const std::string& body, RenderSwitches switches,
                               const SwitchLimits& limits) {
-    const json request = json::parse(body, nullptr, /*allow_exceptions=*/false);
+    const json request = parse_request_json(body, "settings");
     if (request.is_discarded() || !request.is_object())
         throw BadRequest(400, "settings: expected a JSON object such as {\"spp\": 16}");
     for (const auto& [key, value] : request.items()) {

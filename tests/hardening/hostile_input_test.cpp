@@ -11,14 +11,17 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
 #include <string>
+#include <string_view>
 
 #include "render/memory_estimate.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
+#include "scene/scene_error.h"
 
 namespace octray {
 namespace {
@@ -132,6 +135,27 @@ TEST(HostileJson, HundredMegabyteSceneFailsWithThePathOfItsLastObject) {
     if (growth >= 0) {
         EXPECT_LT(growth, 3000.0);
     }
+}
+
+// Issue 38: a sparse scene file (all NUL bytes, as `truncate -s 2G` makes one) was read
+// whole before its first byte was reported. The reader stops at the first NUL: no chunk of
+// the file reaches the caller's hash, and the error is where it is, line 1, column 1.
+TEST(HostileJson, SparseSceneFileStopsAtItsFirstNulByte) {
+    const std::string path =
+        std::string(OCTRAY_TEST_TMPDIR) + "/sparse-" + std::to_string(::getpid()) + ".json";
+    std::filesystem::create_directories(OCTRAY_TEST_TMPDIR);
+    { std::ofstream create(path); }
+    ASSERT_EQ(::truncate(path.c_str(), std::int64_t{256} << 20), 0);
+    std::size_t bytes_read = 0;
+    std::string message;
+    try {
+        read_scene_file(path, [&](std::string_view chunk) { bytes_read += chunk.size(); });
+    } catch (const SceneError& e) {
+        message = e.what();
+    }
+    std::remove(path.c_str());
+    EXPECT_NE(message.find(":1:1: invalid JSON: a NUL byte"), std::string::npos) << message;
+    EXPECT_EQ(bytes_read, 0u) << "the file was read past its first chunk";
 }
 
 // Strings of 100 MB where the loader quotes them or suggests a correction: the message

@@ -1,5 +1,11 @@
 #include "render/image/image_read.h"
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -152,6 +158,35 @@ TEST_F(ImageReadTest, FormatComesFromMagicBytesNotExtension) {
     EXPECT_EQ(read_image(path("actually_png.exr")).format, "PNG 8-bit");
     write_test_exr(path("actually_exr.png"), make_image(1, 1, {"R"}, 2.0f));
     EXPECT_EQ(read_image(path("actually_exr.png")).at(0, 0, 0), 2.0f);
+}
+
+// Issue 38: OpenEXR's InputFile reads part 0 of a multi-part file as the whole file, so a
+// compare or an assemble silently used one part of two. Refused, naming the part count.
+TEST_F(ImageReadTest, MultiPartExrIsRefusedNamingItsParts) {
+    std::vector<Imf::Header> headers;
+    for (const char* name : {"left", "right"}) {
+        Imf::Header header(2, 2);
+        header.setName(name);
+        header.setType(Imf::SCANLINEIMAGE);
+        header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+        headers.push_back(header);
+    }
+    const std::string file = path("two-parts.exr");
+    {
+        Imf::MultiPartOutputFile out(file.c_str(), headers.data(), 2);
+        std::vector<float> pixels(4, 0.25f);
+        for (int part = 0; part < 2; ++part) {
+            Imf::OutputPart writer(out, part);
+            Imf::FrameBuffer frame;
+            frame.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(pixels.data()),
+                                         sizeof(float), 2 * sizeof(float)));
+            writer.setFrameBuffer(frame);
+            writer.writePixels(2);
+        }
+    }
+    const std::string message = read_error(file);
+    EXPECT_NE(message.find("multi-part OpenEXR file (2 parts)"), std::string::npos) << message;
+    EXPECT_NE(message.find("two-parts.exr"), std::string::npos) << message;
 }
 
 TEST_F(ImageReadTest, MissingFileSaysSo) {

@@ -331,6 +331,8 @@ TEST(SceneBuiltinError, BadOptions) {
     expect_error("whitted,width=12px", "width", {"expected an integer", "found \"12px\""});
     expect_error("whitted,height=-2", "height", {"found \"-2\""});
     expect_error("whitted,spp=", "spp", {"expected an integer from 1", "found \"\""});
+    // Issue 38: one spp limit everywhere (a scene file's, `--spp`'s): 2^20.
+    expect_error("whitted,spp=1048577", "spp", {"from 1 to 1048576", "found \"1048577\""});
     expect_error("whitted,max_depth=65", "max_depth", {"expected an integer from 0 to 64"});
     expect_error("whitted,seed=-1", "seed",
                  {"expected a non-negative integer", "found \"-1\""});

@@ -278,7 +278,11 @@ TEST(SceneLoadError, ImageSize) {
                       {"expected an integer from 1 to 2147483647, found -1"});
     j = full_scene();
     j["image"]["spp"] = 0;
-    expect_json_error(j, "image.spp", {"expected an integer from 1 to 2147483647, found 0"});
+    expect_json_error(j, "image.spp", {"expected an integer from 1 to 1048576, found 0"});
+    // Issue 38: one spp limit everywhere, 2^20 as `--spp` (a file's 2^31 - 1 samples per
+    // pixel ignored SIGTERM for minutes and could never finish).
+    j["image"]["spp"] = 1048577;
+    expect_json_error(j, "image.spp", {"expected an integer from 1 to 1048576, found 1048577"});
 }
 
 TEST(SceneLoadError, ImageTooManyPixels) {

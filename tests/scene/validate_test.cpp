@@ -88,5 +88,24 @@ TEST(SceneValidate, ReportsJsonLikePaths) {
     expect_invalid(s, "objects", {"bounding box overflows float range"});
 }
 
+// Issue 38: a camera far from the origin was refused as "up vector is parallel to the view
+// direction"; the cause is that the view vector's length overflows float.
+TEST(SceneValidate, CameraFarAwaySaysItsLengthOverflowsFloat) {
+    for (float far : {1e20f, 1e30f}) {
+        Scene s = valid_scene();
+        s.camera.type = CameraType::pinhole;
+        s.camera.eye = {0.0f, 0.0f, far};
+        s.camera.lookat = {0.0f, 0.0f, 0.0f};
+        s.camera.up = {0.0f, 1.0f, 0.0f};
+        expect_invalid(s, "camera", {"lookat - eye", "overflows float"});
+        s.camera.eye = {0.0f, 0.0f, 5.0f};
+        s.camera.up = {0.0f, far, 0.0f};
+        expect_invalid(s, "camera", {"up vector", "overflows float"});
+    }
+    Scene s = valid_scene();
+    s.camera.type = static_cast<CameraType>(7);
+    expect_invalid(s, "camera.type", {"found the value 7"});
+}
+
 }  // namespace
 }  // namespace octray

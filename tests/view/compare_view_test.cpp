@@ -163,6 +163,12 @@ TEST_F(CompareViewTest, BadRequestsAre400AndTheTokenIsNeeded) {
         ASSERT_TRUE(result) << path;
         EXPECT_EQ(result->status, 400) << path << " -> " << result->body;
     }
+    // Issue 38: the message said "expected a, b, diff or heatmap, found heatmap".
+    const auto heatmap_f32 = get("/api/image.f32?picture=heatmap");
+    ASSERT_TRUE(heatmap_f32);
+    EXPECT_EQ(heatmap_f32->body,
+              "picture: the heatmap is a PNG picture only (/api/image.png?picture=heatmap); "
+              "here expected a, b or diff\n");
     for (const char* path : {"/api/status", "/api/compare", "/api/image.f32"}) {
         const auto result = client_->Get(path);
         ASSERT_TRUE(result);

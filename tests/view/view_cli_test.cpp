@@ -6,9 +6,13 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "tests/tools/run_octray.h"
@@ -104,6 +108,54 @@ TEST(ViewCli, TwoImagesFailAsCompareFails) {
     const RunResult three = run_octray({"view", "a.exr", "a.exr", "a.exr"}, dir);
     EXPECT_EQ(three.status, 2) << three.output;
     std::filesystem::remove_all(dir);
+}
+
+// Issue 38: the viewer has no --channels; a channel mismatch suggested it. It names
+// `octray compare --channels` instead.
+TEST(ViewCli, AChannelMismatchPointsToCompareChannels) {
+    const std::filesystem::path dir =
+        kCwd / ("octray_view_cli_channels_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    RunResult r = run_octray({"render", "whitted,width=8,height=8", "-o", "a.exr"}, dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run_octray({"render", "whitted,width=8,height=8", "--aov", "depth", "-o", "b.exr"},
+                   dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run_octray({"view", "a.exr", "b.exr", "--port", "0"}, dir);
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "channel mismatch")) << r.output;
+    EXPECT_TRUE(contains(r.output, "octray compare A B --channels")) << r.output;
+    EXPECT_FALSE(contains(r.output, "(pick common ones with --channels)")) << r.output;
+    r = run_octray({"compare", "a.exr", "b.exr"}, dir);
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "pick common channels with --channels")) << r.output;
+    std::filesystem::remove_all(dir);
+}
+
+// Issue 38: `view --width 65536 --height 32767` started and failed on its first picture
+// with std::bad_alloc; it is refused up front by render's memory estimate (exit 2). The
+// watchdog ends a viewer that started serving instead.
+TEST(ViewCli, AnImageOverTheMemoryLimitIsRefusedBeforeServing) {
+    const std::string octray = OCTRAY_EXE;
+    const double memory_gib = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
+                              static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1u << 30);
+    for (const std::string limit : {"--max-memory 1G", ""}) {
+        // Without --max-memory the limit is this machine's memory: the picture's 114 GiB
+        // must be more than that.
+        if (limit.empty() && memory_gib > 100.0) continue;
+        const std::string line = "timeout -s KILL 60 " + octray +
+                                 " view whitted --width 65536 --height 32767 --port 0 " +
+                                 limit + " </dev/null >" +
+                                 (kCwd / "octray_view_mem.txt").string() + " 2>&1";
+        const int status = std::system(line.c_str());
+        std::ifstream in(kCwd / "octray_view_mem.txt");
+        const std::string output((std::istreambuf_iterator<char>(in)), {});
+        ASSERT_TRUE(WIFEXITED(status)) << output;
+        EXPECT_EQ(WEXITSTATUS(status), 2) << limit << ": " << output;
+        EXPECT_TRUE(contains(output, "needs about")) << output;
+        EXPECT_TRUE(contains(output, "memory limit")) << output;
+    }
+    std::filesystem::remove(kCwd / "octray_view_mem.txt");
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -145,6 +147,65 @@ TEST(ViewSave, WritesWhatRenderWrites) {
                       octray::make_exr_image(octray::render_packet(reloaded), {}, {}));
     EXPECT_EQ(octray::read_image((dir / "moved.exr").string()).planes,
               octray::read_image(expected_path.string()).planes);
+    server.stop();
+    fs::remove_all(dir);
+}
+
+// Issue 38: with a moved camera, save writes NAME.json beside NAME.exr. When that JSON is
+// the scene being viewed, "overwrite" replaced it (an animated scene lost its animation),
+// and a 409 named only the EXR. The viewed scene is never overwritten, and the 409 names
+// every file that exists.
+TEST(ViewSave, NeverOverwritesTheViewedSceneAndNamesEveryExistingFile) {
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("octray_view_save_source_" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const Scene scene = small_whitted();
+    const std::string source_text = octray::scene_to_json(scene);
+    {
+        std::ofstream(dir / "shot.json") << source_text;
+        std::ofstream(dir / "other.exr") << "x";
+        std::ofstream(dir / "other.json") << "y";
+    }
+    ViewSettings settings;
+    settings.threads = 2;
+    ViewSession session(scene, settings);
+    ServerOptions options;
+    octray::view::SaveSettings save;
+    save.spec = (dir / "shot.json").string();
+    save.directory = dir.string();
+    options.save = save;
+    ViewServer server(session, options);
+    server.start();
+    httplib::Client client("127.0.0.1", server.port());
+    client.set_read_timeout(60, 0);
+    const std::string url = "/api/save?token=" + server.token();
+
+    octray::Camera moved = scene.camera;
+    moved.eye.x += 1.0f;
+    session.set_camera(moved, false);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while ((!session.latest() || session.latest()->camera_version < 2 ||
+            session.latest()->spp < 4) &&
+           std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no refined picture";
+
+    auto result = client.Post(url, R"({"name": "other.exr"})", "application/json");
+    ASSERT_TRUE(result);
+    EXPECT_EQ(result->status, 409) << result->body;
+    EXPECT_NE(result->body.find("other.exr and other.json exist"), std::string::npos)
+        << result->body;
+
+    result = client.Post(url, R"({"name": "shot.exr", "overwrite": true})", "application/json");
+    ASSERT_TRUE(result);
+    EXPECT_EQ(result->status, 409) << result->body;
+    EXPECT_NE(result->body.find("shot.json is the scene being viewed"), std::string::npos)
+        << result->body;
+    std::ifstream in(dir / "shot.json");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), source_text);
+    EXPECT_FALSE(fs::exists(dir / "shot.exr"));
     server.stop();
     fs::remove_all(dir);
 }

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -169,7 +170,9 @@ TEST_F(ViewServerTest, BadCameraRequestsAre400AndChangeNothing) {
           std::string(R"({"fov": 180})"), std::string(R"({"moving": 1})"),
           std::string(R"({"zoom": 2})"),
           std::string(R"({"eye": [0, 0, 0], "lookat": [0, 0, 0]})"),
-          std::string(R"({"up": [0, 0, 0]})")}) {
+          std::string(R"({"up": [0, 0, 0]})"),
+          // Issue 38: a duplicate key, as a scene file's, is refused.
+          std::string(R"({"eye": [0, 1, 5], "eye": [0, 1, 6]})")}) {
         const auto result = client_->Post(with_token("/api/camera"), body, "application/json");
         ASSERT_TRUE(result) << body;
         EXPECT_EQ(result->status, 400) << body << " -> " << result->body;
@@ -356,6 +359,47 @@ TEST_F(ViewServerTest, AHundredReconnectsLeaveTheServerRunning) {
     EXPECT_EQ(s["frame"]["spp"], 4);
 }
 
+// Issue 38: every event stream held one of the 16 workers, so 16 open streams (tabs, or a
+// client opening many) left none for the API: /api/status hung until they closed. Streams
+// take at most half the workers, the others get 503 saying why, and the API answers.
+TEST_F(ViewServerTest, ManyEventStreamsLeaveTheApiAnswering) {
+    ASSERT_FALSE(wait_for_frame([](const json&) { return true; }).is_null());
+    std::atomic<int> refused{0}, open{0};
+    std::vector<std::thread> readers;
+    for (int i = 0; i < 24; ++i) {
+        readers.emplace_back([&] {
+            httplib::Client client("127.0.0.1", server_->port());
+            client.set_read_timeout(60, 0);
+            bool counted = false;
+            const auto result = client.Get(
+                with_token("/api/events"),
+                [&](const httplib::Response& response) {
+                    if (response.status == 200) {
+                        ++open;
+                        counted = true;
+                    }
+                    return true;
+                },
+                [&](const char*, std::size_t) { return true; });
+            if (result && result->status == 503) ++refused;
+            if (counted) --open;
+        });
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (open + refused < 24 && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    EXPECT_EQ(open + refused, 24) << "streams neither open nor refused";
+    EXPECT_EQ(open, 8);
+    httplib::Client api("127.0.0.1", server_->port());
+    api.set_read_timeout(20, 0);
+    const auto answer = api.Get(with_token("/api/status"));
+    ASSERT_TRUE(answer) << "the API did not answer with 24 streams asked for";
+    EXPECT_EQ(answer->status, 200);
+    server_->stop();  // ends the open streams
+    for (std::thread& reader : readers) reader.join();
+    EXPECT_EQ(refused, 16);
+}
+
 TEST_F(ViewServerTest, StopEndsAnOpenEventStream) {
     ASSERT_FALSE(wait_for_frame([](const json&) { return true; }).is_null());
     std::thread stopper([&] {
@@ -447,8 +491,10 @@ TEST_F(ViewServerTest, ThePixelEndpointReadsTheLatestPicture) {
     EXPECT_EQ(answer["width"], scene_.image.width);
     EXPECT_EQ(answer["height"], scene_.image.height);
     for (int c = 0; c < 3; ++c) EXPECT_EQ(answer["rgb"][c].get<float>(), expected[c]) << c;
-    for (const char* query : {"x=64&y=0", "x=0&y=36", "x=-1&y=0", "x=0", "y=0", "x=1e1&y=0",
-                              "x=&y=0", "x=0x1&y=0"}) {
+    // Decimal digits only, as the command line's integers (issue 38: "+1" and " 1" passed).
+    for (const char* query :
+         {"x=64&y=0", "x=0&y=36", "x=-1&y=0", "x=0", "y=0", "x=1e1&y=0", "x=&y=0", "x=0x1&y=0",
+          "x=%2B1&y=0", "x=%201&y=0", "x=1%20&y=0"}) {
         const auto bad = client_->Get(with_token(std::string("/api/pixel?") + query));
         ASSERT_TRUE(bad) << query;
         EXPECT_EQ(bad->status, 400) << query << " -> " << bad->body;

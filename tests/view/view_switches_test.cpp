@@ -79,6 +79,19 @@ TEST(ViewSwitches, PathAndIsaAreParsedAndChecked) {
         EXPECT_EQ(refusal(body, limits).first, 400) << body;
 }
 
+// Issue 38: one JSON rule everywhere. A duplicate key (which nlohmann would let the last
+// one win) and anything else a scene file refuses is refused, with the path and position.
+TEST(ViewSwitches, TheScenesJsonRulesApply) {
+    const SwitchLimits limits{{Isa::sse2}, 1};
+    const auto [status, message] = refusal(R"({"spp": 2, "spp": 4096})", limits);
+    EXPECT_EQ(status, 400);
+    EXPECT_NE(message.find("duplicate key \"spp\""), std::string::npos) << message;
+    for (const char* body : {R"({"spp": +1})", R"({"spp": 0x10})", R"({"spp": "1"})",
+                             R"({"spp": " 1"})", R"({"spp": 1e0})"})
+        EXPECT_EQ(refusal(body, limits).first, 400) << body;
+    EXPECT_EQ(refusal(std::string("{\"spp\": 1}\0", 11), limits).first, 400);
+}
+
 TEST(ViewSwitches, TheFrameIsParsedAndChecked) {
     const SwitchLimits limits{{Isa::sse2}, 48};
     const RenderSwitches s = parse_switches(R"({"frame": 47})", {}, limits);
