@@ -294,6 +294,27 @@ TEST_F(FrameLoopTest, CancelAbandonsTheFrameInProgressAndLeavesNothingBehind) {
     EXPECT_TRUE(files().empty());
 }
 
+// Pixels of the float EXR `file` (frame `frame` of `scene`, written by the frame loop) that
+// differ from the frame rendered on its own: the scene posed at that frame, compiled and
+// built afresh.
+std::size_t pixels_unlike_alone(const Scene& scene, int frame, const fs::path& file) {
+    RenderOptions options;
+    options.frame = static_cast<std::uint32_t>(frame);
+    const RenderResult alone =
+        render_packet(scene_at_frame(scene, frame), options, resolve_isa(Isa::automatic));
+    const ChannelImage image = read_image(file.string());
+    if (image.pixel_count() != alone.image.pixel_count()) return alone.image.pixel_count();
+    const float* r = image.plane(image.find_channel("R"));
+    const float* g = image.plane(image.find_channel("G"));
+    const float* b = image.plane(image.find_channel("B"));
+    std::size_t differ = 0;
+    for (std::size_t k = 0; k < alone.image.pixel_count(); ++k) {
+        const Rgb c = alone.image.data()[k];
+        differ += r[k] != c.r || g[k] != c.g || b[k] != c.b;
+    }
+    return differ;
+}
+
 // Refit (frame_loop.cpp, PreparedScene::update): an animation of moving and growing
 // spheres is prepared for its first frame and updated in place for the next ones (no
 // compile); every frame is, bit for bit, the frame rendered on its own.
@@ -331,23 +352,11 @@ TEST_F(FrameLoopTest, AnAnimationOfMovingSpheresIsRefitAndEachFrameIsTheSameBits
         EXPECT_EQ(observer.finished[f].compile_seconds, 0.0) << "frame " << f;
         EXPECT_GT(observer.finished[f].prepare_seconds, 0.0) << "frame " << f;
     }
-    for (int f = 0; f < 4; ++f) {
-        RenderOptions options;
-        options.frame = static_cast<std::uint32_t>(f);
-        const RenderResult alone =
-            render_packet(scene_at_frame(scenes_[0].scene, f), options, settings_.isa);
-        const ChannelImage file_image =
-            read_image((dir_ / ("m." + std::to_string(f) + ".exr")).string());
-        const float* r = file_image.plane(file_image.find_channel("R"));
-        const float* g = file_image.plane(file_image.find_channel("G"));
-        const float* b = file_image.plane(file_image.find_channel("B"));
-        std::size_t differ = 0;
-        for (std::size_t k = 0; k < alone.image.pixel_count(); ++k) {
-            const Rgb c = alone.image.data()[k];
-            differ += r[k] != c.r || g[k] != c.g || b[k] != c.b;
-        }
-        EXPECT_EQ(differ, 0u) << "frame " << f;
-    }
+    for (int f = 0; f < 4; ++f)
+        EXPECT_EQ(pixels_unlike_alone(scenes_[0].scene, f,
+                                      dir_ / ("m." + std::to_string(f) + ".exr")),
+                  0u)
+            << "frame " << f;
 }
 
 // Prepare once (frame_loop.cpp): a camera-only animation on the simd path compiles the
@@ -383,24 +392,11 @@ TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBit
         EXPECT_EQ(observer.finished[f].prepare_seconds, 0.0) << "frame " << f;
         EXPECT_EQ(observer.finished[f].bvh_seconds, 0.0) << "frame " << f;
     }
-    for (int f = 0; f < 3; ++f) {
-        RenderOptions options;
-        options.frame = static_cast<std::uint32_t>(f);
-        const RenderResult alone =
-            render_packet(scene_at_frame(scenes_[0].scene, f), options, settings_.isa);
-        const ChannelImage file_image =
-            read_image((dir_ / ("o." + std::to_string(f) + ".exr")).string());
-        ASSERT_EQ(file_image.pixel_count(), alone.image.pixel_count());
-        const float* r = file_image.plane(file_image.find_channel("R"));
-        const float* g = file_image.plane(file_image.find_channel("G"));
-        const float* b = file_image.plane(file_image.find_channel("B"));
-        std::size_t differ = 0;
-        for (std::size_t k = 0; k < alone.image.pixel_count(); ++k) {
-            const Rgb c = alone.image.data()[k];
-            differ += r[k] != c.r || g[k] != c.g || b[k] != c.b;
-        }
-        EXPECT_EQ(differ, 0u) << "frame " << f;
-    }
+    for (int f = 0; f < 3; ++f)
+        EXPECT_EQ(pixels_unlike_alone(scenes_[0].scene, f,
+                                      dir_ / ("o." + std::to_string(f) + ".exr")),
+                  0u)
+            << "frame " << f;
 }
 
 }  // namespace

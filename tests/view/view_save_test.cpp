@@ -34,15 +34,21 @@ using octray::view::ViewSession;
 using octray::view::ViewSettings;
 using octray::view::test::small_whitted;
 
+// A new empty directory for one test (this process's, under the temporary directory).
+std::filesystem::path empty_directory(const std::string& prefix) {
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / (prefix + std::to_string(getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
 // POST /api/save writes the refined picture as `octray render` writes the same scene and
 // spp (same pixels, same header attributes), in the save directory only, refusing names
 // with a path and files that exist unless asked; a moved camera writes its scene beside.
 TEST(ViewSave, WritesWhatRenderWrites) {
     namespace fs = std::filesystem;
-    const fs::path dir =
-        fs::temp_directory_path() / ("octray_view_save_" + std::to_string(getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = empty_directory("octray_view_save_");
     const Scene scene = small_whitted();
     ViewSettings settings;
     settings.threads = 2;
@@ -157,10 +163,7 @@ TEST(ViewSave, WritesWhatRenderWrites) {
 // every file that exists.
 TEST(ViewSave, NeverOverwritesTheViewedSceneAndNamesEveryExistingFile) {
     namespace fs = std::filesystem;
-    const fs::path dir =
-        fs::temp_directory_path() / ("octray_view_save_source_" + std::to_string(getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = empty_directory("octray_view_save_source_");
     const Scene scene = small_whitted();
     const std::string source_text = octray::scene_to_json(scene);
     {
