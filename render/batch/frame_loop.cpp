@@ -96,6 +96,10 @@ class BatchRunner {
     // camera. One prepared scene at a time (the memory estimate counts one).
     std::optional<PreparedScene> prepared_;
     std::size_t prepared_index_ = 0;
+    // A camera-only animation's posed copy (scene camera_posed_index_), its camera set
+    // frame by frame.
+    std::optional<Scene> camera_posed_;
+    std::size_t camera_posed_index_ = 0;
 };
 
 }  // namespace
@@ -254,10 +258,26 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         if (!job.png.empty()) remove_stale_temporaries(job.png);
         observer_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
 
-        // A still scene is its own pose: no copy of its (possibly millions of) objects.
+        // A still scene is its own pose: no copy of its (possibly millions of) objects. A
+        // camera-only animation is posed (copied and validated) for its first frame only;
+        // its next frames set the camera of that copy (validate_scene checked every
+        // frame's camera when the scene was loaded). Moving objects pose every frame.
         std::optional<Scene> animated;
-        if (scene.scene.animation) animated = scene_at_frame(scene.scene, job.frame);
-        const Scene& posed = animated ? *animated : scene.scene;
+        const Scene* pose = &scene.scene;
+        if (scene.scene.animation && objects_still(scene.scene)) {
+            if (camera_posed_ && camera_posed_index_ == job.scene) {
+                camera_posed_->camera = camera_at_frame(scene.scene, job.frame);
+            } else {
+                camera_posed_.reset();
+                camera_posed_ = scene_at_frame(scene.scene, job.frame);
+                camera_posed_index_ = job.scene;
+            }
+            pose = &*camera_posed_;
+        } else if (scene.scene.animation) {
+            animated = scene_at_frame(scene.scene, job.frame);
+            pose = &*animated;
+        }
+        const Scene& posed = *pose;
         RenderOptions options = settings_.options;
         options.frame = static_cast<std::uint32_t>(job.frame);
         options.cancel = cancel_;
