@@ -295,6 +295,26 @@ struct Tile {
     int x0, y0, width, height;  // in pixels of the full image
 };
 
+// A rectangle cut into tiles of options' size, row by row from its corner. A tile larger
+// than the rectangle is the rectangle (and the tile counts cannot overflow).
+struct TileGrid {
+    PixelRect rect;
+    int tw, th, tiles_x, tiles_y;
+
+    TileGrid(const PixelRect& r, const RenderOptions& options)
+        : rect(r),
+          tw(std::clamp(options.tile_width, 1, r.width())),
+          th(std::clamp(options.tile_height, 1, r.height())),
+          tiles_x((r.width() + tw - 1) / tw),
+          tiles_y((r.height() + th - 1) / th) {}
+
+    int count() const { return tiles_x * tiles_y; }
+    Tile at(int t) const {
+        const int x0 = rect.x0 + (t % tiles_x) * tw, y0 = rect.y0 + (t / tiles_x) * th;
+        return Tile{x0, y0, std::min(tw, rect.x1 - x0), std::min(th, rect.y1 - y0)};
+    }
+};
+
 // Where a render's tiles go: the crop-sized image (and, for a progressive pass, the sums),
 // and which samples of each pixel to trace (render/crop.h).
 struct RenderTarget {
@@ -630,10 +650,7 @@ RenderResult render_frame(const CompiledScene& scene, FrameTree tree,
         target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
         target.sums = &result.sample_sums;
     }
-    // A tile larger than the rectangle is the rectangle (and tiles_x cannot overflow).
-    const int tw = std::clamp(options.tile_width, 1, rect.width());
-    const int th = std::clamp(options.tile_height, 1, rect.height());
-    const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
+    const TileGrid grid(rect, options);
     TileTallies tallies;
     TileControl control(options);
 
@@ -650,13 +667,7 @@ RenderResult render_frame(const CompiledScene& scene, FrameTree tree,
             tree.is_prepared ? tree.prepared : (build_bvh ? &bvh : nullptr),
             ray_chunk_of(options));
         trace_tiles(
-            tracer, target, tiles_x * tiles_y,
-            [&](int t) {
-                const int x0 = rect.x0 + (t % tiles_x) * tw;
-                const int y0 = rect.y0 + (t / tiles_x) * th;
-                return Tile{x0, y0, std::min(tw, rect.x1 - x0), std::min(th, rect.y1 - y0)};
-            },
-            control, tallies);
+            tracer, target, grid.count(), [&](int t) { return grid.at(t); }, control, tallies);
     };
     run_with_threads(options.threads, render_tiles);
     control.finish();
@@ -691,22 +702,15 @@ FirstHits trace_first_hits(const PreparedScene& prepared, const RenderOptions& o
     out.t.assign(out.rect.pixel_count(), std::numeric_limits<float>::infinity());
     out.object.assign(out.rect.pixel_count(), kernels::kNoHit);
     const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
-    const PixelRect rect = out.rect;
-    const int tw = std::max(1, options.tile_width), th = std::max(1, options.tile_height);
-    const int tiles_x = (rect.width() + tw - 1) / tw, tiles_y = (rect.height() + th - 1) / th;
+    const TileGrid grid(out.rect, options);
     run_with_threads(options.threads, [&] {
         const PacketTracer tracer(scene, table, options.frame, prepared.bvh(),
                                   ray_chunk_of(options));
-        tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
+        tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1),
                           [&](const tbb::blocked_range<int>& range) {
                               TileScratch& s = scratch_for_thread();
-                              for (int t = range.begin(); t < range.end(); ++t) {
-                                  const int x0 = rect.x0 + (t % tiles_x) * tw;
-                                  const int y0 = rect.y0 + (t / tiles_x) * th;
-                                  tracer.first_hits(Tile{x0, y0, std::min(tw, rect.x1 - x0),
-                                                         std::min(th, rect.y1 - y0)},
-                                                    s, out);
-                              }
+                              for (int t = range.begin(); t < range.end(); ++t)
+                                  tracer.first_hits(grid.at(t), s, out);
                           });
     });
     return out;
@@ -732,13 +736,7 @@ PreparedScene::PreparedScene(const Scene& scene, Accel accel, int threads)
 void PreparedScene::build() {
     run_with_threads(threads_, [&] { bvh_ = build_sphere_bvh(compiled_.spheres); });
     built_cost_ = sphere_bvh_cost(bvh_);
-    // Leaf slot i holds the sphere of file index bvh_.object[i]: its compiled index.
-    std::vector<std::uint32_t> compiled_index(compiled_.objects.count, 0);
-    for (std::uint32_t s = 0; s < compiled_.spheres.count; ++s)
-        compiled_index[compiled_.spheres.object[s]] = s;
-    leaf_sphere_.resize(bvh_.sphere_count);
-    for (std::uint32_t i = 0; i < bvh_.sphere_count; ++i)
-        leaf_sphere_[i] = compiled_index[bvh_.object[i]];
+    leaf_sphere_.clear();  // found by the first refit of this tree
 }
 
 PreparedScene::Update PreparedScene::update(const Scene& posed) {
@@ -747,6 +745,15 @@ PreparedScene::Update PreparedScene::update(const Scene& posed) {
     run_with_threads(threads_, [&] { update_compiled_spheres(compiled_, posed); });
     set_camera(posed.camera);
     if (use_bvh_) {
+        if (leaf_sphere_.empty()) {
+            // Leaf slot i holds the sphere of file index bvh_.object[i]: its compiled index.
+            std::vector<std::uint32_t> compiled_index(compiled_.objects.count, 0);
+            for (std::uint32_t s = 0; s < compiled_.spheres.count; ++s)
+                compiled_index[compiled_.spheres.object[s]] = s;
+            leaf_sphere_.resize(bvh_.sphere_count);
+            for (std::uint32_t i = 0; i < bvh_.sphere_count; ++i)
+                leaf_sphere_[i] = compiled_index[bvh_.object[i]];
+        }
         run_with_threads(threads_,
                          [&] { refit_sphere_bvh(bvh_, compiled_.spheres, leaf_sphere_); });
         u.cost_growth = built_cost_ > 0.0 ? sphere_bvh_cost(bvh_) / built_cost_ : 1.0;

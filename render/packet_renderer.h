@@ -81,7 +81,8 @@ class PreparedScene {
     int threads_ = 0;
     SphereBvh bvh_;
     double built_cost_ = 0.0;                 // sphere_bvh_cost when last built
-    std::vector<std::uint32_t> leaf_sphere_;  // leaf slot -> compiled sphere (refits)
+    std::vector<std::uint32_t> leaf_sphere_;  // leaf slot -> compiled sphere (the first
+                                              // refit of a tree finds it)
 };
 
 // Renders a frame of a prepared scene (its camera as set_camera left it): no compile and no

@@ -116,6 +116,35 @@ class FrameLoopTest : public ::testing::Test {
 
     fs::path output(int frame) const { return dir_ / ("w." + std::to_string(frame) + ".exr"); }
 
+    // Spheres s0 ... s47 on a grid over a plane (past the 32 spheres from which the simd
+    // path builds a BVH), with `animation`, as NAME.json, rendered to PREFIX.#.exr in float.
+    static constexpr int kGridSpheres = 48;
+    static Vec3 grid_center(int k) {
+        return {float(k % 8 - 4), float(k / 8 % 3), float(k / 24 - 1)};
+    }
+    void load_grid_scene(const std::string& name, const std::string& animation,
+                         const std::string& prefix) {
+        std::string json = R"({"image": {"width": 24, "height": 16},
+            "camera": {"eye": [0, 3, 12], "lookat": [0, 0, 0], "fov": 50},
+            "materials": {"m": {"color": [0.8, 0.5, 0.3], "ks": 0.3, "reflect": 0.3}},
+            "lights": [{"type": "point", "position": [5, 9, 6], "color": 1}],
+            "objects": [{"type": "plane", "point": [0, -2, 0], "normal": [0, 1, 0],
+                         "material": "m"})";
+        for (int k = 0; k < kGridSpheres; ++k) {
+            const Vec3 c = grid_center(k);
+            json += R"(, {"type": "sphere", "name": "s)" + std::to_string(k) +
+                    R"(", "center": [)" + std::to_string(c.x) + ", " + std::to_string(c.y) +
+                    ", " + std::to_string(c.z) + R"(], "radius": 0.4, "material": "m"})";
+        }
+        json += R"(], "animation": )" + animation + "}";
+        const fs::path file = dir_ / (name + ".json");
+        std::ofstream(file) << json;
+        request_ = BatchRequest{};
+        request_.output = (dir_ / (prefix + ".#.exr")).string();
+        scenes_ = {load_batch_scene(file.string(), request_)};
+        settings_.exr.float32 = true;
+    }
+
     std::set<std::string> files() const {
         std::set<std::string> names;
         for (const auto& entry : fs::directory_iterator(dir_))
@@ -319,29 +348,15 @@ std::size_t pixels_unlike_alone(const Scene& scene, int frame, const fs::path& f
 // spheres is prepared for its first frame and updated in place for the next ones (no
 // compile); every frame is, bit for bit, the frame rendered on its own.
 TEST_F(FrameLoopTest, AnAnimationOfMovingSpheresIsRefitAndEachFrameIsTheSameBits) {
-    std::string json = R"({"image": {"width": 24, "height": 16},
-        "camera": {"eye": [0, 3, 12], "lookat": [0, 0, 0], "fov": 50},
-        "materials": {"m": {"color": [0.8, 0.5, 0.3], "ks": 0.3, "reflect": 0.3}},
-        "lights": [{"type": "point", "position": [5, 9, 6], "color": 1}],
-        "objects": [{"type": "plane", "point": [0, -2, 0], "normal": [0, 1, 0], "material": "m"})";
     std::string tracks;
-    for (int k = 0; k < 48; ++k) {
-        const std::string x = std::to_string(k % 8 - 4), y = std::to_string(k / 8 % 3),
-                          z = std::to_string(k / 24 - 1), name = "s" + std::to_string(k);
-        json += R"(, {"type": "sphere", "name": ")" + name + R"(", "center": [)" + x + ", " +
-                y + ", " + z + R"(], "radius": 0.4, "material": "m"})";
-        tracks += std::string(k == 0 ? "" : ", ") + "\"" + name +
-                  R"(": [{"frame": 0, "radius": 0.4}, {"frame": 3, "center": [)" + x + ".5, " +
-                  y + ".25, " + z + R"(], "radius": 0.45}])";
+    for (int k = 0; k < kGridSpheres; ++k) {
+        const Vec3 c = grid_center(k);
+        tracks += std::string(k == 0 ? "" : ", ") + "\"s" + std::to_string(k) +
+                  R"(": [{"frame": 0, "radius": 0.4}, {"frame": 3, "center": [)" +
+                  std::to_string(c.x + 0.5f) + ", " + std::to_string(c.y + 0.25f) + ", " +
+                  std::to_string(c.z) + R"(], "radius": 0.45}])";
     }
-    json += R"(], "animation": {"frames": 4, "objects": {)" + tracks + "}}}";
-    const fs::path file = dir_ / "moving.json";
-    std::ofstream(file) << json;
-    BatchRequest request;
-    request.output = (dir_ / "m.#.exr").string();
-    scenes_ = {load_batch_scene(file.string(), request)};
-    request_ = request;
-    settings_.exr.float32 = true;
+    load_grid_scene("moving", R"({"frames": 4, "objects": {)" + tracks + "}}", "m");
 
     RecordingObserver observer;
     const BatchSummary summary = run(observer);
@@ -363,24 +378,9 @@ TEST_F(FrameLoopTest, AnAnimationOfMovingSpheresIsRefitAndEachFrameIsTheSameBits
 // scene and builds its BVH for its first frame only, and every frame is, bit for bit, the
 // frame rendered on its own (the scene posed at that frame, compiled and built afresh).
 TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBits) {
-    std::string json = R"({"image": {"width": 24, "height": 16},
-        "camera": {"eye": [0, 3, 12], "lookat": [0, 0, 0], "fov": 50},
-        "materials": {"m": {"color": [0.8, 0.5, 0.3], "ks": 0.3, "reflect": 0.3}},
-        "lights": [{"type": "point", "position": [5, 9, 6], "color": 1}],
-        "objects": [{"type": "plane", "point": [0, -2, 0], "normal": [0, 1, 0], "material": "m"})";
-    for (int k = 0; k < 48; ++k)  // past the 32 spheres from which the simd path builds a BVH
-        json += R"(, {"type": "sphere", "center": [)" + std::to_string(k % 8 - 4) + ", " +
-                std::to_string(k / 8 % 3) + ", " + std::to_string(k / 24 - 1) +
-                R"(], "radius": 0.4, "material": "m"})";
-    json += R"(], "animation": {"frames": 3, "camera": [
-        {"frame": 0, "eye": [0, 3, 12]}, {"frame": 2, "eye": [9, 5, 7], "fov": 40}]}})";
-    const fs::path file = dir_ / "orbit.json";
-    std::ofstream(file) << json;
-    BatchRequest request;
-    request.output = (dir_ / "o.#.exr").string();
-    scenes_ = {load_batch_scene(file.string(), request)};
-    request_ = request;
-    settings_.exr.float32 = true;
+    load_grid_scene("orbit", R"({"frames": 3, "camera": [
+        {"frame": 0, "eye": [0, 3, 12]}, {"frame": 2, "eye": [9, 5, 7], "fov": 40}]})",
+                    "o");
 
     RecordingObserver observer;
     const BatchSummary summary = run(observer);
