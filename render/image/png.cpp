@@ -99,7 +99,7 @@ bool write_rgb8_rows(png_structp png, png_infop info, PngIo* io, png_uint_32 wid
     // zlib's fastest level and one filter (each byte minus its left neighbour's): a PNG
     // octray writes is wanted soon rather than small. On a 1280x720 whitted preview this
     // writes 4x faster than libpng's defaults (level 6, a filter chosen per row), for a
-    // file 30 % larger (docs/performance-log.md, "Writing the image").
+    // file 30 % larger (docs/performance-log.md, "The finished frame").
     png_set_compression_level(png, 1);
     png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
     png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
@@ -168,13 +168,17 @@ float srgb_encode(float linear) {
                                 : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
+}  // namespace
+
 // The preview's byte by the formula: a power and a rounding per channel, which cost more
 // than the trace of a simple scene at 1280x720. srgb8 finds the same byte in a table.
-std::uint8_t srgb8_formula(float linear) {
+std::uint8_t srgb8_by_formula(float linear) {
     // NaN fails both comparisons and lands on 0, like negative values; +inf clamps to 1.
     const float clamped = linear > 0.0f ? (linear < 1.0f ? linear : 1.0f) : 0.0f;
     return static_cast<std::uint8_t>(std::lround(srgb_encode(clamped) * 255.0f));
 }
+
+namespace {
 
 // threshold[v] (v = 1 ... 255): the smallest float that srgb8_formula maps to v or more.
 // The formula never decreases as its argument grows, so the byte of x is the number of
@@ -195,12 +199,12 @@ struct SrgbTable {
             std::uint32_t lo = 0, hi = kOneBits;  // formula(lo) < v <= formula(hi)
             while (hi - lo > 1) {
                 const std::uint32_t mid = lo + (hi - lo) / 2;
-                (srgb8_formula(std::bit_cast<float>(mid)) >= v ? hi : lo) = mid;
+                (srgb8_by_formula(std::bit_cast<float>(mid)) >= v ? hi : lo) = mid;
             }
             threshold[v] = std::bit_cast<float>(hi);
         }
         for (std::uint32_t b = 0; b <= (kOneBits >> 16); ++b)
-            bucket_start[b] = srgb8_formula(std::bit_cast<float>(b << 16));
+            bucket_start[b] = srgb8_by_formula(std::bit_cast<float>(b << 16));
     }
 };
 
@@ -215,8 +219,6 @@ std::uint8_t srgb8(float linear) {
     while (linear >= table.threshold[v + 1]) ++v;
     return static_cast<std::uint8_t>(v);
 }
-
-std::uint8_t srgb8_by_formula(float linear) { return srgb8_formula(linear); }
 
 namespace {
 
