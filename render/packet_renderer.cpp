@@ -742,20 +742,29 @@ void PreparedScene::build() {
 PreparedScene::Update PreparedScene::update(const Scene& posed) {
     const auto start = std::chrono::steady_clock::now();
     Update u;
-    run_with_threads(threads_, [&] { update_compiled_spheres(compiled_, posed); });
     set_camera(posed.camera);
+    if (use_bvh_ && leaf_sphere_.empty()) {
+        // Leaf slot i holds the sphere of file index bvh_.object[i]: its compiled index.
+        std::vector<std::uint32_t> compiled_index(compiled_.objects.count, 0);
+        for (std::uint32_t s = 0; s < compiled_.spheres.count; ++s)
+            compiled_index[compiled_.spheres.object[s]] = s;
+        leaf_sphere_.resize(bvh_.sphere_count);
+        for (std::uint32_t i = 0; i < bvh_.sphere_count; ++i)
+            leaf_sphere_[i] = compiled_index[bvh_.object[i]];
+    }
+    const auto write_and_refit = [&] {
+        update_compiled_spheres(compiled_, posed);
+        if (use_bvh_) refit_sphere_bvh(bvh_, compiled_.spheres, leaf_sphere_);
+    };
+    // One arena for both steps, and none below kArenaUpdateSpheres spheres: their update
+    // is tens of microseconds of work, less than waking the workers of an arena (1024
+    // spheres took 195 us in two arenas against Embree's 23 us refit; the rule:
+    // bench/README.md, "Refit").
+    if (compiled_.spheres.count < kArenaUpdateSpheres)
+        write_and_refit();
+    else
+        run_with_threads(threads_, write_and_refit);
     if (use_bvh_) {
-        if (leaf_sphere_.empty()) {
-            // Leaf slot i holds the sphere of file index bvh_.object[i]: its compiled index.
-            std::vector<std::uint32_t> compiled_index(compiled_.objects.count, 0);
-            for (std::uint32_t s = 0; s < compiled_.spheres.count; ++s)
-                compiled_index[compiled_.spheres.object[s]] = s;
-            leaf_sphere_.resize(bvh_.sphere_count);
-            for (std::uint32_t i = 0; i < bvh_.sphere_count; ++i)
-                leaf_sphere_[i] = compiled_index[bvh_.object[i]];
-        }
-        run_with_threads(threads_,
-                         [&] { refit_sphere_bvh(bvh_, compiled_.spheres, leaf_sphere_); });
         u.cost_growth = built_cost_ > 0.0 ? sphere_bvh_cost(bvh_) / built_cost_ : 1.0;
         if (u.cost_growth > kRefitCostLimit) {
             build();

@@ -66,6 +66,8 @@ class PreparedScene {
     // Measured (docs/performance-log.md, "Refit"): past this growth a frame traces slower
     // through the refit tree than a rebuild costs.
     static constexpr double kRefitCostLimit = 2.0;
+    // Fewer spheres than this are updated on the calling thread's arena (update()).
+    static constexpr std::uint32_t kArenaUpdateSpheres = 16384;
     const CompiledScene& compiled() const { return compiled_; }
     // The spheres' BVH, or nullptr where the scene is traced brute force.
     const SphereBvh* bvh() const { return use_bvh_ ? &bvh_ : nullptr; }

@@ -3,7 +3,11 @@
 
 #include "scene/animation.h"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -110,15 +114,35 @@ void visit_camera_frames(const Scene& scene, int first, int last,
     for (int f = first; f <= last; ++f) visit(f, tracks.pose(scene.camera, clamp_frame(a, f)));
 }
 
-Scene scene_at_frame(const Scene& scene, int frame) {
-    if (!scene.animation) return scene;
-    const Animation& a = *scene.animation;
-    const int f = clamp_frame(a, frame);
-    const std::string at = "at frame " + std::to_string(frame) +
-                           (f != frame ? " (posed as frame " + std::to_string(f) + ")" : "");
+namespace {
 
-    Scene posed = scene;
-    posed.animation.reset();
+// The value at `frame` of the property that `get` reads from a sphere's keys: the same
+// interpolation as PropertyTrack::at, read from the keys directly (posing a million
+// spheres a frame should not build two small vectors for each).
+template <typename T, typename Get>
+std::optional<T> object_property_at(const std::vector<ObjectKey>& keys, int frame, Get get) {
+    const ObjectKey* before = nullptr;  // the last key that sets it at or before `frame`
+    const ObjectKey* after = nullptr;   // the first key that sets it after `frame`
+    for (const ObjectKey& k : keys) {
+        if (!get(k)) continue;
+        if (k.frame > frame) {
+            after = &k;
+            break;
+        }
+        before = &k;
+    }
+    if (before == nullptr) return after != nullptr ? get(*after) : std::nullopt;
+    if (after == nullptr) return get(*before);
+    const double t = (static_cast<double>(frame) - before->frame) /
+                     (static_cast<double>(after->frame) - before->frame);
+    return lerp_value(*get(*before), *get(*after), t);
+}
+
+// Sets the camera and every animated sphere of `posed` (a copy of `scene`'s objects) to
+// their values at frame `f` (clamped). Returns whether every moved sphere is still usable
+// (finite center, finite positive radius), the check validate_scene would make of it.
+bool pose_in_place(const Scene& scene, int f, Scene& posed) {
+    const Animation& a = *scene.animation;
     posed.camera = camera_at_frame(scene, f);
     for (const ObjectTrack& track : a.objects) {
         if (track.object >= posed.objects.size()) {
@@ -127,20 +151,67 @@ Scene scene_at_frame(const Scene& scene, int frame) {
                                  std::to_string(track.object) + "], but the scene has " +
                                  std::to_string(posed.objects.size()) + " objects");
         }
-        Object& o = posed.objects[track.object];
-        const auto& keys = track.keys;
-        const PropertyTrack<Vec3> center(keys, [](const ObjectKey& k) { return k.center; });
-        const PropertyTrack<float> radius(keys, [](const ObjectKey& k) { return k.radius; });
-        if (auto v = center.at(f)) o.center = *v;
-        if (auto v = radius.at(f)) o.radius = *v;
     }
+    std::atomic<bool> usable{true};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.objects.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          bool ok = true;
+                          for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                              const ObjectTrack& track = a.objects[i];
+                              Object& o = posed.objects[track.object];
+                              const auto& keys = track.keys;
+                              if (auto v = object_property_at<Vec3>(
+                                      keys, f, [](const ObjectKey& k) { return k.center; }))
+                                  o.center = *v;
+                              if (auto v = object_property_at<float>(
+                                      keys, f, [](const ObjectKey& k) { return k.radius; }))
+                                  o.radius = *v;
+                              ok &= is_finite(o.center) && std::isfinite(o.radius) &&
+                                    o.radius > 0.0f;
+                          }
+                          if (!ok) usable = false;
+                      });
+    return usable;
+}
+
+// "at frame 7" or "at frame 60 (posed as frame 47)".
+std::string frame_label(const Animation& a, int frame) {
+    const int f = clamp_frame(a, frame);
+    return "at frame " + std::to_string(frame) +
+           (f != frame ? " (posed as frame " + std::to_string(f) + ")" : "");
+}
+
+// validate_scene(posed), its errors naming the frame.
+void validate_pose(const Scene& scene, int frame, const Scene& posed) {
     try {
         validate_scene(posed);
     } catch (const SceneError& e) {
         throw SceneError(e.file(), e.json_path(),
-                         at + ", as posed by the animation: " + bare_message(e));
+                         frame_label(*scene.animation, frame) +
+                             ", as posed by the animation: " + bare_message(e));
     }
+}
+
+}  // namespace
+
+Scene scene_at_frame(const Scene& scene, int frame) {
+    if (!scene.animation) return scene;
+    Scene posed = scene;
+    posed.animation.reset();
+    pose_in_place(scene, clamp_frame(*scene.animation, frame), posed);
+    validate_pose(scene, frame, posed);
     return posed;
+}
+
+void repose_at_frame(const Scene& scene, int frame, Scene& posed) {
+    if (!scene.animation) return;
+    const bool usable = pose_in_place(scene, clamp_frame(*scene.animation, frame), posed);
+    // Only the camera and the moved spheres changed since posed was validated: the camera
+    // of every frame was checked when the scene loaded, the spheres just now, and what
+    // else a pose can break is the spheres' bounding box. Anything wrong takes the whole
+    // validation, for the message scene_at_frame would give.
+    if (!usable || !std::isfinite(self_intersection_epsilon(posed)))
+        validate_pose(scene, frame, posed);
 }
 
 double frame_time(const Scene& scene, int frame) {

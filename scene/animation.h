@@ -71,6 +71,13 @@ void visit_camera_frames(const Scene& scene, int first, int last,
 // skipped validate_scene) throws SceneError with the path and "at frame N" in the message.
 Scene scene_at_frame(const Scene& scene, int frame);
 
+// Poses `posed` at `frame` in place: `posed` is what scene_at_frame(scene, f) returned
+// for some frame f of the same `scene` (possibly reposed since). Only the camera and the
+// animated spheres are written, nothing else is copied, and only what they can break is
+// checked again; an unusable pose throws the SceneError scene_at_frame would. Nothing
+// for a still scene. After a throw, posed holds a mix of frames until its next repose.
+void repose_at_frame(const Scene& scene, int frame, Scene& posed);
+
 // Seconds: frame / fps (kStillFps for a still scene).
 double frame_time(const Scene& scene, int frame);
 

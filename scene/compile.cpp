@@ -3,6 +3,7 @@
 #include <math.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <bit>
@@ -75,15 +76,20 @@ void update_compiled_spheres(CompiledScene& out, const Scene& scene) {
         throw std::invalid_argument(
             "update_compiled_spheres: the scene has " + std::to_string(scene.objects.size()) +
             " objects, the compiled one " + std::to_string(out.objects.count));
-    out.epsilon = self_intersection_epsilon(scene);
+    // The spheres' box (the self-intersection epsilon follows it) in the same pass.
     const CompiledSpheres& s = out.spheres;
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, s.count, 1u << 14),
-                      [&](const tbb::blocked_range<std::uint32_t>& r) {
-                          for (std::uint32_t si = r.begin(); si < r.end(); ++si) {
-                              const std::uint32_t k = s.object[si];
-                              write_sphere(out, si, k, scene.objects[k]);
-                          }
-                      });
+    const SphereBox box = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(0, s.count, 1u << 14), SphereBox{},
+        [&](const tbb::blocked_range<std::uint32_t>& r, SphereBox part) {
+            for (std::uint32_t si = r.begin(); si < r.end(); ++si) {
+                const std::uint32_t k = s.object[si];
+                write_sphere(out, si, k, scene.objects[k]);
+                part.add(scene.objects[k]);
+            }
+            return part;
+        },
+        SphereBox::unite);
+    out.epsilon = self_intersection_epsilon(scene, box);
 }
 
 CompiledScene compile_scene(const Scene& scene) {

@@ -10,10 +10,6 @@
 
 #include "scene/camera.h"
 
-namespace {
-constexpr float kHuge = 3.0e38f;
-}
-
 namespace octray {
 
 namespace {
@@ -53,19 +49,18 @@ std::vector<std::string> scene_warnings(const Scene& scene) {
     return out;
 }
 
+float self_intersection_epsilon(const Scene& scene, const SphereBox& box) {
+    if (scene.render.epsilon) return *scene.render.epsilon;
+    const float extent = box.any ? length(box.hi - box.lo) : 0.0f;
+    return 1e-4f * std::max(1.0f, extent);
+}
+
 float self_intersection_epsilon(const Scene& scene) {
     if (scene.render.epsilon) return *scene.render.epsilon;
-    bool any_sphere = false;
-    Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
-    for (const Object& o : scene.objects) {
-        if (o.type != ObjectType::sphere) continue;
-        const Vec3 r{o.radius, o.radius, o.radius};
-        lo = min(lo, o.center - r);
-        hi = max(hi, o.center + r);
-        any_sphere = true;
-    }
-    const float extent = any_sphere ? length(hi - lo) : 0.0f;
-    return 1e-4f * std::max(1.0f, extent);
+    SphereBox box;
+    for (const Object& o : scene.objects)
+        if (o.type == ObjectType::sphere) box.add(o);
+    return self_intersection_epsilon(scene, box);
 }
 
 TangentBasis checker_basis(Vec3 n) {

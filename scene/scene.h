@@ -125,6 +125,27 @@ std::vector<std::string> scene_warnings(const Scene& scene);
 // 1e-4 * max(1, diagonal of the bounding box of all spheres); planes are ignored.
 float self_intersection_epsilon(const Scene& scene);
 
+// The spheres' bounding box, as self_intersection_epsilon measures it; empty (lo > hi)
+// without spheres. Boxes of parts of the spheres unite with `unite`, in any order, to the
+// same bits.
+struct SphereBox {
+    Vec3 lo{3.0e38f, 3.0e38f, 3.0e38f}, hi{-3.0e38f, -3.0e38f, -3.0e38f};
+    bool any = false;
+
+    void add(const Object& sphere) {
+        const Vec3 r{sphere.radius, sphere.radius, sphere.radius};
+        lo = min(lo, sphere.center - r);
+        hi = max(hi, sphere.center + r);
+        any = true;
+    }
+    static SphereBox unite(const SphereBox& a, const SphereBox& b) {
+        return {min(a.lo, b.lo), max(a.hi, b.hi), a.any || b.any};
+    }
+};
+
+// self_intersection_epsilon of `scene` whose spheres' box is `box`.
+float self_intersection_epsilon(const Scene& scene, const SphereBox& box);
+
 // The checker's tangent basis for a plane normal N: T1 is the world axis along which |N|
 // has its smallest component (x, then y, then z on ties), made orthogonal to N and
 // normalised; T2 = T1 x N.

@@ -275,6 +275,52 @@ TEST(AnimationPose, PosedSceneIsAStillAndDeterministic) {
     EXPECT_TRUE(same_bits(s.objects[1].center, Vec3{-1, 0.5f, 0}));
 }
 
+TEST(AnimationPose, ReposingInPlaceGivesTheSceneOfThatFrame) {
+    // Partial keys on both spheres, a radius track, frames before, between, on and after
+    // the keys, in an order that goes back and forth.
+    Json j = base_scene();
+    j["animation"]["objects"]["moon"] = Json::array({{{"frame", 3}, {"radius", 1}},
+                                                     {{"frame", 9}, {"center", {1, 3, -4}}},
+                                                     {{"frame", 30}, {"radius", 2}}});
+    const Scene s = parse(j);
+    Scene posed = scene_at_frame(s, 0);
+    for (int f : {5, 6, 47, 0, 30, 29, 3, -2, 60, 9, 17}) {
+        repose_at_frame(s, f, posed);
+        EXPECT_EQ(scene_to_json(posed), scene_to_json(scene_at_frame(s, f))) << f;
+    }
+}
+
+TEST(AnimationError, ReposingToAnUnusableFrameGivesTheErrorOfPosingIt) {
+    Json j = base_scene();
+    j["animation"]["objects"]["moon"] =
+        Json::array({{{"frame", 0}, {"radius", 1}}, {{"frame", 40}, {"radius", 3}}});
+    Scene s = parse(j);
+    s.animation->objects.back().keys.back().radius = -3.0f;  // skips validate_scene
+    Scene posed = scene_at_frame(s, 0);
+    const auto message = [&](const std::function<void()>& pose) {
+        try {
+            pose();
+        } catch (const SceneError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    const std::string expected = message([&] { (void)scene_at_frame(s, 35); });
+    EXPECT_NE(expected.find("at frame 35, as posed by the animation"), std::string::npos)
+        << expected;
+    EXPECT_NE(expected.find("objects[2].radius"), std::string::npos) << expected;
+    EXPECT_EQ(message([&] { repose_at_frame(s, 35, posed); }), expected);
+    // The next frame poses every animated sphere again.
+    repose_at_frame(s, 5, posed);
+    EXPECT_EQ(scene_to_json(posed), scene_to_json(scene_at_frame(s, 5)));
+
+    // A bounding box that overflows float is found too.
+    s.animation->objects.back().keys.back().radius = 3e38f;
+    const std::string overflow = message([&] { (void)scene_at_frame(s, 40); });
+    EXPECT_NE(overflow.find("overflows float"), std::string::npos) << overflow;
+    EXPECT_EQ(message([&] { repose_at_frame(s, 40, posed); }), overflow);
+}
+
 // ---------------------------------------------------------------------------------------
 // Errors
 
