@@ -166,6 +166,12 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
     if (params.png_preview)
         e.output = sat_add(e.output, sat_add(sat_mul(pixels, kPngBytesPerPixel),
                                              sat_mul(height, kPngBytesPerRow)));
+    // Writing behind: the frame being written keeps its image and its files' buffers
+    // while the next frame renders into its own.
+    if (params.write_behind) {
+        e.framebuffer = sat_add(e.framebuffer, sat_mul(pixels, kFramebufferBytesPerPixel));
+        e.output = sat_mul(e.output, 2);
+    }
 
     // The authored scene (scene/scene.h), its compiled copy and the BVH.
     std::uint64_t spheres = 0, planes = 0, names = 0;

@@ -35,6 +35,9 @@ struct RenderMemoryParams {
     int exr_lines_per_chunk = 16;    // the codec's scan lines per block (zip: 16, dwab: 256)
     bool png_preview = false;        // --png
     bool progressive = false;        // --progressive: a pass renders while the last is kept
+    // A frame's image and files are written while the next frame renders: two frames'
+    // images and EXR channels at once (batch::BatchSettings::write_behind).
+    bool write_behind = false;
     // --aov: the buffers of compute_aovs and their EXR channels.
     bool aov_depth = false, aov_normal = false, aov_albedo = false, aov_id = false;
     std::uint64_t scene_file_bytes = 0;  // the JSON file the scene was parsed from (0: none)

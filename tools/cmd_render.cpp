@@ -269,6 +269,10 @@ void run_render(const RenderArguments& args) {
     memory.aov_normal = settings.aovs.normal;
     memory.aov_albedo = settings.aovs.albedo;
     memory.aov_id = settings.aovs.id;
+    // A frame is written while the next one renders (--progressive writes its passes as
+    // they finish).
+    bool write_behind = !args.progressive;
+    memory.write_behind = write_behind;
     for (batch::BatchScene& scene : scenes) {
         if (!args.crop.empty()) {
             try {
@@ -281,6 +285,13 @@ void run_render(const RenderArguments& args) {
         if (memory_limit > 0) {
             const auto size = file_sizes.find(scene.spec);
             memory.scene_file_bytes = size != file_sizes.end() ? size->second : 0;
+            // Writing a frame while the next renders holds a second frame: within the
+            // limit, or the frames are written one after another instead.
+            if (memory.write_behind) {
+                memory.write_behind =
+                    estimate_render_memory(scene.scene, memory).total <= memory_limit;
+                write_behind = memory.write_behind;
+            }
             try {
                 check_memory_limit(scene.scene, memory_limit, memory);
             } catch (const SceneError& e) {
@@ -293,6 +304,7 @@ void run_render(const RenderArguments& args) {
         usage_errors([&] { return batch::plan_jobs(scenes, request); });
     const std::size_t planned = jobs.size();
     jobs = batch::select_shard(jobs, shard);
+    settings.write_behind = write_behind && jobs.size() > 1;
     // On stderr, so that standard output stays the progress format (--progress json).
     for (const std::string& dir : batch::prepare_output_directories(jobs))
         std::fprintf(stderr, "octray: created output directory %s/\n", dir.c_str());

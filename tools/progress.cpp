@@ -208,9 +208,12 @@ void ProgressReporter::frame_finished(const FrameReport& report, std::uint64_t w
         note_locked("octray: frame " + std::to_string(report.frame) + " of " +
                     report.scene_spec + " failed: " + report.message);
     work_done_ += work;
-    current_work_ = 0;
-    pixels_done_.store(0, std::memory_order_relaxed);
-    current_index_ = report.index;
+    // A frame written behind ends while the next one renders: that one's progress stays.
+    if (report.index >= current_index_) {
+        current_work_ = 0;
+        pixels_done_.store(0, std::memory_order_relaxed);
+        current_index_ = report.index;
+    }
     if (report.outcome == FrameOutcome::rendered) {
         rays_done_ += report.rays;
         render_seconds_ += report.trace_seconds;

@@ -7,10 +7,14 @@
 #include <chrono>
 #include <cstdint>
 #include <ctime>
+#include <exception>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <new>
 #include <optional>
 #include <system_error>
+#include <thread>
 #include <utility>
 
 #include "core/version.h"
@@ -62,28 +66,103 @@ std::uint64_t frame_work(const BatchScene& scene) {
     return rect.pixel_count() * static_cast<std::uint64_t>(image.spp);
 }
 
+// The reason a frame failed, from what its render or write threw.
+void record_failure(FrameResult& out, const std::exception_ptr& error) {
+    out.report.outcome = FrameOutcome::failed;
+    try {
+        std::rethrow_exception(error);
+    } catch (const RenderCancelled&) {
+        out.failure = FailureKind::interrupted;
+        out.report.message = "interrupted";
+    } catch (const SceneError& e) {
+        out.failure = FailureKind::scene;
+        out.report.message = std::string("scene error: ") + e.what();
+    } catch (const IoError& e) {
+        out.failure = FailureKind::io;
+        out.report.message = std::string("I/O error: ") + e.what();
+    } catch (const std::bad_alloc&) {
+        out.failure = FailureKind::internal;
+        out.report.message = "out of memory";
+    } catch (const std::exception& e) {
+        out.failure = FailureKind::internal;
+        out.report.message = std::string("internal error: ") + e.what();
+    }
+}
+
+// A frame's files, ready to write: the EXR (channels converted, attributes set) and where
+// the preview of its pixels goes.
+struct FrameFiles {
+    std::string exr_path, png_path;  // either may be empty
+    ExrImage exr;
+
+    // Both are written atomically, each on its own; the frame counts as finished only
+    // when both are (resume.h).
+    void write(const Image& pixels) const {
+        if (exr_path.empty()) {
+            write_png_preview(png_path, pixels);
+        } else if (png_path.empty()) {
+            write_exr(exr_path, exr);
+        } else {
+            // The preview is encoded while OpenEXR compresses the EXR's blocks: on 2
+            // cores the two files take the time of the longer one.
+            tbb::parallel_invoke([&] { write_exr(exr_path, exr); },
+                                 [&] { write_png_preview(png_path, pixels); });
+        }
+    }
+};
+
+// A rendered frame whose files a thread of its own writes while the next frame renders.
+struct PendingWrite {
+    FrameResult result;  // the frame's report, but for its outcome and write time
+    std::uint64_t work = 0;
+    std::string claimed;  // its placeholder, released if the write fails
+    Clock::time_point started;
+    FrameFiles files;
+    Image pixels;
+    double seconds = 0.0;
+    std::exception_ptr error;
+    std::thread writer;
+};
+
 class BatchRunner {
   public:
+    using Account = std::function<void(const FrameResult&)>;
+
     BatchRunner(const std::vector<BatchScene>& scenes, const BatchSettings& settings,
-                BatchObserver& observer, const std::atomic<bool>* cancel)
+                BatchObserver& observer, const std::atomic<bool>* cancel, Account account)
         : scenes_(scenes),
           settings_(settings),
           observer_(observer),
           cancel_(cancel),
+          account_(std::move(account)),
           owner_(current_owner()) {}
+    BatchRunner(const BatchRunner&) = delete;
+    BatchRunner& operator=(const BatchRunner&) = delete;
+    // A frame still being written when the run ends by an exception is waited for, not
+    // reported.
+    ~BatchRunner() {
+        if (pending_) pending_->writer.join();
+    }
 
-    FrameResult run(std::size_t index, const BatchJob& job);
+    // Renders and writes one job; every frame that ends (this one, or the one written
+    // behind it) goes to the observer and the account. Returns false when the cancel flag
+    // stopped this frame mid-render (it is not reported).
+    bool run(std::size_t index, const BatchJob& job);
+    // Waits for the frame being written behind, if any, and reports it.
+    void finish_pending();
 
   private:
     ExrAttributes attributes(const BatchScene& scene, const Scene& posed, int frame,
                              const RenderResult& result, int samples_so_far) const;
-    void write_outputs(const BatchScene& scene, const BatchJob& job, const Scene& posed,
-                       const RenderResult& result, const AovImages& aovs, int samples_so_far);
+    FrameFiles files(const BatchScene& scene, const BatchJob& job, const Scene& posed,
+                     const RenderResult& result, const AovImages& aovs, int samples_so_far);
+    void finish(const FrameResult& out, std::uint64_t work);
 
     const std::vector<BatchScene>& scenes_;
     const BatchSettings& settings_;
     BatchObserver& observer_;
     const std::atomic<bool>* cancel_;
+    Account account_;
     std::string owner_;  // octray.owner of this run's unfinished passes
     // The last frame written: the next frame renders into its storage (RenderOptions::
     // spare_image), so only a run's first frame maps fresh pages for its pixels.
@@ -96,10 +175,11 @@ class BatchRunner {
     // camera. One prepared scene at a time (the memory estimate counts one).
     std::optional<PreparedScene> prepared_;
     std::size_t prepared_index_ = 0;
-    // A camera-only animation's posed copy (scene camera_posed_index_), its camera set
-    // frame by frame.
-    std::optional<Scene> camera_posed_;
-    std::size_t camera_posed_index_ = 0;
+    // An animated scene's posed copy (scene posed_index_), reposed frame by frame.
+    std::optional<Scene> posed_;
+    std::size_t posed_index_ = 0;
+    // The frame being written behind (settings_.write_behind), at most one.
+    std::unique_ptr<PendingWrite> pending_;
 };
 
 }  // namespace
@@ -152,32 +232,48 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
                                  samples_so_far, owner_);
 }
 
-void BatchRunner::write_outputs(const BatchScene& scene, const BatchJob& job,
-                                const Scene& posed, const RenderResult& result,
-                                const AovImages& aovs, int samples_so_far) {
+FrameFiles BatchRunner::files(const BatchScene& scene, const BatchJob& job, const Scene& posed,
+                              const RenderResult& result, const AovImages& aovs,
+                              int samples_so_far) {
+    FrameFiles f;
     if (settings_.png_output) {
-        write_png_preview(job.output, result.image);
-        return;
+        f.png_path = job.output;
+        return f;
     }
-    ExrImage exr = make_exr_image(result, settings_.exr,
-                                  attributes(scene, posed, job.frame, result, samples_so_far),
-                                  std::move(spare_channels_));
+    f.exr_path = job.output;
+    f.png_path = job.png;
+    f.exr = make_exr_image(result, settings_.exr,
+                           attributes(scene, posed, job.frame, result, samples_so_far),
+                           std::move(spare_channels_));
     if (aovs.set.any())
-        append_aov_channels(exr, aovs,
+        append_aov_channels(f.exr, aovs,
                             settings_.exr.float32 ? ExrPixelType::float32 : ExrPixelType::half);
-    if (job.png.empty()) {
-        write_exr(job.output, exr);
-    } else {
-        // The preview is encoded while OpenEXR compresses the EXR's blocks: on 2 cores the
-        // two files take the time of the longer one. Both are written atomically, each on
-        // its own; the frame counts as finished only when both are (resume.h).
-        tbb::parallel_invoke([&] { write_exr(job.output, exr); },
-                             [&] { write_png_preview(job.png, result.image); });
-    }
-    spare_channels_ = std::move(exr.channels);
+    return f;
 }
 
-FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
+void BatchRunner::finish(const FrameResult& out, std::uint64_t work) {
+    if (out.failure != FailureKind::interrupted) observer_.frame_finished(out.report, work);
+    account_(out);
+}
+
+void BatchRunner::finish_pending() {
+    if (!pending_) return;
+    const std::unique_ptr<PendingWrite> p = std::move(pending_);
+    p->writer.join();
+    FrameResult& out = p->result;
+    out.report.write_seconds += p->seconds;
+    if (p->error) {
+        record_failure(out, p->error);
+        if (!p->claimed.empty()) release_claim(p->claimed);
+    }
+    out.report.seconds = std::chrono::duration<double>(Clock::now() - p->started).count();
+    // Its storage serves the frame after the next.
+    spare_frame_ = std::move(p->pixels);
+    spare_channels_ = std::move(p->files.exr.channels);
+    finish(out, p->work);
+}
+
+bool BatchRunner::run(std::size_t index, const BatchJob& job) {
     const BatchScene& scene = scenes_[job.scene];
     FrameResult out;
     out.report.index = index;
@@ -188,10 +284,15 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
     out.report.preview = job.png;
     const std::uint64_t work = frame_work(scene);
 
+    // A frame that ends before it renders: the one written behind is reported first.
+    const auto end_early = [&] {
+        finish_pending();
+        finish(out, work);
+        return true;
+    };
     const auto skip = [&](FrameOutcome outcome) {
         out.report.outcome = outcome;
-        observer_.frame_finished(out.report, work);
-        return out;
+        return end_early();
     };
     // A directory at an output path can never be replaced by an image: the frame fails
     // before any time is spent rendering it, and it never counts as finished or claimed.
@@ -202,8 +303,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         out.report.outcome = FrameOutcome::failed;
         out.report.message = "I/O error: cannot write " + *file +
                              ": it is a directory; expected an image file (or nothing) there";
-        observer_.frame_finished(out.report, work);
-        return out;
+        return end_early();
     }
     // Resume and claims. A frame is finished only when all its outputs are (the EXR and
     // the --png preview); one missing output makes it render again.
@@ -225,8 +325,7 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
             out.report.message = "I/O error: " + damaged->error +
                                  "; not a finished frame, and left alone: remove it to "
                                  "render the frame again";
-            observer_.frame_finished(out.report, work);
-            return out;
+            return end_early();
         }
         if (existing == Existing::claim || preview == Existing::claim)
             return skip(FrameOutcome::skipped_claimed);
@@ -258,24 +357,20 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         if (!job.png.empty()) remove_stale_temporaries(job.png);
         observer_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
 
-        // A still scene is its own pose: no copy of its (possibly millions of) objects. A
-        // camera-only animation is posed (copied and validated) for its first frame only;
-        // its next frames set the camera of that copy (validate_scene checked every
-        // frame's camera when the scene was loaded). Moving objects pose every frame.
-        std::optional<Scene> animated;
+        // A still scene is its own pose: no copy of its (possibly millions of) objects. An
+        // animated scene is posed (copied and validated) for its first frame only; its
+        // next frames repose that copy in place: the camera and the moving spheres
+        // (validate_scene checked every frame's camera when the scene was loaded).
         const Scene* pose = &scene.scene;
-        if (scene.scene.animation && objects_still(scene.scene)) {
-            if (camera_posed_ && camera_posed_index_ == job.scene) {
-                camera_posed_->camera = camera_at_frame(scene.scene, job.frame);
+        if (scene.scene.animation) {
+            if (posed_ && posed_index_ == job.scene) {
+                repose_at_frame(scene.scene, job.frame, *posed_);
             } else {
-                camera_posed_.reset();
-                camera_posed_ = scene_at_frame(scene.scene, job.frame);
-                camera_posed_index_ = job.scene;
+                posed_.reset();
+                posed_ = scene_at_frame(scene.scene, job.frame);
+                posed_index_ = job.scene;
             }
-            pose = &*camera_posed_;
-        } else if (scene.scene.animation) {
-            animated = scene_at_frame(scene.scene, job.frame);
-            pose = &*animated;
+            pose = &*posed_;
         }
         const Scene& posed = *pose;
         RenderOptions options = settings_.options;
@@ -336,7 +431,9 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         double write_seconds = 0.0;
         const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
             const auto write_started = Clock::now();
-            write_outputs(scene, job, posed, r, aovs, samples_so_far);
+            FrameFiles f = files(scene, job, posed, r, aovs, samples_so_far);
+            f.write(r.image);
+            spare_channels_ = std::move(f.exr.channels);
             write_seconds +=
                 std::chrono::duration<double>(Clock::now() - write_started).count();
         };
@@ -357,39 +454,51 @@ FrameResult BatchRunner::run(std::size_t index, const BatchJob& job) {
         out.report.trace_seconds =
             std::chrono::duration<double>(Clock::now() - trace_started).count() -
             write_seconds - prepare_seconds;
-        timed_write(result, posed.image.spp);
-        spare_frame_ = std::move(result.image);
-        out.report.write_seconds = write_seconds;
         out.report.load_seconds = scene.load_seconds;
         out.report.render_seconds =
             result.seconds - result.compile_seconds - result.bvh_seconds;
         out.report.rays = result.rays.total();
+        // The frame written behind this one is on disk before this one's files start:
+        // at most one frame in flight.
+        finish_pending();
+        if (settings_.write_behind && !settings_.progressive) {
+            auto p = std::make_unique<PendingWrite>();
+            const auto write_started = Clock::now();
+            p->files = files(scene, job, posed, result, aovs, posed.image.spp);
+            p->seconds = std::chrono::duration<double>(Clock::now() - write_started).count();
+            p->pixels = std::move(result.image);
+            out.report.write_seconds = write_seconds;
+            p->result = std::move(out);
+            p->work = work;
+            p->claimed = claimed;
+            p->started = started;
+            p->writer = std::thread([w = p.get()] {
+                const auto write_started = Clock::now();
+                try {
+                    w->files.write(w->pixels);
+                } catch (...) {
+                    w->error = std::current_exception();
+                }
+                w->seconds +=
+                    std::chrono::duration<double>(Clock::now() - write_started).count();
+            });
+            pending_ = std::move(p);
+            return true;
+        }
+        timed_write(result, posed.image.spp);
+        spare_frame_ = std::move(result.image);
+        out.report.write_seconds = write_seconds;
         out.report.outcome = FrameOutcome::rendered;
-    } catch (const RenderCancelled&) {
-        out.failure = FailureKind::interrupted;
-        out.report.outcome = FrameOutcome::failed;
-        out.report.message = "interrupted";
-    } catch (const SceneError& e) {
-        out.failure = FailureKind::scene;
-        out.report.outcome = FrameOutcome::failed;
-        out.report.message = std::string("scene error: ") + e.what();
-    } catch (const IoError& e) {
-        out.failure = FailureKind::io;
-        out.report.outcome = FrameOutcome::failed;
-        out.report.message = std::string("I/O error: ") + e.what();
-    } catch (const std::bad_alloc&) {
-        out.failure = FailureKind::internal;
-        out.report.outcome = FrameOutcome::failed;
-        out.report.message = "out of memory";
-    } catch (const std::exception& e) {
-        out.failure = FailureKind::internal;
-        out.report.outcome = FrameOutcome::failed;
-        out.report.message = std::string("internal error: ") + e.what();
+    } catch (...) {
+        record_failure(out, std::current_exception());
     }
-    if (out.failure != FailureKind::none && !claimed.empty()) release_claim(claimed);
+    if (out.failure != FailureKind::none) {
+        finish_pending();  // the frame before this one is reported first
+        if (!claimed.empty()) release_claim(claimed);
+    }
     out.report.seconds = std::chrono::duration<double>(Clock::now() - started).count();
-    if (out.failure != FailureKind::interrupted) observer_.frame_finished(out.report, work);
-    return out;
+    finish(out, work);
+    return out.failure != FailureKind::interrupted;
 }
 
 }  // namespace
@@ -425,15 +534,8 @@ BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<
                           total_work});
 
     const auto cancelled = [cancel] { return cancel != nullptr && cancel->load(); };
-    BatchRunner runner(scenes, settings, observer, cancel);
     BatchSummary summary;
-    const auto started = Clock::now();
-    for (std::size_t k = 0; k < jobs.size(); ++k) {
-        if (cancelled()) {
-            summary.not_started = jobs.size() - k;
-            break;
-        }
-        const FrameResult result = runner.run(k + 1, jobs[k]);
+    const auto account = [&summary](const FrameResult& result) {
         switch (result.report.outcome) {
             case FrameOutcome::rendered:
                 ++summary.rendered;
@@ -447,18 +549,30 @@ BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<
                 ++summary.skipped;
                 break;
             case FrameOutcome::failed:
-                if (result.failure == FailureKind::interrupted) {
+                if (result.failure == FailureKind::interrupted)
                     summary.interrupted_frames = 1;  // abandoned mid-render
-                    summary.not_started = jobs.size() - k - 1;
-                    k = jobs.size();
-                } else {
+                else
                     ++summary.failed;
-                }
                 break;
         }
         summary.scene_failure |= result.failure == FailureKind::scene;
         summary.io_failure |= result.failure == FailureKind::io;
         summary.internal_failure |= result.failure == FailureKind::internal;
+    };
+    const auto started = Clock::now();
+    {
+        BatchRunner runner(scenes, settings, observer, cancel, account);
+        for (std::size_t k = 0; k < jobs.size(); ++k) {
+            if (cancelled()) {
+                summary.not_started = jobs.size() - k;
+                break;
+            }
+            if (!runner.run(k + 1, jobs[k])) {
+                summary.not_started = jobs.size() - k - 1;
+                break;
+            }
+        }
+        runner.finish_pending();
     }
     summary.interrupted = cancelled();
     // The run's time counts its scenes' loading (done before it, once per scene).

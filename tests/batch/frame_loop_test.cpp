@@ -13,8 +13,10 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <atomic>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -61,10 +63,12 @@ class RecordingObserver : public BatchObserver {
                        std::uint64_t work, int spp) override {
         pixels = 0;
         started.push_back({index, scene, frame, work, spp});
+        events.push_back("start " + std::to_string(index));
         if (on_frame_started) on_frame_started(frame);
     }
     void frame_finished(const FrameReport& report, std::uint64_t work) override {
         finished.push_back(report);
+        events.push_back("finish " + std::to_string(report.index));
         finished_work.push_back(work);
         pixels_at_finish.push_back(pixels.load());
     }
@@ -88,6 +92,7 @@ class RecordingObserver : public BatchObserver {
     std::atomic<std::uint64_t> pixels{0};
     std::vector<Started> started;
     std::vector<FrameReport> finished;
+    std::vector<std::string> events;  // "start 2", "finish 1", ...
     std::vector<std::uint64_t> finished_work, pixels_at_finish;
     BatchSummary summary;
 };
@@ -397,6 +402,113 @@ TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBit
                                       dir_ / ("o." + std::to_string(f) + ".exr")),
                   0u)
             << "frame " << f;
+}
+
+// Write behind (BatchSettings::write_behind): each frame's files are written while the
+// next frame renders. The frames are those written one by one (bit for bit the frame
+// rendered alone), each is reported once, in order, with its preview, and nothing else is
+// left in the directory.
+TEST_F(FrameLoopTest, WritingBehindGivesEveryFrameAsRenderedAloneReportedOnceInOrder) {
+    std::string tracks;
+    for (int k = 0; k < kGridSpheres; k += 3)
+        tracks += std::string(k == 0 ? "" : ", ") + "\"s" + std::to_string(k) +
+                  R"(": [{"frame": 0, "radius": 0.4}, {"frame": 4, "radius": 0.7}])";
+    load_grid_scene("behind", R"({"frames": 5, "objects": {)" + tracks + "}}", "b");
+    request_.png = (dir_ / "b.#.png").string();
+    settings_.write_behind = true;
+
+    RecordingObserver observer;
+    const BatchSummary summary = run(observer);
+    EXPECT_EQ(summary.rendered, 5u);
+    EXPECT_FALSE(summary.io_failure || summary.internal_failure || summary.interrupted);
+    // Frame N is reported once its files are written, after frame N + 1 has rendered.
+    EXPECT_EQ(observer.events, (std::vector<std::string>{
+                                   "start 1", "start 2", "finish 1", "start 3", "finish 2",
+                                   "start 4", "finish 3", "start 5", "finish 4", "finish 5"}));
+    ASSERT_EQ(observer.started.size(), 5u);
+    ASSERT_EQ(observer.finished.size(), 5u);
+    std::set<std::string> expected;
+    for (int f = 0; f < 5; ++f) {
+        const FrameReport& r = observer.finished[static_cast<std::size_t>(f)];
+        EXPECT_EQ(r.index, static_cast<std::size_t>(f) + 1);
+        EXPECT_EQ(r.frame, f);
+        EXPECT_EQ(r.outcome, FrameOutcome::rendered);
+        EXPECT_GT(r.write_seconds, 0.0) << "frame " << f;
+        const std::string name = "b." + std::to_string(f);
+        EXPECT_EQ(pixels_unlike_alone(scenes_[0].scene, f, dir_ / (name + ".exr")), 0u)
+            << "frame " << f;
+        expected.insert(name + ".exr");
+        expected.insert(name + ".png");
+    }
+    expected.insert("behind.json");
+    EXPECT_EQ(files(), expected);
+}
+
+// Write behind: a write that fails while the next frame renders fails its own frame (an
+// I/O error, nothing left of it, its claim released) and the others are written. The
+// failure: a file size limit (RLIMIT_FSIZE, which binds root too) that only the large
+// frame's uncompressed EXR exceeds.
+TEST_F(FrameLoopTest, AWriteThatFailsWhileTheNextFrameRendersFailsThatFrameAlone) {
+    BatchRequest small_request, large_request;
+    small_request.overrides.width = 8, small_request.overrides.height = 8;
+    large_request.overrides.width = 160, large_request.overrides.height = 160;
+    scenes_ = {load_batch_scene("whitted", small_request),
+               load_batch_scene("whitted", large_request)};
+    const std::vector<BatchJob> jobs = {{0, 0, (dir_ / "small.0.exr").string(), ""},
+                                        {1, 0, (dir_ / "large.0.exr").string(), ""},
+                                        {0, 1, (dir_ / "small.1.exr").string(), ""}};
+    settings_.exr = {true, ExrCompression::none};  // 160 x 160 x 12 bytes: 300 KiB
+    settings_.write_behind = true;
+    settings_.placeholders = true;  // the large frame's claim is released when it fails
+
+    rlimit before{};
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &before), 0);
+    rlimit limit = before;
+    limit.rlim_cur = 64 * 1024;
+    const auto previous_handler = std::signal(SIGXFSZ, SIG_IGN);  // EFBIG, not a signal
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+    RecordingObserver observer;
+    const BatchSummary summary = run_batch(scenes_, jobs, settings_, observer, nullptr);
+    setrlimit(RLIMIT_FSIZE, &before);
+    std::signal(SIGXFSZ, previous_handler);
+
+    // The large frame's write failed while the last frame rendered.
+    EXPECT_EQ(observer.events, (std::vector<std::string>{"start 1", "start 2", "finish 1",
+                                                         "start 3", "finish 2", "finish 3"}));
+    ASSERT_EQ(observer.finished.size(), 3u);
+    EXPECT_EQ(observer.finished[0].outcome, FrameOutcome::rendered);
+    EXPECT_EQ(observer.finished[1].outcome, FrameOutcome::failed);
+    EXPECT_EQ(observer.finished[1].output, jobs[1].output);
+    EXPECT_EQ(observer.finished[1].message.rfind("I/O error: ", 0), 0u)
+        << observer.finished[1].message;
+    EXPECT_EQ(observer.finished[2].outcome, FrameOutcome::rendered);
+    EXPECT_EQ(summary.rendered, 2u);
+    EXPECT_EQ(summary.failed, 1u);
+    EXPECT_TRUE(summary.io_failure);
+    EXPECT_FALSE(summary.internal_failure || summary.interrupted);
+    EXPECT_EQ(files(), (std::set<std::string>{"small.0.exr", "small.1.exr"}));
+}
+
+// Write behind and cancel: the frame being written when the next one is cancelled is
+// finished and reported; the cancelled one is abandoned as always.
+TEST_F(FrameLoopTest, CancelWhileAFrameIsWrittenBehindKeepsThatFrame) {
+    settings_.write_behind = true;
+    std::atomic<bool> cancel{false};
+    RecordingObserver observer;
+    observer.on_frame_started = [&](int frame) {
+        if (frame == 1) cancel = true;
+    };
+    const BatchSummary summary = run(observer, &cancel);
+    EXPECT_EQ(observer.events, (std::vector<std::string>{"start 1", "start 2", "finish 1"}));
+    ASSERT_EQ(observer.finished.size(), 1u);
+    EXPECT_EQ(observer.finished[0].frame, 0);
+    EXPECT_EQ(observer.finished[0].outcome, FrameOutcome::rendered);
+    EXPECT_TRUE(summary.interrupted);
+    EXPECT_EQ(summary.rendered, 1u);
+    EXPECT_EQ(summary.interrupted_frames, 1u);
+    EXPECT_EQ(summary.not_started, 1u);
+    EXPECT_EQ(files(), (std::set<std::string>{"w.0.exr"}));
+    EXPECT_EQ(read_image(output(0).string()).width, kWidth);
 }
 
 }  // namespace

@@ -63,6 +63,21 @@ TEST(RenderMemory, AovsFloatOutputAndProgressivePassesAreCounted) {
     EXPECT_LT(plain.total, all.total);
 }
 
+// Write behind (batch::BatchSettings::write_behind): the frame being written keeps its
+// image and its files' buffers while the next frame renders, so both count twice.
+TEST(RenderMemory, AFrameWrittenBehindCountsItsImageAndFilesTwice) {
+    RenderMemoryParams p;
+    p.threads = 1;
+    p.png_preview = true;
+    const Scene s = image_scene(1920, 1080);
+    const RenderMemoryEstimate one = estimate_render_memory(s, p);
+    p.write_behind = true;
+    const RenderMemoryEstimate behind = estimate_render_memory(s, p);
+    EXPECT_EQ(behind.framebuffer, one.framebuffer + 1920u * 1080u * 12u);
+    EXPECT_EQ(behind.output, 2 * one.output);
+    EXPECT_EQ(behind.total - one.total, 1920u * 1080u * 12u + one.output);
+}
+
 // A scene file is estimated from its size before it is parsed.
 TEST(MemoryLimit, ASceneFileTooLargeToParseIsRefusedFromItsSize) {
     const std::uint64_t bytes = std::uint64_t{350} << 20;     // 5 M spheres as JSON

@@ -5,6 +5,8 @@
 // estimate is read through the option itself: with the limit one byte below the measured
 // peak, the same command line must be refused before rendering.
 
+#include "render/memory_estimate.h"
+
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -17,6 +19,7 @@
 #include <vector>
 
 #include "run_octray.h"
+#include "scene/load.h"
 
 namespace {
 
@@ -124,6 +127,25 @@ TEST_F(MemoryEstimateTest, ASceneFileWhoseParseDominates) {
     ASSERT_EQ(written.status, 0) << written.output;
     expect_estimate_covers_peak({"render", "big.json", "--width", "32", "--height", "18",
                                  "--accel", "none", "-o", "b.exr"});
+}
+
+// Frames written behind the next frame's render (a multi-frame run holds two frames at a
+// time): the peak of the run stays within the estimate with RenderMemoryParams::
+// write_behind, the one `octray render` admits such a run with.
+TEST_F(MemoryEstimateTest, FramesWrittenWhileTheNextRendersStayWithinTheEstimate) {
+    if (kSanitized) GTEST_SKIP() << "a sanitizer's shadow memory is not in the estimate";
+    const Peak peak =
+        run_measured({"render", "whitted", "--width", "1920", "--height", "1080", "--frames",
+                      "0-3", "--float", "--png", "w.#.png", "-o", "w.#.exr", "--threads", "2"},
+                     dir_);
+    ASSERT_EQ(peak.status, 0);
+    octray::RenderMemoryParams params;
+    params.threads = 2;
+    params.float32_output = true;
+    params.png_preview = true;
+    params.write_behind = true;
+    const octray::Scene scene = octray::load_scene("whitted,width=1920,height=1080");
+    EXPECT_LE(peak.bytes, octray::estimate_render_memory(scene, params).total);
 }
 
 // An image whose framebuffer alone exceeds this machine's memory (the largest the pixel
