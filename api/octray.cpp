@@ -12,6 +12,7 @@
 #include <exception>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -399,9 +400,18 @@ std::vector<Isa> supported_isas() {
     return out;
 }
 
-RenderResult render(const Scene& scene, const RenderOptions& options) try {
-    return translate_errors([&] {
-        if (options.frame < 0) throw std::invalid_argument("render: frame must be >= 0");
+// The render options checked, and the scene they apply to, once per Renderer.
+struct Renderer::Impl {
+    RenderOptions options;
+    octray::Scene source;  // the overrides applied, validated
+    octray::RenderOptions internal;
+    octray::Isa isa = octray::Isa::automatic;  // resolved (simd path)
+    // The last frame's pose of an animated scene, reposed in place for the next.
+    std::optional<octray::Scene> posed;
+    // The simd path's compiled scene and BVH, from the first frame on.
+    std::optional<octray::PreparedScene> prepared;
+
+    Impl(const Scene& scene, const RenderOptions& o) : options(o) {
         // The command line's limits (render --help): a thread count beyond them would ask
         // the OS for that many threads (INT_MAX crashed TBB), a negative size or spp was
         // silently ignored.
@@ -412,43 +422,84 @@ RenderResult render(const Scene& scene, const RenderOptions& options) try {
         if (options.width < 0 || options.height < 0 || options.spp < 0)
             throw std::invalid_argument(
                 "render: width, height and spp must be >= 0 (0 keeps the scene's)");
-        octray::Scene s = SceneAccess::get(scene);
-        if (options.width > 0) s.image.width = options.width;
-        if (options.height > 0) s.image.height = options.height;
-        if (options.spp > 0) s.image.spp = options.spp;
-        validate_scene(s);
-        const octray::Scene posed = scene_at_frame(s, options.frame);
-
-        octray::RenderOptions o;
-        o.threads = options.threads;
-        o.frame = static_cast<std::uint32_t>(options.frame);
-        o.tile_width = options.tile_width;
-        o.tile_height = options.tile_height;
-        if (o.tile_width < 1 || o.tile_height < 1) {
+        if (options.tile_width < 1 || options.tile_height < 1)
             throw std::invalid_argument("render: tiles must be at least 1x1");
-        }
+        source = SceneAccess::get(scene);
+        if (options.width > 0) source.image.width = options.width;
+        if (options.height > 0) source.image.height = options.height;
+        if (options.spp > 0) source.image.spp = options.spp;
+        validate_scene(source);
+        internal.threads = options.threads;
+        internal.tile_width = options.tile_width;
+        internal.tile_height = options.tile_height;
+        if (options.path != Path::scalar) isa = resolve_isa(to_internal(options.isa));
+    }
 
+    // The scene of `frame`: the source itself when still.
+    const octray::Scene& pose(int frame) {
+        if (!source.animation) return source;
+        if (posed)
+            repose_at_frame(source, frame, *posed);
+        else
+            posed = scene_at_frame(source, frame);
+        return *posed;
+    }
+
+    RenderResult render(int frame) {
+        if (frame < 0) throw std::invalid_argument("render: frame must be >= 0");
+        const octray::Scene& scene = pose(frame);
+        octray::RenderOptions o = internal;
+        o.frame = static_cast<std::uint32_t>(frame);
         RenderResult out;
         octray::RenderResult r;
         // With a progress callback, on a thread of its own (render_reporting).
         const auto rendered = [&](const auto& run) {
-            return options.progress ? render_reporting(run, o, posed, options) : run();
+            return options.progress ? render_reporting(run, o, scene, options) : run();
         };
         if (options.path == Path::scalar) {
-            r = rendered([&] { return render_reference(posed, o); });
+            r = rendered([&] { return render_reference(scene, o); });
             out.path = "scalar";
         } else {
-            const octray::Isa isa = resolve_isa(to_internal(options.isa));
-            r = rendered([&] { return render_packet(posed, o, isa); });
+            if (!prepared) {
+                prepared.emplace(scene, octray::Accel::automatic, options.threads);
+            } else if (!source.animation || source.animation->objects.empty()) {
+                prepared->set_camera(scene.camera);
+            } else {
+                prepared->update(scene);
+            }
+            r = rendered([&] { return render_packet(*prepared, o, isa); });
             out.path = std::string("simd (") + octray::isa_name(isa) + ")";
         }
         out.image = from_internal(r.image);
         out.rays = {r.rays.primary, r.rays.shadow, r.rays.reflected, r.rays.refracted};
         out.seconds = r.seconds;
         return out;
-    });
+    }
+};
+
+Renderer::Renderer(const Scene& scene, const RenderOptions& options) {
+    translate_errors([&] { impl_ = std::make_unique<Impl>(scene, options); });
+}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+RenderResult Renderer::render(int frame) try {
+    if (!impl_) throw Error(ErrorKind::invalid_argument, "render: the Renderer was moved from");
+    return translate_errors([&] { return impl_->render(frame); });
 } catch (const CallbackFailure& failure) {
     std::rethrow_exception(failure.error);
+}
+
+int Renderer::frame_count() const {
+    if (!impl_) return 0;
+    return impl_->source.animation ? std::max(impl_->source.animation->frames, 1) : 1;
+}
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
+    if (options.frame < 0)
+        throw Error(ErrorKind::invalid_argument, "render: frame must be >= 0");
+    return Renderer(scene, options).render(options.frame);
 }
 
 // ---- Images ------------------------------------------------------------------------------

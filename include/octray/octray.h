@@ -211,8 +211,39 @@ struct RenderResult {
 };
 
 // Renders the scene (or its animation frame options.frame) with the options' overrides
-// applied and the result validated. Throws Error.
+// applied and the result validated. Throws Error. The same as
+// Renderer(scene, options).render(options.frame).
 RenderResult render(const Scene& scene, const RenderOptions& options = {});
+
+// A scene prepared once and rendered frame after frame. The constructor copies the scene,
+// applies the options' overrides and validates it; on the simd path the first frame
+// compiles it and builds its BVH, and the next frames reuse them: a still scene's frames,
+// and a camera-only animation's, only take their camera; an animation of moving spheres
+// updates the compiled spheres in place and refits the BVH (or rebuilds it when the refit
+// tree has grown too costly). render(f) is, bit for bit, render(scene, options) with
+// .frame = f, whatever the frames rendered before it and their order. The scalar path
+// renders each frame from its posed scene. One render at a time per Renderer.
+//
+//   octray::api::Renderer renderer(octray::api::Scene::load("anim.json"), {.threads = 2});
+//   for (int f = 0; f < renderer.frame_count(); ++f) save(renderer.render(f).image);
+class Renderer {
+  public:
+    explicit Renderer(const Scene& scene, const RenderOptions& options = {});
+    ~Renderer();
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
+
+    // Frame `frame` (>= 0; frames past an animation's end hold its last pose); the
+    // options' frame is not used. Throws Error.
+    RenderResult render(int frame);
+    // The animation's frame count; 1 for a still scene (0 for a moved-from Renderer, whose
+    // render() throws).
+    int frame_count() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 // ---- Images ---------------------------------------------------------------------------
 

@@ -223,6 +223,13 @@ TEST(ApiHostile, RenderOptionsAtTheirEdges) {
         returns_or_api_error("tile height" + at,
                              [&] { api::render(scene, {.tile_height = n}); });
         returns_or_api_error("frame" + at, [&] { api::render(scene, {.frame = n}); });
+        returns_or_api_error("Renderer frame" + at, [&] { api::Renderer(scene).render(n); });
+        if (n <= 2)
+            returns_or_api_error("Renderer threads" + at,
+                                 [&] { api::Renderer(scene, {.threads = n}).render(0); });
+        returns_or_api_error("Renderer tiles" + at, [&] {
+            api::Renderer(scene, {.tile_width = n, .tile_height = n}).render(1);
+        });
         if (n <= 16)
             returns_or_api_error("size" + at,
                                  [&] { api::render(scene, {.width = n, .height = n}); });

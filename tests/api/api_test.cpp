@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -202,4 +203,67 @@ TEST(Api, ProgressCallbackReportsAndCancels) {
     } catch (const std::runtime_error& e) {
         EXPECT_STREQ(e.what(), "from the callback");
     }
+}
+
+namespace {
+
+// small_scene()'s ball and camera animated over 5 frames: the ball moves and grows, the
+// camera moves (JSON: the API builds no animation in code).
+api::Scene animated_scene(bool camera_only) {
+    std::string json = small_scene().to_json();
+    const std::string objects = camera_only ? "" : R"(, "objects": {"ball": [
+        {"frame": 0, "center": [0, 1, 0]}, {"frame": 4, "center": [1, 1.5, -1], "radius": 1.4}]})";
+    json.insert(json.rfind('}'), R"(, "animation": {"frames": 5, "camera": [
+        {"frame": 0, "eye": [0, 1.5, 6]}, {"frame": 4, "eye": [3, 2.5, 5]}])" +
+                                     objects + "}");
+    return api::Scene::from_json(json, "animated.json");
+}
+
+}  // namespace
+
+// Renderer (prepare once, render many): every frame, in any order, is bit for bit the frame
+// api::render gives alone, on both paths, for moving spheres, a moving camera and a still.
+TEST(Api, ARendererGivesEachFrameAsRenderedAlone) {
+    const api::Scene scenes[] = {animated_scene(false), animated_scene(true), small_scene()};
+    for (const api::Scene& scene : scenes) {
+        for (api::Path path : {api::Path::simd, api::Path::scalar}) {
+            const api::RenderOptions options{.path = path, .threads = 2, .spp = 1};
+            api::Renderer renderer(scene, options);
+            EXPECT_EQ(renderer.frame_count(),
+                      scene.to_json().find("animation") != std::string::npos ? 5 : 1);
+            for (int frame : {0, 3, 1, 4, 2, 7, 0}) {
+                api::RenderOptions alone = options;
+                alone.frame = frame;
+                EXPECT_EQ(renderer.render(frame).image.rgb, api::render(scene, alone).image.rgb)
+                    << "frame " << frame << (path == api::Path::scalar ? " scalar" : " simd");
+            }
+        }
+    }
+    // The moving ball really moves: frames differ.
+    api::Renderer renderer(animated_scene(false), {.threads = 2, .spp = 1});
+    EXPECT_NE(renderer.render(0).image.rgb, renderer.render(4).image.rgb);
+}
+
+TEST(Api, ARendererRefusesWhatRenderRefuses) {
+    const api::Scene scene = small_scene();
+    const auto kind = [](const std::function<void()>& f) {
+        try {
+            f();
+        } catch (const api::Error& e) {
+            return e.kind();
+        }
+        ADD_FAILURE() << "no api::Error";
+        return api::ErrorKind::io;
+    };
+    EXPECT_EQ(kind([&] { api::Renderer(scene, {.threads = -1}); }),
+              api::ErrorKind::invalid_argument);
+    EXPECT_EQ(kind([&] { api::Renderer(scene, {.tile_width = 0}); }),
+              api::ErrorKind::invalid_argument);
+    EXPECT_EQ(kind([&] { api::Renderer(scene, {.spp = (1 << 20) + 1}); }),
+              api::ErrorKind::scene);
+    api::Renderer renderer(scene, {.threads = 1});
+    EXPECT_EQ(kind([&] { renderer.render(-1); }), api::ErrorKind::invalid_argument);
+    api::Renderer moved = std::move(renderer);
+    EXPECT_EQ(moved.render(0).image.width, 48);
+    EXPECT_EQ(kind([&] { renderer.render(0); }), api::ErrorKind::invalid_argument);  // NOLINT
 }
