@@ -12,7 +12,6 @@
 #include <exception>
 #include <mutex>
 #include <new>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -20,6 +19,7 @@
 
 #include "core/version.h"
 #include "kernels/dispatch.h"
+#include "render/frame_renderer.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
@@ -406,10 +406,8 @@ struct Renderer::Impl {
     octray::Scene source;  // the overrides applied, validated
     octray::RenderOptions internal;
     octray::Isa isa = octray::Isa::automatic;  // resolved (simd path)
-    // The last frame's pose of an animated scene, reposed in place for the next.
-    std::optional<octray::Scene> posed;
-    // The simd path's compiled scene and BVH, from the first frame on.
-    std::optional<octray::PreparedScene> prepared;
+    // The frames of `source`, posed and prepared once (render/frame_renderer.h).
+    std::unique_ptr<octray::FrameRenderer> renderer;
 
     Impl(const Scene& scene, const RenderOptions& o) : options(o) {
         // The command line's limits (render --help): a thread count beyond them would ask
@@ -433,43 +431,24 @@ struct Renderer::Impl {
         internal.tile_width = options.tile_width;
         internal.tile_height = options.tile_height;
         if (options.path != Path::scalar) isa = resolve_isa(to_internal(options.isa));
-    }
-
-    // The scene of `frame`: the source itself when still.
-    const octray::Scene& pose(int frame) {
-        if (!source.animation) return source;
-        if (posed)
-            repose_at_frame(source, frame, *posed);
-        else
-            posed = scene_at_frame(source, frame);
-        return *posed;
+        renderer = std::make_unique<octray::FrameRenderer>(
+            source, options.path == Path::scalar ? RenderPath::scalar : RenderPath::simd, isa,
+            octray::Accel::automatic, options.threads);
     }
 
     RenderResult render(int frame) {
         if (frame < 0) throw std::invalid_argument("render: frame must be >= 0");
-        const octray::Scene& scene = pose(frame);
+        const octray::Scene& scene = renderer->prepare(frame);
         octray::RenderOptions o = internal;
         o.frame = static_cast<std::uint32_t>(frame);
-        RenderResult out;
-        octray::RenderResult r;
         // With a progress callback, on a thread of its own (render_reporting).
-        const auto rendered = [&](const auto& run) {
-            return options.progress ? render_reporting(run, o, scene, options) : run();
-        };
-        if (options.path == Path::scalar) {
-            r = rendered([&] { return render_reference(scene, o); });
-            out.path = "scalar";
-        } else {
-            if (!prepared) {
-                prepared.emplace(scene, octray::Accel::automatic, options.threads);
-            } else if (!source.animation || source.animation->objects.empty()) {
-                prepared->set_camera(scene.camera);
-            } else {
-                prepared->update(scene);
-            }
-            r = rendered([&] { return render_packet(*prepared, o, isa); });
-            out.path = std::string("simd (") + octray::isa_name(isa) + ")";
-        }
+        const auto run = [&] { return renderer->render(o); };
+        const octray::RenderResult r =
+            options.progress ? render_reporting(run, o, scene, options) : run();
+        RenderResult out;
+        out.path = options.path == Path::scalar
+                       ? std::string("scalar")
+                       : std::string("simd (") + octray::isa_name(isa) + ")";
         out.image = from_internal(r.image);
         out.rays = {r.rays.primary, r.rays.shadow, r.rays.reflected, r.rays.refracted};
         out.seconds = r.seconds;

@@ -24,8 +24,7 @@
 #include "render/batch/progressive.h"
 #include "render/batch/result_exr.h"
 #include "render/batch/resume.h"
-#include "render/packet_renderer.h"
-#include "render/reference.h"
+#include "render/frame_renderer.h"
 #include "scene/animation.h"
 #include "scene/scene_error.h"
 
@@ -41,12 +40,6 @@ struct FrameResult {
     FrameReport report;
     FailureKind failure = FailureKind::none;
 };
-
-// Whether the frames of `scene` can share one prepared scene: its objects never move (a
-// still, or an animation of the camera alone), so only the camera differs between frames.
-bool objects_still(const Scene& scene) {
-    return !scene.animation || scene.animation->objects.empty();
-}
 
 // EXR's capDate convention: "YYYY:MM:DD HH:MM:SS" in local time, with utcOffset holding
 // UTC minus local time in seconds.
@@ -170,14 +163,10 @@ class BatchRunner {
     // The channels of the last EXR written, converted into again by the next (the same
     // reason: make_exr_image's `spare`).
     std::vector<ExrChannel> spare_channels_;
-    // The simd path's scene prepared once (compiled, its BVH built) for all the frames of
-    // scene prepared_index_ while its objects stay still: a frame of it only sets the
-    // camera. One prepared scene at a time (the memory estimate counts one).
-    std::optional<PreparedScene> prepared_;
-    std::size_t prepared_index_ = 0;
-    // An animated scene's posed copy (scene posed_index_), reposed frame by frame.
-    std::optional<Scene> posed_;
-    std::size_t posed_index_ = 0;
+    // The frames of scene renderer_index_, posed and prepared once (FrameRenderer).
+    // (A pointer: g++ 12 takes an optional holding an optional for maybe-uninitialized.)
+    std::unique_ptr<FrameRenderer> renderer_;
+    std::size_t renderer_index_ = 0;
     // The frame being written behind (settings_.write_behind), at most one.
     std::unique_ptr<PendingWrite> pending_;
 };
@@ -357,22 +346,23 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         if (!job.png.empty()) remove_stale_temporaries(job.png);
         observer_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
 
-        // A still scene is its own pose: no copy of its (possibly millions of) objects. An
-        // animated scene is posed (copied and validated) for its first frame only; its
-        // next frames repose that copy in place: the camera and the moving spheres
-        // (validate_scene checked every frame's camera when the scene was loaded).
-        const Scene* pose = &scene.scene;
-        if (scene.scene.animation) {
-            if (posed_ && posed_index_ == job.scene) {
-                repose_at_frame(scene.scene, job.frame, *posed_);
-            } else {
-                posed_.reset();
-                posed_ = scene_at_frame(scene.scene, job.frame);
-                posed_index_ = job.scene;
-            }
-            pose = &*posed_;
+        // The frame posed and prepared (frame_renderer.h): a scene's first frame compiles
+        // it and builds its BVH (simd path); a next frame of a still or camera-only
+        // animation only takes its camera, one whose spheres move updates them in place
+        // and refits the BVH. One scene's renderer at a time (the memory estimate counts
+        // one prepared scene).
+        if (!renderer_ || renderer_index_ != job.scene) {
+            renderer_.reset();
+            renderer_ = std::make_unique<FrameRenderer>(scene.scene, settings_.path,
+                                                        settings_.isa, settings_.options.accel,
+                                                        settings_.options.threads);
+            renderer_index_ = job.scene;
         }
-        const Scene& posed = *pose;
+        FrameRenderer::Timing prepared;
+        const Scene& posed = renderer_->prepare(job.frame, &prepared);
+        out.report.compile_seconds = prepared.compile_seconds;
+        out.report.bvh_seconds = prepared.bvh_seconds;  // or the spheres' update and refit
+        out.report.prepare_seconds = prepared.seconds();
         RenderOptions options = settings_.options;
         options.frame = static_cast<std::uint32_t>(job.frame);
         options.cancel = cancel_;
@@ -393,41 +383,8 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         // the summary report each, and the rate is rays over trace time alone.
         const auto trace_started = Clock::now();
 
-        // Prepare once: the simd path renders a prepared scene (compiled, its BVH built),
-        // prepared for a scene's first frame. A next frame of a scene whose objects stay
-        // still (a still, a camera-only animation) only takes its camera; one whose
-        // spheres move updates the compiled spheres in place and refits the BVH (or
-        // rebuilds it, when the refit tree has grown too costly: PreparedScene::update).
-        double prepare_seconds = 0.0;
-        const bool simd = settings_.path == RenderPath::simd;
-        const bool reuse = simd && prepared_ && prepared_index_ == job.scene;
-        if (reuse && objects_still(scene.scene)) {
-            prepared_->set_camera(posed.camera);
-        } else if (reuse) {
-            const PreparedScene::Update update = prepared_->update(posed);
-            out.report.bvh_seconds = update.seconds;  // the spheres' update with the refit
-            prepare_seconds = update.seconds;
-        } else if (simd) {
-            prepared_.reset();  // one prepared scene at a time
-            prepared_.emplace(posed, options.accel, options.threads);
-            prepared_index_ = job.scene;
-            out.report.compile_seconds = prepared_->compile_seconds();
-            out.report.bvh_seconds = prepared_->bvh_seconds();
-            prepare_seconds = out.report.compile_seconds + out.report.bvh_seconds;
-        } else {
-            prepared_.reset();
-        }
-        const auto render_pass = [&](const RenderOptions& o) {
-            return simd ? render_packet(*prepared_, o, settings_.isa)
-                        : render_reference(posed, o);
-        };
-        // AOVs from each pixel's first hit: traced by the kernels on the simd path, by the
-        // reference on the scalar one (the same bits either way).
-        const AovImages aovs =
-            !settings_.aovs.any() || !simd
-                ? compute_aovs(posed, options, settings_.aovs)
-                : compute_aovs(posed, options, settings_.aovs,
-                               trace_first_hits(*prepared_, options, settings_.isa));
+        const auto render_pass = [&](const RenderOptions& o) { return renderer_->render(o); };
+        const AovImages aovs = renderer_->aovs(options, settings_.aovs);
         double write_seconds = 0.0;
         const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
             const auto write_started = Clock::now();
@@ -450,10 +407,8 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         }
         // trace: the render (and AOVs) alone; preparing (compile, BVH) and writing are
         // reported apart.
-        out.report.prepare_seconds = prepare_seconds;
         out.report.trace_seconds =
-            std::chrono::duration<double>(Clock::now() - trace_started).count() -
-            write_seconds - prepare_seconds;
+            std::chrono::duration<double>(Clock::now() - trace_started).count() - write_seconds;
         out.report.load_seconds = scene.load_seconds;
         out.report.render_seconds =
             result.seconds - result.compile_seconds - result.bvh_seconds;
