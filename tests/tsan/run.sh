@@ -6,7 +6,8 @@
 #   3. configures the `tsan` preset against that TBB, builds the test binaries and runs
 #      their thread tests (both renderers, the parallel BVH build, BVH renders) with
 #      halt_on_error=1 and tests/tsan/tsan.supp,
-#   4. renders a small batch with `octray render` (progress thread, progressive passes).
+#   4. renders a small batch with `octray render` (progress thread, progressive passes),
+#   5. and one whose frames are written while the next renders (write behind).
 # Usage: tests/tsan/run.sh   (root on a fresh machine: step 1 adds a deb-src entry)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -39,4 +40,9 @@ trap 'rm -rf "$out"' EXIT
 build/tsan/tools/octray render random:64,width=96,height=64,spp=4 --frames 0-3 --threads 2 \
   --progress lines --progressive -o "$out/t.#.exr" > build/tsan/batch_render.log 2>&1 ||
   { cat build/tsan/batch_render.log; echo "tests/tsan/run.sh: the batch render failed" >&2; exit 1; }
+# 5. Frames written behind: each frame's EXR and PNG written by a thread of its own (and
+#    OpenEXR's pool) while the next frame renders on the TBB workers.
+build/tsan/tools/octray render random:64,width=96,height=64 --frames 0-3 --threads 2 \
+  --progress lines --png "$out/w.#.png" -o "$out/w.#.exr" > build/tsan/write_behind.log 2>&1 ||
+  { cat build/tsan/write_behind.log; echo "tests/tsan/run.sh: the write-behind render failed" >&2; exit 1; }
 echo "tests/tsan/run.sh: passed in $((SECONDS - start)) s"
