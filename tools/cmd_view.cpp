@@ -323,7 +323,9 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
     cmd->footer(
         "The command prints a URL such as http://127.0.0.1:8090/?token=3f9c...: open it in a\n"
         "browser. The token is 128 random bits, new each run; a request without it gets\n"
-        "403. The page shows the picture refining pass by pass (1, 2, 4, ... samples per\n"
+        "403, and a connection that has not presented it within 5 s is closed. At most 256\n"
+        "connections are served at once (event streams included); one more gets a 503.\n"
+        "The page shows the picture refining pass by pass (1, 2, 4, ... samples per\n"
         "pixel) with spp, Mrays/s and frame time; drag orbits the camera about its look-at\n"
         "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
         "(--preview-divisor) until it stops. The mouse shows the linear RGB value under it.\n"

@@ -23,6 +23,7 @@
 
 #include "core/decimal.h"
 #include "render/image/image_io.h"
+#include "render/view/guarded_server.h"
 #include "render/view/http_error.h"
 #include "render/view/page.h"
 #include "render/view/request_json.h"
@@ -191,22 +192,17 @@ struct ViewServer::Impl {
     std::string token;
     std::string cookie_name;
     int port = 0;
-    httplib::Server server;
+    GuardedServer server;
     std::thread listener;
     std::atomic<bool> stopping{false};
-    // Event streams open now. Each holds one of the http_threads workers for as long as it
-    // is open, so at most half of them may: the rest answer the page and the API however
-    // many tabs or clients open streams (past the cap, 503 says why).
-    // A stream whose reader left is noticed at its next heartbeat and frees its slot, so a
-    // new stream waits a little for one (a page reloading) before it is refused.
-    int open_streams = 0;
-    std::mutex streams_mutex;
-    std::condition_variable stream_closed;
     std::atomic<bool> listener_done{false};
     std::mutex stop_mutex;
 
     Impl(ViewSession* s, const CompareView* c, ServerOptions o)
-        : session_ptr(s), compare_ptr(c), options(std::move(o)) {
+        : session_ptr(s),
+          compare_ptr(c),
+          options(std::move(o)),
+          server(ConnectionLimits{options.max_connections, options.auth_deadline}) {
         token = options.token.empty() ? random_token() : options.token;
     }
 
@@ -227,13 +223,17 @@ void ViewServer::Impl::routes() {
     server.set_keep_alive_timeout(2);
     server.set_read_timeout(5, 0);
     server.set_write_timeout(5, 0);
-    const auto threads = static_cast<std::size_t>(std::max(2, options.http_threads));
-    server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+    // Each connection is served on a thread of its own, at most max_connections at once
+    // (GuardedServer), so an open event stream holds no worker the page and the API need.
 
     // The token first: nothing, not even a 404, answers a request without it.
     server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
         set_common_headers(res);
-        if (authorized(req)) return httplib::Server::HandlerResponse::Unhandled;
+        if (authorized(req)) {
+            // This connection is no longer held to the deadline for presenting the token.
+            GuardedServer::mark_authenticated();
+            return httplib::Server::HandlerResponse::Unhandled;
+        }
         res.status = 403;
         res.set_content(
             "403 Forbidden: open the URL that `octray view` printed (it carries the token)\n",
@@ -293,50 +293,31 @@ void ViewServer::Impl::scene_routes() {
         res.set_content(status.dump(), "application/json");
     });
 
-    server.Get("/api/events", [this, &session](const httplib::Request&,
-                                               httplib::Response& res) {
-        const int max_streams = std::max(1, options.http_threads / 2);
-        {
-            std::unique_lock<std::mutex> lock(streams_mutex);
-            if (!stream_closed.wait_for(lock, 4 * kHeartbeat,
-                                        [&] { return open_streams < max_streams; }))
-                throw BadRequest(503, "too many event streams: " + std::to_string(max_streams) +
-                                          " are open, the most this viewer serves at once "
-                                          "(close a tab, or poll /api/status)");
-            ++open_streams;
-        }
-        res.set_chunked_content_provider(
-            "text/event-stream",
-            [this, &session, last = std::uint64_t{0}, last_error = std::string()](
-                std::size_t, httplib::DataSink& sink) mutable {
-                const auto frame = session.wait_newer(last, kHeartbeat);
-                if (stopping || session.stopped()) {
-                    sink.done();
-                    return true;
-                }
-                std::string message = ": heartbeat\n\n";
-                if (std::string error = session.error(); error != last_error) {
-                    last_error = error;
-                    if (!error.empty()) {
-                        message =
-                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
-                            "\n\n";
+    server.Get(
+        "/api/events", [this, &session](const httplib::Request&, httplib::Response& res) {
+            res.set_chunked_content_provider(
+                "text/event-stream",
+                [this, &session, last = std::uint64_t{0}, last_error = std::string()](
+                    std::size_t, httplib::DataSink& sink) mutable {
+                    const auto frame = session.wait_newer(last, kHeartbeat);
+                    if (stopping || session.stopped()) {
+                        sink.done();
+                        return true;
                     }
-                } else if (frame && frame->generation > last) {
-                    last = frame->generation;
-                    message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
-                }
-                return sink.write(message.data(), message.size());
-            },
-            // Called when the stream ends, however it ends.
-            [this](bool) {
-                {
-                    const std::lock_guard<std::mutex> lock(streams_mutex);
-                    --open_streams;
-                }
-                stream_closed.notify_one();
-            });
-    });
+                    std::string message = ": heartbeat\n\n";
+                    if (std::string error = session.error(); error != last_error) {
+                        last_error = error;
+                        if (!error.empty()) {
+                            message = "event: render-error\ndata: " +
+                                      json{{"message", error}}.dump() + "\n\n";
+                        }
+                    } else if (frame && frame->generation > last) {
+                        last = frame->generation;
+                        message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                    }
+                    return sink.write(message.data(), message.size());
+                });
+        });
 
     const auto image_headers = [](httplib::Response& res, const ViewFrame& frame) {
         res.set_header("X-Octray-Generation", std::to_string(frame.generation));
@@ -510,6 +491,8 @@ void ViewServer::stop() {
     std::lock_guard lock(impl_->stop_mutex);
     impl_->stopping = true;
     impl_->server.stop();
+    // Idle keep-alive connections and unfinished requests end now, not at their timeouts.
+    impl_->server.end_connections();
 }
 
 void ViewServer::wait() {
