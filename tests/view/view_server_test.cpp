@@ -286,6 +286,36 @@ TEST_F(ViewServerTest, AMovingCameraGetsAPreviewThenTheRefinedPicture) {
     EXPECT_EQ(refined["width"], 64);
 }
 
+// Issue 44: a camera that moves faster than a preview renders still gets previews on the
+// screen. Each move abandoned the preview in flight, so while a drag's moves came every
+// few milliseconds no picture was published at all; now a moving camera lets the preview
+// in flight finish, and the latest camera is rendered next.
+TEST(ViewSessionPreviews, MovesFasterThanAPreviewRendersStillPublishPreviews) {
+    Scene scene = small_whitted();
+    scene.image.width = 640;  // a preview of some milliseconds: longer than a move
+    scene.image.height = 360;
+    ViewSettings settings;
+    settings.threads = 1;
+    settings.preview_divisor = 1;
+    ViewSession session(scene, settings);
+    ASSERT_TRUE(session.wait_newer(0, std::chrono::seconds(60)));
+    octray::Camera camera = scene.camera;
+    const std::uint64_t first = session.set_camera(camera, true);
+    std::uint64_t previews_seen = 0, last_generation = 0;
+    for (int i = 0; i < 2000 && previews_seen < 3; ++i) {
+        camera.eye.x += 0.001f;
+        session.set_camera(camera, true);
+        const auto frame = session.latest();
+        if (frame && frame->preview && frame->camera_version > first &&
+            frame->generation != last_generation) {
+            last_generation = frame->generation;
+            ++previews_seen;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    EXPECT_GE(previews_seen, 3u) << "previews were abandoned while the camera kept moving";
+}
+
 // Reads one event stream until `enough` says so; the events' JSON payloads.
 std::vector<json> read_events(httplib::Client& client, const std::string& path,
                               const std::function<bool(const std::vector<json>&)>& enough) {
