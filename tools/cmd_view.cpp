@@ -26,6 +26,7 @@
 #include "render/image/image_io.h"
 #include "render/memory_estimate.h"
 #include "render/view/compare_view.h"
+#include "render/view/jpeg.h"
 #include "render/view/view_bench.h"
 #include "render/view/view_server.h"
 #include "render/view/view_session.h"
@@ -99,6 +100,11 @@ void print_bench(const Scene& scene, const view::ViewSettings& settings,
         "PNG %.0f bytes\n",
         r.updates, r.update_width, r.update_height, r.seconds, r.updates_per_second,
         r.mrays_per_second, r.png_bytes);
+    std::printf(
+        "last picture, one thread: tone map %.2f ms; then PNG %.2f ms (%.0f bytes), JPEG q%d "
+        "%.2f ms (%.0f bytes), RGBA8 %.2f ms (%.0f bytes)\n",
+        r.tone_map_ms, r.png_ms, r.last_png_bytes, view::kStreamJpegQuality, r.jpeg_ms,
+        r.jpeg_bytes, r.rgba_ms, r.rgba_bytes);
     std::fflush(stdout);
 }
 

@@ -25,6 +25,7 @@
 #include "render/image/image_io.h"
 #include "render/view/guarded_server.h"
 #include "render/view/http_error.h"
+#include "render/view/jpeg.h"
 #include "render/view/page.h"
 #include "render/view/request_json.h"
 #include "render/view/token.h"
@@ -177,6 +178,33 @@ std::string float_bytes(const Image& image) {
                        image.pixel_count() * sizeof(Rgb));
 }
 
+// One message of /api/pictures: "OCTP", the lengths of `header` and `picture` (uint32,
+// little-endian), then both.
+std::string picture_message(const std::string& header, const std::string& picture) {
+    std::string message = "OCTP";
+    for (const std::size_t length : {header.size(), picture.size()}) {
+        for (int byte = 0; byte < 4; ++byte)
+            message.push_back(static_cast<char>((length >> (8 * byte)) & 0xff));
+    }
+    return message + header + picture;
+}
+
+// `frame` as a message of /api/pictures: tone-mapped at `exposure`; the refined picture
+// (the last pass, all of it rendered with this camera) as PNG, any other as JPEG.
+std::string encoded_picture(const ViewFrame& frame, float exposure) {
+    const int width = frame.image.width(), height = frame.image.height();
+    const std::vector<std::uint8_t> rgb = tone_map_srgb8(frame.image, exposure);
+    const bool refined =
+        !frame.preview && frame.spp >= frame.target_spp && frame.coverage >= 1.0;
+    json header = frame_json(frame);
+    header["event"] = "frame";
+    header["format"] = refined ? "png" : "jpeg";
+    header["exposure"] = exposure;
+    return picture_message(header.dump(),
+                           refined ? encode_png_rgb8(width, height, rgb)
+                                   : encode_jpeg_rgb8(width, height, rgb, kStreamJpegQuality));
+}
+
 void set_common_headers(httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -314,6 +342,42 @@ void ViewServer::Impl::scene_routes() {
                     } else if (frame && frame->generation > last) {
                         last = frame->generation;
                         message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                    }
+                    return sink.write(message.data(), message.size());
+                });
+        });
+
+    // The pictures themselves, pushed (issue 44): one long-lived chunked response of
+    // messages, each "OCTP", the length of a JSON header and the length of a picture
+    // (uint32, little-endian), the JSON (the event's frame JSON with "event": "frame" and
+    // "format": "jpeg" or "png"; or "event": "render-error" with "message") and the
+    // picture's file bytes. Lengths of 0 and 0: a heartbeat. The latest picture wins: the
+    // stream encodes and writes the newest picture once the last one is written, so a
+    // slow browser skips pictures and nothing queues; the render thread goes on with the
+    // next picture meanwhile. Previews and the passes before the last are JPEG (a few
+    // milliseconds to encode and to decode at 1280x720; PNG costs several times that),
+    // the refined picture PNG, lossless.
+    server.Get(
+        "/api/pictures", [this, &session](const httplib::Request& req, httplib::Response& res) {
+            const float exposure = exposure_param(req);
+            res.set_chunked_content_provider(
+                "application/octet-stream",
+                [this, &session, exposure, last = std::uint64_t{0}, last_error = std::string()](
+                    std::size_t, httplib::DataSink& sink) mutable {
+                    const auto frame = session.wait_newer(last, kHeartbeat);
+                    if (stopping || session.stopped()) {
+                        sink.done();
+                        return true;
+                    }
+                    std::string message = picture_message(std::string(), std::string());
+                    if (std::string error = session.error(); error != last_error) {
+                        last_error = error;
+                        if (!error.empty())
+                            message = picture_message(
+                                json{{"event", "render-error"}, {"message", error}}.dump(), {});
+                    } else if (frame && frame->generation > last) {
+                        last = frame->generation;
+                        message = encoded_picture(*frame, exposure);
                     }
                     return sink.write(message.data(), message.size());
                 });

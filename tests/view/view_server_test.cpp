@@ -389,6 +389,77 @@ TEST_F(ViewServerTest, AHundredReconnectsLeaveTheServerRunning) {
     EXPECT_EQ(s["frame"]["spp"], 4);
 }
 
+// One message of /api/pictures: the JSON header (null for a heartbeat) and the picture.
+struct PictureMessage {
+    json header;
+    std::string picture;
+};
+
+// Reads /api/pictures until `enough` says so; the messages other than heartbeats.
+std::vector<PictureMessage> read_pictures(
+    httplib::Client& client, const std::string& path,
+    const std::function<bool(const std::vector<PictureMessage>&)>& enough) {
+    std::vector<PictureMessage> messages;
+    std::string buffer;
+    const auto u32 = [&](std::size_t at) {
+        std::uint32_t v = 0;
+        for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(buffer[at + i]);
+        return std::size_t{v};
+    };
+    client.Get(path, [&](const char* data, std::size_t size) {
+        buffer.append(data, size);
+        while (buffer.size() >= 12) {
+            EXPECT_EQ(buffer.substr(0, 4), "OCTP");
+            const std::size_t header = u32(4), picture = u32(8);
+            if (buffer.size() < 12 + header + picture) break;
+            if (header > 0)
+                messages.push_back({json::parse(buffer.substr(12, header)),
+                                    buffer.substr(12 + header, picture)});
+            buffer.erase(0, 12 + header + picture);
+        }
+        return !enough(messages);
+    });
+    return messages;
+}
+
+// Issue 44: the pictures themselves come over one long-lived stream, no request each. Its
+// first message is the current picture; the refined picture is the very PNG that
+// /api/image.png serves (lossless), a preview of a moving camera a JPEG; each carries the
+// frame's JSON as the event stream does.
+TEST_F(ViewServerTest, ThePictureStreamSendsTheLatestPictureRefinedAsPngPreviewsAsJpeg) {
+    ASSERT_FALSE(wait_for_frame([](const json& f) { return f["spp"] == 4; }).is_null());
+    const auto png = client_->Get(with_token("/api/image.png?exposure=1"));
+    ASSERT_TRUE(png);
+    httplib::Client stream_client("127.0.0.1", server_->port());
+    stream_client.set_read_timeout(60, 0);
+    std::thread mover([&] {
+        httplib::Client other("127.0.0.1", server_->port());
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        other.Post(with_token("/api/camera"), R"({"eye": [-1.0, 2.0, 7.0], "moving": true})",
+                   "application/json");
+    });
+    const auto messages = read_pictures(stream_client, with_token("/api/pictures?exposure=1"),
+                                        [](const std::vector<PictureMessage>& m) {
+                                            return !m.empty() &&
+                                                   m.back().header["camera_version"] == 2 &&
+                                                   m.back().header["preview"] == true;
+                                        });
+    mover.join();
+    ASSERT_GE(messages.size(), 2u);
+    const PictureMessage& first = messages.front();
+    EXPECT_EQ(first.header["event"], "frame");
+    EXPECT_EQ(first.header["camera_version"], 1);
+    EXPECT_EQ(first.header["spp"], 4);
+    EXPECT_EQ(first.header["format"], "png");
+    EXPECT_TRUE(first.picture == png->body) << "the refined picture differs from image.png's";
+    const PictureMessage& preview = messages.back();
+    EXPECT_EQ(preview.header["format"], "jpeg");
+    EXPECT_EQ(preview.header["width"], 16);
+    ASSERT_GE(preview.picture.size(), 4u);
+    EXPECT_EQ(static_cast<unsigned char>(preview.picture[0]), 0xff);  // JPEG's SOI marker
+    EXPECT_EQ(static_cast<unsigned char>(preview.picture[1]), 0xd8);
+}
+
 // (Many event streams, slow clients and the cap on connections: view_load_test.cpp.)
 
 TEST_F(ViewServerTest, StopEndsAnOpenEventStream) {
