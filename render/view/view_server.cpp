@@ -414,10 +414,29 @@ void ViewServer::Impl::scene_routes() {
 
     // The linear value under the page's cursor, of the latest picture (whose size the
     // answer repeats: a preview is smaller than the refined picture).
+    // `width` and `height`, when given, are the size of the picture the page shows, in
+    // which x and y are: a page that still shows a preview while the refined picture is
+    // in (or the other way round) is answered the pixel at the same place of the latest.
     server.Get("/api/pixel", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto frame = session.latest();
         if (!frame) throw BadRequest(503, "no picture yet");
-        json answer = pixel_json(req, frame->image);
+        json answer;
+        if (req.has_param("width") || req.has_param("height")) {
+            const int shown_w = integer_param(req, "width", 1, 1 << 16);
+            const int shown_h = integer_param(req, "height", 1, 1 << 16);
+            const int x = integer_param(req, "x", 0, shown_w - 1);
+            const int y = integer_param(req, "y", 0, shown_h - 1);
+            const int w = frame->image.width(), h = frame->image.height();
+            httplib::Request at;
+            at.params = {
+                {"x", std::to_string(static_cast<int>(
+                          (static_cast<std::int64_t>(2 * x + 1) * w) / (2 * shown_w)))},
+                {"y", std::to_string(static_cast<int>(
+                          (static_cast<std::int64_t>(2 * y + 1) * h) / (2 * shown_h)))}};
+            answer = pixel_json(at, frame->image);
+        } else {
+            answer = pixel_json(req, frame->image);
+        }
         answer["generation"] = frame->generation;
         res.set_content(answer.dump(), "application/json");
     });

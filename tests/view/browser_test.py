@@ -373,6 +373,10 @@ def check_compare(browser, octray, artifacts, ActionChains, WebDriverWait):
                             f"{status['compare']['verdict']}")
             browser.save_screenshot(os.path.join(artifacts, "view_compare_a.png"))
             canvas = browser.find_element("id", "view")
+            # The keys work on the page as loaded, before any click on the canvas.
+            ActionChains(browser).send_keys("d").perform()
+            WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(
+                "return document.getElementById('view').dataset.picture === 'diff';"))
             canvas.click()
             canvas.send_keys("h")
             WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(

@@ -563,6 +563,29 @@ TEST_F(ViewServerTest, ThePixelEndpointReadsTheLatestPicture) {
     }
 }
 
+// Issue 44: a page that shows a preview (16x9 here) while the refined picture (64x36) is in
+// asks with the size it shows: the answer is the pixel at the same place of the latest
+// picture, not a 400 (as during every drag before).
+TEST_F(ViewServerTest, ThePixelEndpointMapsThePlaceInTheShownPictureToTheLatest) {
+    ASSERT_FALSE(
+        wait_for_frame([&](const json& f) { return f["spp"] == scene_.image.spp; }).is_null());
+    const auto scaled = client_->Get(with_token("/api/pixel?x=15&y=8&width=16&height=9"));
+    ASSERT_TRUE(scaled);
+    ASSERT_EQ(scaled->status, 200) << scaled->body;
+    const json answer = json::parse(scaled->body);
+    EXPECT_EQ(answer["x"], 62);  // the centre of (15, 8) of 16x9: (15.5 * 4, 8.5 * 4)
+    EXPECT_EQ(answer["y"], 34);
+    const auto direct = client_->Get(with_token("/api/pixel?x=62&y=34"));
+    ASSERT_TRUE(direct);
+    EXPECT_EQ(json::parse(direct->body)["rgb"], answer["rgb"]);
+    for (const char* query :
+         {"x=16&y=0&width=16&height=9", "x=0&y=0&width=16", "x=0&y=0&width=0&height=9"}) {
+        const auto bad = client_->Get(with_token(std::string("/api/pixel?") + query));
+        ASSERT_TRUE(bad) << query;
+        EXPECT_EQ(bad->status, 400) << query << " -> " << bad->body;
+    }
+}
+
 }  // namespace
 
 namespace {
