@@ -97,9 +97,9 @@ void print_bench(const Scene& scene, const view::ViewSettings& settings,
                 r.first_spp, r.first_picture_seconds);
     std::printf(
         "orbit: %d updates of %dx%d in %.3f s: %.1f updates/s, %.1f Mrays/s, "
-        "PNG %.0f bytes\n",
+        "%.0f bytes each as sent (JPEG)\n",
         r.updates, r.update_width, r.update_height, r.seconds, r.updates_per_second,
-        r.mrays_per_second, r.png_bytes);
+        r.mrays_per_second, r.sent_bytes);
     std::printf(
         "last picture, one thread: tone map %.2f ms; then PNG %.2f ms (%.0f bytes), JPEG q%d "
         "%.2f ms (%.0f bytes), RGBA8 %.2f ms (%.0f bytes)\n",
@@ -300,12 +300,12 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->type_name("D")
         ->transform(decimal_integer(1, 64))
         ->capture_default_str();
-    cmd->add_option(
-           "--bench", args->bench,
-           "Serve nothing: measure the time to the first picture and the pictures\n"
-           "a second while the camera orbits, over N updates, " +
-               integer_range_text(1, 1000000) +
-               " (each rendered as a moving\ncamera is and PNG-encoded as for the page)")
+    cmd->add_option("--bench", args->bench,
+                    "Serve nothing: measure the time to the first picture and the pictures\n"
+                    "a second while the camera orbits, over N updates, " +
+                        integer_range_text(1, 1000000) +
+                        " (each rendered as a moving\ncamera is and encoded as the page is "
+                        "sent it: JPEG)")
         ->type_name("N")
         ->transform(decimal_integer(1, 1000000));
     cmd->add_option("--order", args->order,
@@ -343,8 +343,9 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "With two images, octray view A B compares them as octray compare A B does (same\n"
         "defaults, same figures) and the page flips between A, B, |A - B| and the error\n"
         "heatmap; an image that cannot be read exits 4, two that cannot be compared exit 3.\n"
-        "The HTTP API (status, events, PNG and float32 pictures, camera) is described in\n"
-        "render/view/README.md. Ctrl-C (or SIGTERM) stops the server.\n\n"
+        "The HTTP API (status, events, the picture stream, PNG and float32 pictures,\n"
+        "camera) is described in render/view/README.md. Ctrl-C (or SIGTERM) stops the\n"
+        "server.\n\n"
         "Examples:\n"
         "  octray view                                  # the built-in whitted scene\n"
         "  octray view scene.json --port 0              # any free port\n"

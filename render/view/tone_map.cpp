@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "render/image/image_io.h"
+#include "render/view/jpeg.h"
 
 namespace octray::view {
 
@@ -12,6 +13,14 @@ std::vector<std::uint8_t> tone_map_srgb8(const Image& image, float exposure) {
     srgb8_scaled(reinterpret_cast<const float*>(image.data()), rgb.size(), std::exp2(exposure),
                  rgb.data());
     return rgb;
+}
+
+PagePicture encode_for_page(const ViewFrame& frame, float exposure) {
+    const int width = frame.image.width(), height = frame.image.height();
+    const std::vector<std::uint8_t> rgb = tone_map_srgb8(frame.image, exposure);
+    if (!frame.preview && frame.spp >= frame.target_spp && frame.coverage >= 1.0)
+        return {encode_png_rgb8(width, height, rgb), "png"};
+    return {encode_jpeg_rgb8(width, height, rgb, kStreamJpegQuality), "jpeg"};
 }
 
 }  // namespace octray::view

@@ -58,17 +58,14 @@ ViewBenchResult bench_orbit(const Scene& scene, const ViewSettings& settings, in
     result.first_spp = first->spp;
 
     const Camera initial = session.camera();  // an animation's: its first frame's
-    double rays = 0.0, render_seconds = 0.0, png_bytes = 0.0;
+    double rays = 0.0, render_seconds = 0.0, sent_bytes = 0.0;
     const auto orbit_start = Clock::now();
     for (int i = 1; i <= updates; ++i) {
         const float angle =
             6.28318530718f * static_cast<float>(i) / static_cast<float>(updates);
         const std::uint64_t version = session.set_camera(orbit(initial, angle), true);
         const auto frame = wait_for_version(session, version);
-        png_bytes +=
-            static_cast<double>(encode_png_rgb8(frame->image.width(), frame->image.height(),
-                                                tone_map_srgb8(frame->image, 0.0f))
-                                    .size());
+        sent_bytes += static_cast<double>(encode_for_page(*frame, 0.0f).bytes.size());
         rays += frame->mrays_per_second * 1e6 * frame->pass_seconds;
         render_seconds += frame->pass_seconds;
         result.update_width = frame->image.width();
@@ -78,7 +75,7 @@ ViewBenchResult bench_orbit(const Scene& scene, const ViewSettings& settings, in
     result.updates = updates;
     result.updates_per_second = updates / result.seconds;
     result.mrays_per_second = render_seconds > 0.0 ? rays / render_seconds / 1e6 : 0.0;
-    result.png_bytes = png_bytes / updates;
+    result.sent_bytes = sent_bytes / updates;
 
     // The encodings of the last picture, timed one after the other.
     const auto last = session.latest();

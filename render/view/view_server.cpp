@@ -189,20 +189,14 @@ std::string picture_message(const std::string& header, const std::string& pictur
     return message + header + picture;
 }
 
-// `frame` as a message of /api/pictures: tone-mapped at `exposure`; the refined picture
-// (the last pass, all of it rendered with this camera) as PNG, any other as JPEG.
+// `frame` as a message of /api/pictures (encode_for_page: PNG once refined, else JPEG).
 std::string encoded_picture(const ViewFrame& frame, float exposure) {
-    const int width = frame.image.width(), height = frame.image.height();
-    const std::vector<std::uint8_t> rgb = tone_map_srgb8(frame.image, exposure);
-    const bool refined =
-        !frame.preview && frame.spp >= frame.target_spp && frame.coverage >= 1.0;
+    PagePicture picture = encode_for_page(frame, exposure);
     json header = frame_json(frame);
     header["event"] = "frame";
-    header["format"] = refined ? "png" : "jpeg";
+    header["format"] = picture.format;
     header["exposure"] = exposure;
-    return picture_message(header.dump(),
-                           refined ? encode_png_rgb8(width, height, rgb)
-                                   : encode_jpeg_rgb8(width, height, rgb, kStreamJpegQuality));
+    return picture_message(header.dump(), picture.bytes);
 }
 
 void set_common_headers(httplib::Response& res) {
