@@ -205,6 +205,22 @@ def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWai
         return fail(f"the page asked for pictures one by one: {stream}")
     if stream["format"] != "png":
         return fail(f"the refined picture was not sent lossless (PNG): {stream}")
+    # The exposure is applied by the server: the stream reopens with it and the picture
+    # drawn next is brighter.
+    _, unexposed = canvas_digest(browser)
+    browser.execute_script(
+        "const e = document.getElementById('exposure'); e.value = '2';"
+        "e.dispatchEvent(new Event('input'));")
+    WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+        "return document.getElementById('view').dataset.exposure === '2';"))
+    _, exposed = canvas_digest(browser)
+    if exposed == unexposed:
+        return fail("the canvas did not change with the exposure")
+    browser.execute_script(
+        "const e = document.getElementById('exposure'); e.value = '0';"
+        "e.dispatchEvent(new Event('input'));")
+    WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+        "return document.getElementById('view').dataset.exposure === '0';"))
 
     # The wheel dollies: scrolling down moves the eye away along the view.
     ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(canvas), 0,
