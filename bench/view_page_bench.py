@@ -82,7 +82,11 @@ def measure(browser, url, moves, move_ms, ActionChains, WebDriverWait):
         "Number(document.getElementById('view').dataset.spp) === Number(document.body.dataset.spp)"))
     refined_ms = browser.execute_script(
         "return window.octrayDrawTimes[window.octrayDrawTimes.length - 1]") - end
-    return first_ms, loaded_ms, draws, (end - start) / 1000.0, mrays, refined_ms
+    # How the pictures came: the picture stream (issue 44), or an event and a PNG request
+    # each (the page before it).
+    transport = browser.execute_script(
+        "return document.getElementById('view').dataset.transport || 'event + PNG request'")
+    return first_ms, loaded_ms, draws, (end - start) / 1000.0, mrays, refined_ms, transport
 
 
 def main():
@@ -126,7 +130,7 @@ def main():
                 options.add_argument(argument)
             browser = webdriver.Chrome(service=Service(driver), options=options)
             try:
-                first_ms, loaded_ms, draws, seconds, mrays, refined_ms = measure(
+                first_ms, loaded_ms, draws, seconds, mrays, refined_ms, transport = measure(
                     browser, url, max(1, args.moves), max(0, args.move_ms), ActionChains,
                     WebDriverWait)
             finally:
@@ -135,7 +139,8 @@ def main():
         process.send_signal(signal.SIGINT)
         process.communicate(timeout=60)
     loaded = f" (DOMContentLoaded at {loaded_ms:.0f} ms)" if loaded_ms else ""
-    print(f"scene {args.scene} {args.width}x{args.height}, {args.threads} threads")
+    print(f"scene {args.scene} {args.width}x{args.height}, {args.threads} threads, "
+          f"pictures by {transport}")
     print(f"first picture: drawn {first_ms:.0f} ms after navigation began{loaded}")
     print(f"orbit: {draws} pictures drawn in {seconds:.2f} s of dragging ({args.moves} moves, "
           f"{args.moves / seconds:.1f} a second): {draws / seconds:.1f} pictures/s; "

@@ -26,6 +26,7 @@
 #include "render/image/image_io.h"
 #include "render/memory_estimate.h"
 #include "render/view/compare_view.h"
+#include "render/view/jpeg.h"
 #include "render/view/view_bench.h"
 #include "render/view/view_server.h"
 #include "render/view/view_session.h"
@@ -96,9 +97,14 @@ void print_bench(const Scene& scene, const view::ViewSettings& settings,
                 r.first_spp, r.first_picture_seconds);
     std::printf(
         "orbit: %d updates of %dx%d in %.3f s: %.1f updates/s, %.1f Mrays/s, "
-        "PNG %.0f bytes\n",
+        "%.0f bytes each as sent (JPEG)\n",
         r.updates, r.update_width, r.update_height, r.seconds, r.updates_per_second,
-        r.mrays_per_second, r.png_bytes);
+        r.mrays_per_second, r.sent_bytes);
+    std::printf(
+        "last picture, one thread: tone map %.2f ms; then PNG %.2f ms (%.0f bytes), JPEG q%d "
+        "%.2f ms (%.0f bytes), RGBA8 %.2f ms (%.0f bytes)\n",
+        r.tone_map_ms, r.png_ms, r.last_png_bytes, view::kStreamJpegQuality, r.jpeg_ms,
+        r.jpeg_bytes, r.rgba_ms, r.rgba_bytes);
     std::fflush(stdout);
 }
 
@@ -294,12 +300,12 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->type_name("D")
         ->transform(decimal_integer(1, 64))
         ->capture_default_str();
-    cmd->add_option(
-           "--bench", args->bench,
-           "Serve nothing: measure the time to the first picture and the pictures\n"
-           "a second while the camera orbits, over N updates, " +
-               integer_range_text(1, 1000000) +
-               " (each rendered as a moving\ncamera is and PNG-encoded as for the page)")
+    cmd->add_option("--bench", args->bench,
+                    "Serve nothing: measure the time to the first picture and the pictures\n"
+                    "a second while the camera orbits, over N updates, " +
+                        integer_range_text(1, 1000000) +
+                        " (each rendered as a moving\ncamera is and encoded as the page is "
+                        "sent it: JPEG)")
         ->type_name("N")
         ->transform(decimal_integer(1, 1000000));
     cmd->add_option("--order", args->order,
@@ -323,7 +329,9 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
     cmd->footer(
         "The command prints a URL such as http://127.0.0.1:8090/?token=3f9c...: open it in a\n"
         "browser. The token is 128 random bits, new each run; a request without it gets\n"
-        "403. The page shows the picture refining pass by pass (1, 2, 4, ... samples per\n"
+        "403, and a connection that has not presented it within 5 s is closed. At most 256\n"
+        "connections are served at once (event streams included); one more gets a 503.\n"
+        "The page shows the picture refining pass by pass (1, 2, 4, ... samples per\n"
         "pixel) with spp, Mrays/s and frame time; drag orbits the camera about its look-at\n"
         "point, the wheel dollies, and a moving camera renders at reduced resolution\n"
         "(--preview-divisor) until it stops. The mouse shows the linear RGB value under it.\n"
@@ -335,8 +343,9 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "With two images, octray view A B compares them as octray compare A B does (same\n"
         "defaults, same figures) and the page flips between A, B, |A - B| and the error\n"
         "heatmap; an image that cannot be read exits 4, two that cannot be compared exit 3.\n"
-        "The HTTP API (status, events, PNG and float32 pictures, camera) is described in\n"
-        "render/view/README.md. Ctrl-C (or SIGTERM) stops the server.\n\n"
+        "The HTTP API (status, events, the picture stream, PNG and float32 pictures,\n"
+        "camera) is described in render/view/README.md. Ctrl-C (or SIGTERM) stops the\n"
+        "server.\n\n"
         "Examples:\n"
         "  octray view                                  # the built-in whitted scene\n"
         "  octray view scene.json --port 0              # any free port\n"

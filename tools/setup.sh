@@ -7,8 +7,9 @@
 # slurm-client and munge let tests/farm/slurm.sh run a single-node Slurm (it starts the
 # daemons itself, from a temporary folder; installing them starts nothing here).
 # python3-matplotlib draws bench/plot.py's charts; groff-base checks the man pages.
-# libcpp-httplib-dev is the HTTP server of `octray view`; chromium, chromium-driver and
-# python3-selenium drive its page headless in tests/view/browser_test.py.
+# libcpp-httplib-dev is the HTTP server of `octray view` (libjpeg62-turbo-dev its picture
+# stream's JPEG); chromium, chromium-driver and python3-selenium drive its page headless
+# in tests/view/browser_test.py.
 set -euo pipefail
 
 packages=(
@@ -20,7 +21,7 @@ packages=(
     libpng-dev libembree-dev libssl-dev
     slurmctld slurmd slurm-client munge
     python3-matplotlib groff-base
-    libcpp-httplib-dev chromium chromium-driver python3-selenium
+    libcpp-httplib-dev libjpeg62-turbo-dev chromium chromium-driver python3-selenium
 )
 
 missing=()

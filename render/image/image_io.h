@@ -176,6 +176,9 @@ void write_png_preview(const std::string& path, const Image& image);
 // OETF's power (the tests hold the two equal).
 std::uint8_t srgb8(float linear);
 std::uint8_t srgb8_by_formula(float linear);
+// srgb8(linear[i] * scale) for i < count, into out[i]: the same bytes, the table looked up
+// once for the whole run (`octray view` tone-maps a 1280x720 picture per camera move).
+void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint8_t* out);
 
 // An 8-bit RGB PNG of `rgb` (3 * width * height bytes, row 0 on top) with an sRGB chunk,
 // in memory (`octray view` sends it to the browser): zlib's fastest level, since it is

@@ -208,16 +208,27 @@ struct SrgbTable {
     }
 };
 
-}  // namespace
-
-std::uint8_t srgb8(float linear) {
+const SrgbTable& srgb_table() {
     static const SrgbTable table;
+    return table;
+}
+
+inline std::uint8_t srgb8_in(const SrgbTable& table, float linear) {
     if (!(linear > 0.0f)) return 0;  // NaN too
     if (linear >= 1.0f) return 255;
     int v = table.bucket_start[std::bit_cast<std::uint32_t>(linear) >> 16];
     v += linear >= table.threshold[v + 1] ? 1 : 0;
     while (linear >= table.threshold[v + 1]) ++v;
     return static_cast<std::uint8_t>(v);
+}
+
+}  // namespace
+
+std::uint8_t srgb8(float linear) { return srgb8_in(srgb_table(), linear); }
+
+void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint8_t* out) {
+    const SrgbTable& table = srgb_table();
+    for (std::size_t i = 0; i < count; ++i) out[i] = srgb8_in(table, linear[i] * scale);
 }
 
 namespace {

@@ -3,19 +3,24 @@
 #include <cmath>
 
 #include "render/image/image_io.h"
+#include "render/view/jpeg.h"
 
 namespace octray::view {
 
 std::vector<std::uint8_t> tone_map_srgb8(const Image& image, float exposure) {
-    const float scale = std::exp2(exposure);
+    static_assert(sizeof(Rgb) == 3 * sizeof(float));
     std::vector<std::uint8_t> rgb(3 * image.pixel_count());
-    const Rgb* pixels = image.data();
-    for (std::size_t i = 0; i < image.pixel_count(); ++i) {
-        rgb[3 * i + 0] = srgb8(pixels[i].r * scale);
-        rgb[3 * i + 1] = srgb8(pixels[i].g * scale);
-        rgb[3 * i + 2] = srgb8(pixels[i].b * scale);
-    }
+    srgb8_scaled(reinterpret_cast<const float*>(image.data()), rgb.size(), std::exp2(exposure),
+                 rgb.data());
     return rgb;
+}
+
+PagePicture encode_for_page(const ViewFrame& frame, float exposure) {
+    const int width = frame.image.width(), height = frame.image.height();
+    const std::vector<std::uint8_t> rgb = tone_map_srgb8(frame.image, exposure);
+    if (!frame.preview && frame.spp >= frame.target_spp && frame.coverage >= 1.0)
+        return {encode_png_rgb8(width, height, rgb), "png"};
+    return {encode_jpeg_rgb8(width, height, rgb, kStreamJpegQuality), "jpeg"};
 }
 
 }  // namespace octray::view

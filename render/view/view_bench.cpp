@@ -3,15 +3,20 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "core/vec3.h"
 #include "render/image/image_io.h"
+#include "render/view/jpeg.h"
 #include "render/view/tone_map.h"
 
 namespace octray::view {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+constexpr int kEncodeRepeats = 10;
 
 // The eye turned by `angle` about the up axis through the look-at point (Rodrigues).
 Camera orbit(const Camera& camera, float angle) {
@@ -53,17 +58,14 @@ ViewBenchResult bench_orbit(const Scene& scene, const ViewSettings& settings, in
     result.first_spp = first->spp;
 
     const Camera initial = session.camera();  // an animation's: its first frame's
-    double rays = 0.0, render_seconds = 0.0, png_bytes = 0.0;
+    double rays = 0.0, render_seconds = 0.0, sent_bytes = 0.0;
     const auto orbit_start = Clock::now();
     for (int i = 1; i <= updates; ++i) {
         const float angle =
             6.28318530718f * static_cast<float>(i) / static_cast<float>(updates);
         const std::uint64_t version = session.set_camera(orbit(initial, angle), true);
         const auto frame = wait_for_version(session, version);
-        png_bytes +=
-            static_cast<double>(encode_png_rgb8(frame->image.width(), frame->image.height(),
-                                                tone_map_srgb8(frame->image, 0.0f))
-                                    .size());
+        sent_bytes += static_cast<double>(encode_for_page(*frame, 0.0f).bytes.size());
         rays += frame->mrays_per_second * 1e6 * frame->pass_seconds;
         render_seconds += frame->pass_seconds;
         result.update_width = frame->image.width();
@@ -73,7 +75,35 @@ ViewBenchResult bench_orbit(const Scene& scene, const ViewSettings& settings, in
     result.updates = updates;
     result.updates_per_second = updates / result.seconds;
     result.mrays_per_second = render_seconds > 0.0 ? rays / render_seconds / 1e6 : 0.0;
-    result.png_bytes = png_bytes / updates;
+    result.sent_bytes = sent_bytes / updates;
+
+    // The encodings of the last picture, timed one after the other.
+    const auto last = session.latest();
+    const auto time_ms = [](const auto& work) {
+        const auto t0 = Clock::now();
+        for (int i = 0; i < kEncodeRepeats; ++i) work();
+        return std::chrono::duration<double, std::milli>(Clock::now() - t0).count() /
+               kEncodeRepeats;
+    };
+    const int w = last->image.width(), h = last->image.height();
+    std::vector<std::uint8_t> rgb;
+    result.tone_map_ms = time_ms([&] { rgb = tone_map_srgb8(last->image, 0.0f); });
+    std::string bytes;
+    result.png_ms = time_ms([&] { bytes = encode_png_rgb8(w, h, rgb); });
+    result.last_png_bytes = static_cast<double>(bytes.size());
+    result.jpeg_ms = time_ms([&] { bytes = encode_jpeg_rgb8(w, h, rgb, kStreamJpegQuality); });
+    result.jpeg_bytes = static_cast<double>(bytes.size());
+    std::vector<std::uint8_t> rgba;
+    result.rgba_ms = time_ms([&] {
+        rgba.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4);
+        for (std::size_t p = 0, n = rgba.size() / 4; p < n; ++p) {
+            rgba[4 * p] = rgb[3 * p];
+            rgba[4 * p + 1] = rgb[3 * p + 1];
+            rgba[4 * p + 2] = rgb[3 * p + 2];
+            rgba[4 * p + 3] = 255;
+        }
+    });
+    result.rgba_bytes = static_cast<double>(rgba.size());
     return result;
 }
 

@@ -8,7 +8,6 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
@@ -23,7 +22,9 @@
 
 #include "core/decimal.h"
 #include "render/image/image_io.h"
+#include "render/view/guarded_server.h"
 #include "render/view/http_error.h"
+#include "render/view/jpeg.h"
 #include "render/view/page.h"
 #include "render/view/request_json.h"
 #include "render/view/token.h"
@@ -176,6 +177,27 @@ std::string float_bytes(const Image& image) {
                        image.pixel_count() * sizeof(Rgb));
 }
 
+// One message of /api/pictures: "OCTP", the lengths of `header` and `picture` (uint32,
+// little-endian), then both.
+std::string picture_message(const std::string& header, const std::string& picture) {
+    std::string message = "OCTP";
+    for (const std::size_t length : {header.size(), picture.size()}) {
+        for (int byte = 0; byte < 4; ++byte)
+            message.push_back(static_cast<char>((length >> (8 * byte)) & 0xff));
+    }
+    return message + header + picture;
+}
+
+// `frame` as a message of /api/pictures (encode_for_page: PNG once refined, else JPEG).
+std::string encoded_picture(const ViewFrame& frame, float exposure) {
+    PagePicture picture = encode_for_page(frame, exposure);
+    json header = frame_json(frame);
+    header["event"] = "frame";
+    header["format"] = picture.format;
+    header["exposure"] = exposure;
+    return picture_message(header.dump(), picture.bytes);
+}
+
 void set_common_headers(httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -191,22 +213,17 @@ struct ViewServer::Impl {
     std::string token;
     std::string cookie_name;
     int port = 0;
-    httplib::Server server;
+    GuardedServer server;
     std::thread listener;
     std::atomic<bool> stopping{false};
-    // Event streams open now. Each holds one of the http_threads workers for as long as it
-    // is open, so at most half of them may: the rest answer the page and the API however
-    // many tabs or clients open streams (past the cap, 503 says why).
-    // A stream whose reader left is noticed at its next heartbeat and frees its slot, so a
-    // new stream waits a little for one (a page reloading) before it is refused.
-    int open_streams = 0;
-    std::mutex streams_mutex;
-    std::condition_variable stream_closed;
     std::atomic<bool> listener_done{false};
     std::mutex stop_mutex;
 
     Impl(ViewSession* s, const CompareView* c, ServerOptions o)
-        : session_ptr(s), compare_ptr(c), options(std::move(o)) {
+        : session_ptr(s),
+          compare_ptr(c),
+          options(std::move(o)),
+          server(ConnectionLimits{options.max_connections, options.auth_deadline}) {
         token = options.token.empty() ? random_token() : options.token;
     }
 
@@ -227,13 +244,17 @@ void ViewServer::Impl::routes() {
     server.set_keep_alive_timeout(2);
     server.set_read_timeout(5, 0);
     server.set_write_timeout(5, 0);
-    const auto threads = static_cast<std::size_t>(std::max(2, options.http_threads));
-    server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+    // Each connection is served on a thread of its own, at most max_connections at once
+    // (GuardedServer), so an open event stream holds no worker the page and the API need.
 
     // The token first: nothing, not even a 404, answers a request without it.
     server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
         set_common_headers(res);
-        if (authorized(req)) return httplib::Server::HandlerResponse::Unhandled;
+        if (authorized(req)) {
+            // This connection is no longer held to the deadline for presenting the token.
+            GuardedServer::mark_authenticated();
+            return httplib::Server::HandlerResponse::Unhandled;
+        }
         res.status = 403;
         res.set_content(
             "403 Forbidden: open the URL that `octray view` printed (it carries the token)\n",
@@ -293,50 +314,67 @@ void ViewServer::Impl::scene_routes() {
         res.set_content(status.dump(), "application/json");
     });
 
-    server.Get("/api/events", [this, &session](const httplib::Request&,
-                                               httplib::Response& res) {
-        const int max_streams = std::max(1, options.http_threads / 2);
-        {
-            std::unique_lock<std::mutex> lock(streams_mutex);
-            if (!stream_closed.wait_for(lock, 4 * kHeartbeat,
-                                        [&] { return open_streams < max_streams; }))
-                throw BadRequest(503, "too many event streams: " + std::to_string(max_streams) +
-                                          " are open, the most this viewer serves at once "
-                                          "(close a tab, or poll /api/status)");
-            ++open_streams;
-        }
-        res.set_chunked_content_provider(
-            "text/event-stream",
-            [this, &session, last = std::uint64_t{0}, last_error = std::string()](
-                std::size_t, httplib::DataSink& sink) mutable {
-                const auto frame = session.wait_newer(last, kHeartbeat);
-                if (stopping || session.stopped()) {
-                    sink.done();
-                    return true;
-                }
-                std::string message = ": heartbeat\n\n";
-                if (std::string error = session.error(); error != last_error) {
-                    last_error = error;
-                    if (!error.empty()) {
-                        message =
-                            "event: render-error\ndata: " + json{{"message", error}}.dump() +
-                            "\n\n";
+    server.Get(
+        "/api/events", [this, &session](const httplib::Request&, httplib::Response& res) {
+            res.set_chunked_content_provider(
+                "text/event-stream",
+                [this, &session, last = std::uint64_t{0}, last_error = std::string()](
+                    std::size_t, httplib::DataSink& sink) mutable {
+                    const auto frame = session.wait_newer(last, kHeartbeat);
+                    if (stopping || session.stopped()) {
+                        sink.done();
+                        return true;
                     }
-                } else if (frame && frame->generation > last) {
-                    last = frame->generation;
-                    message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
-                }
-                return sink.write(message.data(), message.size());
-            },
-            // Called when the stream ends, however it ends.
-            [this](bool) {
-                {
-                    const std::lock_guard<std::mutex> lock(streams_mutex);
-                    --open_streams;
-                }
-                stream_closed.notify_one();
-            });
-    });
+                    std::string message = ": heartbeat\n\n";
+                    if (std::string error = session.error(); error != last_error) {
+                        last_error = error;
+                        if (!error.empty()) {
+                            message = "event: render-error\ndata: " +
+                                      json{{"message", error}}.dump() + "\n\n";
+                        }
+                    } else if (frame && frame->generation > last) {
+                        last = frame->generation;
+                        message = "event: frame\ndata: " + frame_json(*frame).dump() + "\n\n";
+                    }
+                    return sink.write(message.data(), message.size());
+                });
+        });
+
+    // The pictures themselves, pushed (issue 44): one long-lived chunked response of
+    // messages, each "OCTP", the length of a JSON header and the length of a picture
+    // (uint32, little-endian), the JSON (the event's frame JSON with "event": "frame" and
+    // "format": "jpeg" or "png"; or "event": "render-error" with "message") and the
+    // picture's file bytes. Lengths of 0 and 0: a heartbeat. The latest picture wins: the
+    // stream encodes and writes the newest picture once the last one is written, so a
+    // slow browser skips pictures and nothing queues; the render thread goes on with the
+    // next picture meanwhile. Previews and the passes before the last are JPEG (a few
+    // milliseconds to encode and to decode at 1280x720; PNG costs several times that),
+    // the refined picture PNG, lossless.
+    server.Get(
+        "/api/pictures", [this, &session](const httplib::Request& req, httplib::Response& res) {
+            const float exposure = exposure_param(req);
+            res.set_chunked_content_provider(
+                "application/octet-stream",
+                [this, &session, exposure, last = std::uint64_t{0}, last_error = std::string()](
+                    std::size_t, httplib::DataSink& sink) mutable {
+                    const auto frame = session.wait_newer(last, kHeartbeat);
+                    if (stopping || session.stopped()) {
+                        sink.done();
+                        return true;
+                    }
+                    std::string message = picture_message(std::string(), std::string());
+                    if (std::string error = session.error(); error != last_error) {
+                        last_error = error;
+                        if (!error.empty())
+                            message = picture_message(
+                                json{{"event", "render-error"}, {"message", error}}.dump(), {});
+                    } else if (frame && frame->generation > last) {
+                        last = frame->generation;
+                        message = encoded_picture(*frame, exposure);
+                    }
+                    return sink.write(message.data(), message.size());
+                });
+        });
 
     const auto image_headers = [](httplib::Response& res, const ViewFrame& frame) {
         res.set_header("X-Octray-Generation", std::to_string(frame.generation));
@@ -369,10 +407,29 @@ void ViewServer::Impl::scene_routes() {
 
     // The linear value under the page's cursor, of the latest picture (whose size the
     // answer repeats: a preview is smaller than the refined picture).
+    // `width` and `height`, when given, are the size of the picture the page shows, in
+    // which x and y are: a page that still shows a preview while the refined picture is
+    // in (or the other way round) is answered the pixel at the same place of the latest.
     server.Get("/api/pixel", [&session](const httplib::Request& req, httplib::Response& res) {
         const auto frame = session.latest();
         if (!frame) throw BadRequest(503, "no picture yet");
-        json answer = pixel_json(req, frame->image);
+        json answer;
+        if (req.has_param("width") || req.has_param("height")) {
+            const int shown_w = integer_param(req, "width", 1, 1 << 16);
+            const int shown_h = integer_param(req, "height", 1, 1 << 16);
+            const int x = integer_param(req, "x", 0, shown_w - 1);
+            const int y = integer_param(req, "y", 0, shown_h - 1);
+            const int w = frame->image.width(), h = frame->image.height();
+            httplib::Request at;
+            at.params = {
+                {"x", std::to_string(static_cast<int>(
+                          (static_cast<std::int64_t>(2 * x + 1) * w) / (2 * shown_w)))},
+                {"y", std::to_string(static_cast<int>(
+                          (static_cast<std::int64_t>(2 * y + 1) * h) / (2 * shown_h)))}};
+            answer = pixel_json(at, frame->image);
+        } else {
+            answer = pixel_json(req, frame->image);
+        }
         answer["generation"] = frame->generation;
         res.set_content(answer.dump(), "application/json");
     });
@@ -510,6 +567,8 @@ void ViewServer::stop() {
     std::lock_guard lock(impl_->stop_mutex);
     impl_->stopping = true;
     impl_->server.stop();
+    // Idle keep-alive connections and unfinished requests end now, not at their timeouts.
+    impl_->server.end_connections();
 }
 
 void ViewServer::wait() {

@@ -2,6 +2,7 @@
 // The HTTP side of `octray view`: the page, the pictures of a ViewSession and the camera
 // endpoint, behind an access token (render/view/README.md lists the protocol).
 
+#include <chrono>
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -22,12 +23,16 @@ struct SaveSettings {
 };
 
 struct ServerOptions {
-    std::string bind = "127.0.0.1";    // loopback only unless the user says otherwise
-    int port = 0;                      // 0: a free port, chosen by the kernel
-    std::string token;                 // empty: random_token()
-    std::size_t max_body = 4096;       // bytes; a longer request body gets 413
-    int http_threads = 16;             // requests served at once (an event stream holds one;
-                                       // at most half of them are streams, 503 past that)
+    std::string bind = "127.0.0.1";  // loopback only unless the user says otherwise
+    int port = 0;                    // 0: a free port, chosen by the kernel
+    std::string token;               // empty: random_token()
+    std::size_t max_body = 4096;     // bytes; a longer request body gets 413
+    // Connections open at once, event streams included (each is served on a thread of its
+    // own); one more is answered 503 saying so, then closed.
+    int max_connections = 256;
+    // A connection that has not presented the token this long after it opened is closed,
+    // however slowly it trickles its bytes.
+    std::chrono::milliseconds auth_deadline{5000};
     std::optional<SaveSettings> save;  // absent: no /api/save
 };
 

@@ -212,7 +212,7 @@ std::uint64_t ViewSession::set_camera(const Camera& camera, bool moving) {
         camera_ = camera;
         moving_ = moving;
         version = ++camera_version_;
-        cancel_ = true;
+        if (!(moving && previewing_)) cancel_ = true;
     }
     changed_.notify_all();
     return version;
@@ -248,6 +248,7 @@ void ViewSession::run() {
         const Camera camera = camera_;
         const bool preview = moving_ && !(version == done_version && !refined);
         moving_ = false;
+        previewing_ = preview;
         cancel_ = false;
         error_.clear();
         lock.unlock();
@@ -266,6 +267,7 @@ void ViewSession::run() {
             // The thread must not end the process; the page shows why, and the next
             // camera tries again.
             lock.lock();
+            previewing_ = false;
             error_ = e.what();
             done_version = version;
             refined = true;
@@ -273,6 +275,7 @@ void ViewSession::run() {
             continue;
         }
         lock.lock();
+        previewing_ = false;
     }
 }
 

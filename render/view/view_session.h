@@ -115,8 +115,11 @@ class ViewSession {
     std::shared_ptr<const ViewFrame> wait_newer(std::uint64_t generation,
                                                 std::chrono::milliseconds timeout) const;
 
-    // Moves the camera: the picture being rendered is abandoned at its next tile. `moving`:
-    // more moves follow soon, so render a preview first. Throws SceneError (with what is
+    // Moves the camera: the picture being rendered is abandoned at its next tile, except a
+    // preview when `moving` (the preview is finished and published, then the latest camera
+    // is rendered: abandoning every preview for the next move would show nothing while the
+    // moves come faster than a preview renders). `moving`: more moves follow soon, so
+    // render a preview first. Throws SceneError (with what is
     // wrong) for a camera the scene cannot have: non-finite numbers, eye on the look-at
     // point, up along the view, a fov out of range. Returns the new camera version.
     std::uint64_t set_camera(const Camera& camera, bool moving);
@@ -158,6 +161,9 @@ class ViewSession {
     Camera camera_;
     std::uint64_t camera_version_ = 1;
     bool moving_ = false;
+    // A preview is being rendered: a newer moving camera does not abandon it (it is
+    // rendered next), so that previews reach the screen however fast the camera moves.
+    bool previewing_ = false;
     bool stop_ = false;
     std::uint64_t generation_ = 0;
     std::shared_ptr<const ViewFrame> latest_;

@@ -190,6 +190,37 @@ def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWai
     _, after = canvas_digest(browser)
     if after == before:
         return fail("the canvas did not change after the drag")
+    # The pictures came over the picture stream (/api/pictures, one long-lived response),
+    # not a request each: no PNG fetched, no event stream opened; the refined one is PNG.
+    stream = browser.execute_script(
+        "const c = document.getElementById('view');"
+        "const asked = performance.getEntriesByType('resource').map((e) => e.name);"
+        "return {transport: c.dataset.transport, format: c.dataset.format,"
+        " drawn: window.octrayStreamPictures,"
+        " per_picture: asked.filter((n) => n.includes('/api/image.png') ||"
+        "                                  n.includes('/api/events')).length};")
+    if stream["transport"] != "stream" or not stream["drawn"]:
+        return fail(f"the pictures did not come over the picture stream: {stream}")
+    if stream["per_picture"]:
+        return fail(f"the page asked for pictures one by one: {stream}")
+    if stream["format"] != "png":
+        return fail(f"the refined picture was not sent lossless (PNG): {stream}")
+    # The exposure is applied by the server: the stream reopens with it and the picture
+    # drawn next is brighter.
+    _, unexposed = canvas_digest(browser)
+    browser.execute_script(
+        "const e = document.getElementById('exposure'); e.value = '2';"
+        "e.dispatchEvent(new Event('input'));")
+    WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+        "return document.getElementById('view').dataset.exposure === '2';"))
+    _, exposed = canvas_digest(browser)
+    if exposed == unexposed:
+        return fail("the canvas did not change with the exposure")
+    browser.execute_script(
+        "const e = document.getElementById('exposure'); e.value = '0';"
+        "e.dispatchEvent(new Event('input'));")
+    WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+        "return document.getElementById('view').dataset.exposure === '0';"))
 
     # The wheel dollies: scrolling down moves the eye away along the view.
     ActionChains(browser).scroll_from_origin(ScrollOrigin.from_element(canvas), 0,
@@ -206,7 +237,8 @@ def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWai
     r2 = math.dist(dollied["camera"]["eye"], lookat)
     if not r2 > 1.01 * r1:
         return fail(f"the wheel did not dolly out: distance {r1} -> {r2}")
-    print(f"PASS: first picture {lit} lit pixels; drag moved the eye {eye0} -> {eye1} "
+    print(f"PASS: {stream['drawn']} pictures drawn from the picture stream; "
+          f"first picture {lit} lit pixels; drag moved the eye {eye0} -> {eye1} "
           f"(camera version {moved['camera_version']}); the wheel dollied from {r1:.3f} "
           f"to {r2:.3f}; screenshots in {artifacts}")
     return 0
@@ -357,6 +389,10 @@ def check_compare(browser, octray, artifacts, ActionChains, WebDriverWait):
                             f"{status['compare']['verdict']}")
             browser.save_screenshot(os.path.join(artifacts, "view_compare_a.png"))
             canvas = browser.find_element("id", "view")
+            # The keys work on the page as loaded, before any click on the canvas.
+            ActionChains(browser).send_keys("d").perform()
+            WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(
+                "return document.getElementById('view').dataset.picture === 'diff';"))
             canvas.click()
             canvas.send_keys("h")
             WebDriverWait(browser, WAIT).until(lambda br: br.execute_script(
