@@ -6,13 +6,13 @@
 // Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
 // (packet_math.h; kernels/README.md, "the ODR rule").
 //
-// A pinhole camera's tile of 16 x 16 pixels sees a narrow pyramid of the scene. On
-// random:1024 each of its 16-ray packets visited about 4 BVH nodes and tested about 9
-// spheres, of which fewer than one came near any of its rays (docs/performance-log.md,
-// "Beams"). The node visits, the packet frustum and the box offsets of every ray cost
-// more than the sphere tests that decide the hits. So closest_hit takes a group of up to
-// kBeamRays rays that share their origin O (Reshetov et al. 2005, "Multi-level ray tracing
-// algorithm", finds entry points the same way):
+// A pinhole camera's tile of 16 x 16 pixels sees a narrow pyramid of the scene: each of
+// its 16-ray packets visits a few BVH nodes and tests a few spheres, of which hardly any
+// comes near any of its rays (counted: docs/performance-log.md, "Beams"). The node visits,
+// the packet frustum and the box offsets of every ray cost more than the sphere tests that
+// decide the hits. So closest_hit takes a group of up to kBeamRays rays that share their
+// origin O (Reshetov et al. 2005, "Multi-level ray tracing algorithm", finds entry points
+// the same way):
 // 1. beam_rays: every direction has one sign on a main axis m; per ray, its slopes
 //    u = d_a / d_m and v = d_b / d_m on the two other axes. The rays lie in the pyramid
 //    u_lo <= p_a / w <= u_hi, v_lo <= p_b / w <= v_hi, w >= 0, in coordinates about O with

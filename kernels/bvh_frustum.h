@@ -31,12 +31,12 @@ namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 // are the same with it or without it.
 //
 // Where the live lanes also share their origin (a pinhole camera's packet), the bundle is
-// nearly as tight as its rays: on random:1048576, per-lane tests dropped only 5 % of the
-// children it entered. They then cost more than they cull, and every child the bundle
-// enters takes all the packet's lanes; the bundle's own t_far (the farthest closest hit so
-// far) still culls the children behind every lane's hit. Rays from many origins
-// (reflections, shadows) spread the bundle's offsets and keep the per-lane tests
-// (docs/performance-log.md, "Packets from one origin; leaf prefetches").
+// nearly as tight as its rays: the per-lane tests drop few of the children it enters.
+// They then cost more than they cull, and every child the bundle enters takes all the
+// packet's lanes; the bundle's own t_far (the farthest closest hit so far) still culls the
+// children behind every lane's hit. Rays from many origins (reflections, shadows) spread
+// the bundle's offsets and keep the per-lane tests (docs/performance-log.md, "Packets from
+// one origin; leaf prefetches").
 template <class F>
 struct PacketFrustum {
     using Plane = const float (BvhNode8::*)[kBvhWidth];

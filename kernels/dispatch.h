@@ -67,9 +67,9 @@ inline constexpr std::uint32_t kBvhSecondaryRayByRayMinSpheres = 131072;
 // ... and from this many on where the spheres are dense: where a line through the BVH's
 // root box crosses kBvhSecondaryRayByRayMinCrossings spheres or more on average
 // (sphere_crossings), secondary rays end a few spheres from where they start and their
-// packets part at once (measured: random:65536, 7.6 crossings, single rays 7 % faster on one
-// thread; random:32768, 6.1, packets 4 % faster; sphereflake:5, 66430 spheres but 0.8,
-// packets 2.5 times faster: docs/performance-log.md, "Single rays two at a time").
+// packets part at once. The sphere count alone does not tell the scenes where single rays
+// win from those where packets do; the crossings do (measured: docs/performance-log.md,
+// "Single rays two at a time", the paragraph "Which secondary rays go ray by ray").
 inline constexpr std::uint32_t kBvhSecondaryRayByRayDenseMinSpheres = 32768;
 inline constexpr double kBvhSecondaryRayByRayMinCrossings = 7.0;
 

@@ -221,10 +221,11 @@ void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t cou
     // Packets of neighbouring pixels' shadow rays start on surfaces at any depth and may
     // head for different lights, and their traversals share little. Sorted by direction
     // octant and origin cell, rays from one neighbourhood towards one light travel
-    // together (docs/performance-log.md: shadow rays 7-13 % faster on random:65536,
-    // random:1048576 and sphereflake:5). Each ray's answer is exact whatever its packet,
-    // so the order changes no result. The sort is a counting sort of words holding the key
-    // (18 bits) above the ray's index in the batch (12 bits), two passes of 9 bits.
+    // together (measured, with the threshold kBvhShadowSortMinSpheres:
+    // docs/performance-log.md, "BVH: millions of spheres against Embree"). Each ray's
+    // answer is exact whatever its packet, so the order changes no result. The sort is a
+    // counting sort of words holding the key (18 bits) above the ray's index in the batch
+    // (12 bits), two passes of 9 bits.
     static_assert(kShadowBatch <= 4096);
     alignas(64) std::uint32_t order[kShadowBatch], sorted[kShadowBatch];
     constexpr std::uint32_t N = kTraversalWidth;

@@ -19,7 +19,8 @@ namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 // c' = O'.O' - r^2 and disc = a (r^2 - l.l) with l = O' - (b/a) V; sphere_roots the two
 // roots, sorted, from q = -b - sign(b) sqrt(disc): q/a and c'/q (q/a alone when q = 0).
 // A negative or NaN discriminant gives NaN roots: every comparison with them fails.
-// Forced inline: GCC kept them as calls in the leaf loops (4 % of a frame, perf).
+// Forced inline: GCC kept them as calls in the leaf loops (docs/performance-log.md,
+// "Figures from source comments").
 template <class F>
 struct SphereQuadratic {
     F b, c, disc;

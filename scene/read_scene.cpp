@@ -1,6 +1,7 @@
 // JSON scene files (docs/scene-format.md) into the authored Scene: the diagnosing reader
-// (scene/load.h, parse_scene_json_diagnosing). Defaults and the exact rules are in
-// scene/README.md; every message names the file, the JSON path and what was expected.
+// (scene/load.h, parse_scene_json_diagnosing). Defaults and the rules are in
+// docs/scene-format.md, what the code decides where it is silent in scene/README.md; every
+// message names the file, the JSON path and what was expected.
 
 #include <algorithm>
 #include <array>

@@ -1,7 +1,7 @@
 #pragma once
 // The scene as authored: what a JSON file or a built-in generator describes, in file
 // order, before it is compiled into the flat SoA layout the packet kernels read.
-// Field semantics: docs/rendering-model.md; defaults: scene/README.md.
+// Field semantics: docs/rendering-model.md; defaults: docs/scene-format.md.
 
 #include <cstdint>
 #include <optional>

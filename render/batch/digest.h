@@ -1,8 +1,9 @@
 #pragma once
 // SHA-256 of a scene (`octray.sceneSha256`): the digest `sha256sum scene.json` prints, so a
 // farm can tell which version of a scene file produced an image. OpenSSL's libcrypto does
-// the hashing; it uses the CPU's SHA instructions where there are some (0.13 s for a
-// 114 MB scene file, where a portable C++ implementation took 0.88 s).
+// the hashing; it uses the CPU's SHA instructions where there are some, far faster than a
+// portable C++ implementation (measured: docs/performance-log.md, "Figures from source
+// comments").
 
 #include <memory>
 #include <string>

@@ -475,8 +475,8 @@ BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<
                              static_cast<std::size_t>(settings.options.threads));
     // OpenEXR compresses the blocks of scan lines of a frame on a pool of its own: as many
     // threads as the render's (none for one thread: the caller compresses). The file's
-    // bytes are the same for any count; a 1920x1080 ZIP frame is written about twice as
-    // fast on 2 threads (tools/README.md, "Time to image").
+    // bytes are the same for any count, and the write is faster with more threads
+    // (measured: docs/performance-log.md, "Time to image on a Zen 3 VM").
     const std::size_t threads =
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
     set_exr_thread_count(threads > 1 ? static_cast<int>(std::min<std::size_t>(threads, 64))

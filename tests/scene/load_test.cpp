@@ -1,5 +1,5 @@
-// JSON scene loading: every key of docs/scene-format.md and the defaults of
-// scene/README.md. Errors: load_error_test.cpp; validate_scene: validate_test.cpp.
+// JSON scene loading: every key of docs/scene-format.md and its defaults, and the rules
+// scene/README.md adds. Errors: load_error_test.cpp; validate_scene: validate_test.cpp.
 
 #include "scene/load.h"
 
