@@ -51,6 +51,15 @@ class PreparedScene {
     explicit PreparedScene(const Scene& scene, Accel accel = Accel::automatic, int threads = 0);
     // The same scene seen through `camera` (valid for it: validate_scene's camera rules).
     void set_camera(const Camera& camera) { set_compiled_camera(compiled_, camera); }
+    // ... on a `width` x `height` picture of `spp` samples a pixel (each at least 1): the
+    // viewer's previews are smaller than its refined pictures, and neither the compiled
+    // objects nor the BVH depend on the picture.
+    void set_view(const Camera& camera, int width, int height, int spp) {
+        compiled_.width = width;
+        compiled_.height = height;
+        compiled_.spp = spp;
+        set_compiled_camera(compiled_, camera);
+    }
 
     // The scene posed again (an animation's frame: the same objects in the same order,
     // validated, its spheres moved or resized, its camera moved): the compiled arrays are

@@ -15,7 +15,6 @@
 #include "render/reference.h"
 #include "render/view/frameless.h"
 #include "scene/animation.h"
-#include "scene/compile.h"
 #include "scene/load.h"
 #include "scene/scene_error.h"
 
@@ -229,6 +228,7 @@ void ViewSession::publish(ViewFrame frame) {
 
 void ViewSession::run() {
     if (settings_.order == PixelOrder::frameless) return run_frameless();
+    std::optional<PreparedScene> prepared_scene;  // these switches' scene (simd path)
     std::uint64_t done_version = 0;  // the camera version of the last picture rendered
     bool refined = true;             // whether that picture was the full progressive one
     Clock::time_point last_preview;
@@ -254,11 +254,11 @@ void ViewSession::run() {
         lock.unlock();
         try {
             if (preview) {
-                render_preview(camera, version);
+                render_preview(camera, version, prepared_scene);
                 last_preview = Clock::now();
                 refined = false;
             } else {
-                refined = render_passes(camera, version);
+                refined = render_passes(camera, version, prepared_scene);
             }
             done_version = version;
         } catch (const RenderCancelled&) {
@@ -317,9 +317,7 @@ void ViewSession::run_frameless() {
         try {
             if (new_camera) {
                 if (settings_.path == RenderPath::simd) {
-                    if (!prepared)
-                        prepared.emplace(scene_, Accel::automatic, settings_.threads);
-                    prepared->set_camera(camera);
+                    this->prepared(prepared).set_camera(camera);
                 } else {
                     scalar->camera = camera;
                 }
@@ -355,18 +353,33 @@ void ViewSession::run_frameless() {
     }
 }
 
-void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
-    Scene scene = scene_;
-    scene.camera = camera;
+// The SIMD path's scene, compiled and its BVH built for the first picture of these
+// switches; each picture after only re-aims it (and sizes it, for a preview).
+PreparedScene& ViewSession::prepared(std::optional<PreparedScene>& prepared) const {
+    if (!prepared) prepared.emplace(scene_, Accel::automatic, settings_.threads);
+    return *prepared;
+}
+
+void ViewSession::render_preview(const Camera& camera, std::uint64_t version,
+                                 std::optional<PreparedScene>& prepared_scene) {
     const int d = std::max(1, settings_.preview_divisor);
-    scene.image.width = std::max(1, (scene_.image.width + d - 1) / d);
-    scene.image.height = std::max(1, (scene_.image.height + d - 1) / d);
-    scene.image.spp = 1;
-    const RenderOptions options = render_options(scene.image.width);
+    const int width = std::max(1, (scene_.image.width + d - 1) / d);
+    const int height = std::max(1, (scene_.image.height + d - 1) / d);
+    const RenderOptions options = render_options(width);
     const auto start = Clock::now();
-    RenderResult result = settings_.path == RenderPath::simd
-                              ? render_packet(scene, options, settings_.isa)
-                              : render_reference(scene, options);
+    RenderResult result;
+    if (settings_.path == RenderPath::simd) {
+        PreparedScene& scene = prepared(prepared_scene);
+        scene.set_view(camera, width, height, 1);
+        result = render_packet(scene, options, settings_.isa);
+    } else {
+        Scene scene = scene_;
+        scene.camera = camera;
+        scene.image.width = width;
+        scene.image.height = height;
+        scene.image.spp = 1;
+        result = render_reference(scene, options);
+    }
     ViewFrame frame = frame_of(version, camera);
     frame.image = std::move(result.image);
     frame.preview = true;
@@ -377,17 +390,22 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version) {
     publish(std::move(frame));
 }
 
-bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
-    Scene scene = scene_;
-    scene.camera = camera;
-    const RenderOptions options = render_options(scene.image.width);
+bool ViewSession::render_passes(const Camera& camera, std::uint64_t version,
+                                std::optional<PreparedScene>& prepared_scene) {
+    const RenderOptions options = render_options(scene_.image.width);
     const auto start = Clock::now();
-    // The SIMD path compiles the scene once for all passes of this camera.
-    std::optional<CompiledScene> compiled;
-    if (settings_.path == RenderPath::simd) compiled.emplace(compile_scene(scene));
+    std::optional<Scene> scalar;  // the scalar path's scene with this camera
+    PreparedScene* simd = nullptr;
+    if (settings_.path == RenderPath::simd) {
+        simd = &prepared(prepared_scene);
+        simd->set_view(camera, scene_.image.width, scene_.image.height, scene_.image.spp);
+    } else {
+        scalar = scene_;
+        scalar->camera = camera;
+    }
     const batch::PassRenderer render_pass = [&](const RenderOptions& pass_options) {
-        return compiled ? render_packet(*compiled, pass_options, settings_.isa)
-                        : render_reference(scene, pass_options);
+        return simd ? render_packet(*simd, pass_options, settings_.isa)
+                    : render_reference(*scalar, pass_options);
     };
     RayCounts rays;
     double render_seconds = 0.0;
@@ -404,7 +422,7 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version) {
         frame.mrays_per_second = mrays_per_second(so_far);
         publish(std::move(frame));
     };
-    batch::render_progressive(render_pass, scene.image.spp, options, on_pass);
+    batch::render_progressive(render_pass, scene_.image.spp, options, on_pass);
     return true;
 }
 

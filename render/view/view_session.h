@@ -16,6 +16,7 @@
 
 #include "core/image.h"
 #include "kernels/isa.h"
+#include "render/packet_renderer.h"
 #include "render/types.h"
 #include "scene/scene.h"
 
@@ -136,8 +137,13 @@ class ViewSession {
   private:
     void run();
     void run_frameless();
-    void render_preview(const Camera& camera, std::uint64_t version);
-    bool render_passes(const Camera& camera, std::uint64_t version);
+    // A picture of `camera`; the simd path renders `prepared_scene`, prepared for the
+    // first picture of the current switches (run() keeps it, reconfigure() drops it).
+    void render_preview(const Camera& camera, std::uint64_t version,
+                        std::optional<PreparedScene>& prepared_scene);
+    bool render_passes(const Camera& camera, std::uint64_t version,
+                       std::optional<PreparedScene>& prepared_scene);
+    PreparedScene& prepared(std::optional<PreparedScene>& prepared) const;
     void publish(ViewFrame frame);
 
     // Options of every render of the current switches: threads, the cancel flag, the

@@ -42,11 +42,15 @@ using octray::view::ViewSession;
 using octray::view::ViewSettings;
 using octray::view::test::small_whitted;
 
+// An image's raw bytes, as /api/image.f32 returns them.
+std::string bytes_of(const octray::Image& image) {
+    return std::string(reinterpret_cast<const char*>(image.data()),
+                       image.pixel_count() * sizeof(octray::Rgb));
+}
+
 // The raw bytes of render_packet's image of `scene`: what /api/image.f32 must return.
 std::string rendered_bytes(const Scene& scene) {
-    const octray::RenderResult result = octray::render_packet(scene);
-    return std::string(reinterpret_cast<const char*>(result.image.data()),
-                       result.image.pixel_count() * sizeof(octray::Rgb));
+    return bytes_of(octray::render_packet(scene).image);
 }
 
 class ViewServerTest : public ::testing::Test {
@@ -314,6 +318,39 @@ TEST(ViewSessionPreviews, MovesFasterThanAPreviewRendersStillPublishPreviews) {
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     EXPECT_GE(previews_seen, 3u) << "previews were abandoned while the camera kept moving";
+}
+
+// The viewer prepares the scene once (compile + BVH) and re-aims and re-sizes it for each
+// picture: a preview (a quarter of the size, 1 spp) and the refined picture after it are
+// each, bit for bit, the scene rendered afresh at that size with that camera.
+TEST(ViewSessionPreviews, APreviewAndTheRefinedPictureAreThoseOfAFreshRender) {
+    Scene scene = octray::load_scene("random:64,width=64,height=36,spp=2");
+    ViewSettings settings;
+    settings.threads = 2;
+    settings.settle = std::chrono::milliseconds(300);
+    ViewSession session(scene, settings);
+    auto frame = session.wait_newer(0, std::chrono::seconds(60));
+    ASSERT_TRUE(frame);
+    octray::Camera camera = scene.camera;
+    camera.eye = {0.7f, 0.4f, 3.5f};
+    const std::uint64_t version = session.set_camera(camera, true);
+    std::shared_ptr<const octray::view::ViewFrame> preview, refined;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!refined && std::chrono::steady_clock::now() < deadline) {
+        frame = session.wait_newer(frame->generation, std::chrono::seconds(1));
+        if (!frame || frame->camera_version != version) continue;
+        if (frame->preview) preview = frame;
+        if (!frame->preview && frame->spp == 2) refined = frame;
+    }
+    ASSERT_TRUE(preview) << "no preview of the moved camera";
+    ASSERT_TRUE(refined) << "no refined picture of the moved camera";
+    Scene moved = scene;
+    moved.camera = camera;
+    EXPECT_EQ(bytes_of(refined->image), rendered_bytes(moved));
+    moved.image.width = 16;
+    moved.image.height = 9;
+    moved.image.spp = 1;
+    EXPECT_EQ(bytes_of(preview->image), rendered_bytes(moved));
 }
 
 // Reads one event stream until `enough` says so; the events' JSON payloads.
