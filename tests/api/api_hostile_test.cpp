@@ -18,9 +18,11 @@
 #include <string>
 #include <vector>
 
+#include "error_kind.h"
 #include "octray/octray.h"
 
 namespace api = octray::api;
+using octray::api::testing::kind_of;
 
 namespace {
 
@@ -51,16 +53,6 @@ bool returns_or_api_error(const std::string& what, const std::function<void()>& 
         ADD_FAILURE() << what << ": threw a non-std exception";
     }
     return false;
-}
-
-api::ErrorKind kind_of(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const api::Error& e) {
-        return e.kind();
-    }
-    ADD_FAILURE() << "no api::Error thrown";
-    return api::ErrorKind::io;
 }
 
 // A small valid scene to break one piece at a time.

@@ -11,9 +11,11 @@
 #include <thread>
 #include <vector>
 
+#include "error_kind.h"
 #include "octray/octray.h"
 
 namespace api = octray::api;
+using octray::api::testing::kind_of;
 
 namespace {
 
@@ -113,15 +115,6 @@ TEST(Api, ExrWrittenReadsBackAndCompares) {
 }
 
 TEST(Api, FailuresAreErrorsOfTheRightKind) {
-    const auto kind_of = [](auto&& f) {
-        try {
-            f();
-        } catch (const api::Error& e) {
-            return e.kind();
-        }
-        ADD_FAILURE() << "no api::Error thrown";
-        return api::ErrorKind::invalid_argument;
-    };
     EXPECT_EQ(kind_of([] { api::Scene::load(temp_path("missing.json")); }),
               api::ErrorKind::scene);
     EXPECT_EQ(kind_of([] { api::Scene::from_json("{\"camera\": {}}"); }),
@@ -246,24 +239,16 @@ TEST(Api, ARendererGivesEachFrameAsRenderedAlone) {
 
 TEST(Api, ARendererRefusesWhatRenderRefuses) {
     const api::Scene scene = small_scene();
-    const auto kind = [](const std::function<void()>& f) {
-        try {
-            f();
-        } catch (const api::Error& e) {
-            return e.kind();
-        }
-        ADD_FAILURE() << "no api::Error";
-        return api::ErrorKind::io;
-    };
-    EXPECT_EQ(kind([&] { api::Renderer(scene, {.threads = -1}); }),
+    EXPECT_EQ(kind_of([&] { api::Renderer(scene, {.threads = -1}); }),
               api::ErrorKind::invalid_argument);
-    EXPECT_EQ(kind([&] { api::Renderer(scene, {.tile_width = 0}); }),
+    EXPECT_EQ(kind_of([&] { api::Renderer(scene, {.tile_width = 0}); }),
               api::ErrorKind::invalid_argument);
-    EXPECT_EQ(kind([&] { api::Renderer(scene, {.spp = (1 << 20) + 1}); }),
+    EXPECT_EQ(kind_of([&] { api::Renderer(scene, {.spp = (1 << 20) + 1}); }),
               api::ErrorKind::scene);
     api::Renderer renderer(scene, {.threads = 1});
-    EXPECT_EQ(kind([&] { renderer.render(-1); }), api::ErrorKind::invalid_argument);
+    EXPECT_EQ(kind_of([&] { renderer.render(-1); }), api::ErrorKind::invalid_argument);
     api::Renderer moved = std::move(renderer);
     EXPECT_EQ(moved.render(0).image.width, 48);
-    EXPECT_EQ(kind([&] { renderer.render(0); }), api::ErrorKind::invalid_argument);  // NOLINT
+    EXPECT_EQ(kind_of([&] { renderer.render(0); }),
+              api::ErrorKind::invalid_argument);  // NOLINT
 }

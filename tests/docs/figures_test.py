@@ -15,9 +15,11 @@ when Chromium, chromedriver or python3-selenium is missing.
 """
 
 import os
-import shutil
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import headless_chromium  # noqa: E402  (tests/headless_chromium.py)
 
 SKIP = 77
 WAIT = 90  # seconds: generous, for a loaded two-core machine
@@ -80,16 +82,6 @@ def problems(name, view_box, boxes):
 
 
 def run(figures, artifacts):
-    try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.service import Service
-    except ImportError:
-        return skip("python3-selenium is not installed")
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
-    driver = shutil.which("chromedriver") or (
-        "/usr/bin/chromedriver" if os.path.exists("/usr/bin/chromedriver") else None)
-    if not chromium or not driver:
-        return skip("chromium or chromedriver is not installed")
     svgs = sorted(f for f in os.listdir(figures) if f.endswith(".svg"))
     if not svgs:
         print(f"FAIL: no .svg in {figures}")
@@ -99,13 +91,9 @@ def run(figures, artifacts):
 
     found = []
     with tempfile.TemporaryDirectory() as profile:
-        options = webdriver.ChromeOptions()
-        options.binary_location = chromium
-        for argument in ("--headless=new", "--no-sandbox", "--disable-gpu",
-                         "--disable-dev-shm-usage", "--window-size=1200,800",
-                         "--hide-scrollbars", f"--user-data-dir={profile}"):
-            options.add_argument(argument)
-        browser = webdriver.Chrome(service=Service(driver), options=options)
+        browser, missing = headless_chromium.start(profile, "1200,800", ("--hide-scrollbars",))
+        if browser is None:
+            return skip(missing)
         try:
             browser.set_page_load_timeout(WAIT)
             for name in svgs:

@@ -20,13 +20,15 @@ python3-selenium is missing.
 import json
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
 import tempfile
 import urllib.error
 import urllib.request
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import headless_chromium  # noqa: E402  (tests/headless_chromium.py)
 
 SKIP = 77
 WAIT = 90  # seconds: generous, for a loaded two-core machine
@@ -80,18 +82,11 @@ def canvas_digest(browser):
 
 def run(octray, artifacts):
     try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.service import Service
         from selenium.webdriver.common.action_chains import ActionChains
         from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
         from selenium.webdriver.support.ui import WebDriverWait
     except ImportError:
         return skip("python3-selenium is not installed")
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
-    driver = shutil.which("chromedriver") or (
-        "/usr/bin/chromedriver" if os.path.exists("/usr/bin/chromedriver") else None)
-    if not chromium or not driver:
-        return skip("chromium or chromedriver is not installed")
     os.makedirs(artifacts, exist_ok=True)
 
     process, url = start_view(octray)
@@ -106,13 +101,9 @@ def run(octray, artifacts):
                 return fail(f"without the token: HTTP {e.code}, expected 403")
 
         with tempfile.TemporaryDirectory() as profile:
-            options = webdriver.ChromeOptions()
-            options.binary_location = chromium
-            for argument in ("--headless=new", "--no-sandbox", "--disable-gpu",
-                             "--disable-dev-shm-usage", "--window-size=640,400",
-                             f"--user-data-dir={profile}"):
-                options.add_argument(argument)
-            browser = webdriver.Chrome(service=Service(driver), options=options)
+            browser, missing = headless_chromium.start(profile, "640,400")
+            if browser is None:
+                return skip(missing)
             try:
                 status = check_page(browser, url, artifacts, ActionChains, ScrollOrigin,
                                     WebDriverWait)
