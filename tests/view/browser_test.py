@@ -108,6 +108,8 @@ def run(octray, artifacts):
                 status = check_page(browser, url, artifacts, ActionChains, ScrollOrigin,
                                     WebDriverWait)
                 if status == 0:
+                    status = check_zoom(browser, WebDriverWait)
+                if status == 0:
                     status = check_frameless(browser, octray, artifacts, WebDriverWait)
                 if status == 0:
                     status = check_save(browser, octray, WebDriverWait)
@@ -232,6 +234,48 @@ def check_page(browser, url, artifacts, ActionChains, ScrollOrigin, WebDriverWai
           f"first picture {lit} lit pixels; drag moved the eye {eye0} -> {eye1} "
           f"(camera version {moved['camera_version']}); the wheel dollied from {r1:.3f} "
           f"to {r2:.3f}; screenshots in {artifacts}")
+    return 0
+
+
+def check_zoom(browser, WebDriverWait):
+    """The z key (no click first) zooms the 160 x 90 picture to 1, 2, 4 and 8 screen pixels a
+    pixel and back to fitting the window, and the value under the cursor at 2x is that of
+    the picture pixel under it."""
+    def shown():
+        return browser.execute_script(
+            "const r = document.getElementById('view').getBoundingClientRect();"
+            "return [r.width, r.height, document.getElementById('zoom').textContent];")
+
+    body = browser.find_element("tag name", "body")
+    for width, height, label in ((160, 90, "1x"), (320, 180, "2x"), (640, 360, "4x"),
+                                 (1280, 720, "8x"), (160, 90, "fit")):
+        body.send_keys("z")
+        got = shown()
+        if abs(got[0] - width) > 0.5 or abs(got[1] - height) > 0.5 or got[2] != label:
+            return fail(f"zoom {label}: the canvas is {got[0]} x {got[1]} ({got[2]!r}), "
+                        f"expected {width} x {height}")
+        if label == "2x":
+            # Picture pixel (10, 5) is CSS pixels 20-21, 10-11 from the canvas's corner.
+            browser.execute_script(
+                "const c = document.getElementById('view');"
+                "const r = c.getBoundingClientRect();"
+                "c.dispatchEvent(new MouseEvent('mousemove', {bubbles: true,"
+                " clientX: r.left + 21, clientY: r.top + 11}));")
+            try:
+                WebDriverWait(browser, WAIT).until(lambda b: b.execute_script(
+                    "return document.getElementById('pixel').textContent"
+                    ".startsWith('(10, 5)');"))
+            except Exception:
+                text = browser.execute_script(
+                    "return document.getElementById('pixel').textContent;")
+                return fail(f"at 2x the cursor over pixel (10, 5) reads {text!r}")
+    # Fit: a picture larger than the window is shown whole, its shape kept.
+    fits = browser.execute_script(
+        "const c = document.getElementById('view'); const s = getComputedStyle(c);"
+        "return [s.maxWidth, parseFloat(s.maxHeight), window.innerHeight];")
+    if fits[0] != "100%" or abs(fits[1] - (fits[2] - 130)) > 1:
+        return fail(f"fit: the canvas's max width and height are {fits[:2]}, expected 100% "
+                    f"and the window's height ({fits[2]}) less the header and help")
     return 0
 
 
