@@ -45,7 +45,8 @@ struct ViewArguments {
     int width = 0, height = 0, spp = 0, max_depth = 0;
     int threads = 0;
     int preview_divisor = 4;
-    int bench = 0;  // orbit updates to measure; 0: serve
+    int frameless_block = 8;  // --frameless-block: side of the frameless order's blocks
+    int bench = 0;            // orbit updates to measure; 0: serve
     std::string path{"simd"};
     std::string isa{"auto"};
     std::string order{"tiled"};
@@ -220,6 +221,7 @@ void run_view(const ViewArguments& args) {
     }
     settings.threads = args.threads;
     settings.preview_divisor = args.preview_divisor;
+    settings.frameless_block = args.frameless_block;
     settings.order = view::parse_pixel_order(args.order).value_or(view::PixelOrder::tiled);
 
     if (args.bench > 0) {
@@ -308,13 +310,23 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
                         "sent it: JPEG)")
         ->type_name("N")
         ->transform(decimal_integer(1, 1000000));
-    cmd->add_option("--order", args->order,
-                    "Pixel order: tiled (whole pictures, progressive passes, previews while\n"
-                    "moving), rows (the same, one tile a row: row-major) or frameless (8x8\n"
-                    "blocks re-rendered in a fixed random order and shown as they land, no\n"
-                    "frame boundaries; Bishop et al. 1994); the page can switch it")
+    cmd->add_option(
+           "--order", args->order,
+           "Pixel order: tiled (whole pictures, progressive passes, previews while\n"
+           "moving), rows (the same, one tile a row: row-major) or frameless (blocks\n"
+           "of --frameless-block pixels re-rendered in a fixed random order and shown\n"
+           "as they land, no frame boundaries; Bishop et al. 1994); the page can\n"
+           "switch it")
         ->type_name("ORDER")
         ->check(one_of({"tiled", "rows", "frameless"}))
+        ->capture_default_str();
+    cmd->add_option("--frameless-block", args->frameless_block,
+                    "Side in pixels of the frameless order's blocks, " +
+                        integer_range_text(1, 64) +
+                        ": 1 re-renders single pixels in a\nrandom order (each a packet with "
+                        "one live ray of 8)")
+        ->type_name("N")
+        ->transform(decimal_integer(1, 64))
         ->capture_default_str();
     cmd->add_option("--path", args->path,
                     "Render path: simd (8-ray packets) or scalar (the reference renderer)")

@@ -538,6 +538,25 @@ class FramelessViewTest : public ViewServerTest {
     }
 };
 
+// Single pixels (--frameless-block 1): 64 x 36 blocks of one pixel, in batches; once every
+// pixel of the camera has landed, the picture is the tiled order's bit for bit.
+TEST(FramelessSinglePixels, ConvergeToTheTiledPictureBitForBit) {
+    const Scene scene = octray::load_scene("random:64,width=64,height=36,spp=2");
+    ViewSettings settings;
+    settings.order = octray::view::PixelOrder::frameless;
+    settings.frameless_block = 1;
+    settings.threads = 2;
+    ViewSession session(scene, settings);
+    std::shared_ptr<const octray::view::ViewFrame> frame;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < deadline) {
+        frame = session.wait_newer(frame ? frame->generation : 0, std::chrono::seconds(1));
+        if (frame && frame->coverage == 1.0) break;
+    }
+    ASSERT_TRUE(frame && frame->coverage == 1.0);
+    EXPECT_EQ(bytes_of(frame->image), rendered_bytes(scene));
+}
+
 // Blocks land a batch at a time; once every block of a still camera has been rendered,
 // the picture is the tiled order's (render_packet's) bit for bit, for the first camera and
 // for a camera set later, whose sweep starts over a picture of the old one.
