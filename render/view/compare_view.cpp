@@ -1,6 +1,8 @@
 #include "render/view/compare_view.h"
 
 #include <array>
+#include <set>
+#include <stdexcept>
 #include <utility>
 
 namespace octray::view {
@@ -24,6 +26,45 @@ Image display_rgb(const ChannelImage& image) {
     return rgb;
 }
 
+std::vector<std::string> display_layers(const ChannelImage& image) {
+    std::set<std::string> named;
+    for (const std::string& name : image.channel_names) {
+        const std::size_t dot = name.rfind('.');
+        if (dot != std::string::npos && dot > 0)
+            named.insert(name.substr(0, dot));
+        else if (name != "R" && name != "G" && name != "B" && name != "A" && name != "Y")
+            named.insert(name);
+    }
+    std::vector<std::string> layers{""};
+    layers.insert(layers.end(), named.begin(), named.end());
+    return layers;
+}
+
+Image display_rgb(const ChannelImage& image, const std::string& layer) {
+    if (layer.empty()) return display_rgb(image);
+    const auto find = [&](const char* suffix) {
+        return image.find_channel(layer + "." + suffix);
+    };
+    std::array<int, 3> source{find("R"), find("G"), find("B")};
+    if (source[0] < 0 || source[1] < 0 || source[2] < 0)
+        source = {find("X"), find("Y"), find("Z")};
+    if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
+        // One channel as gray: the layer's first, or the unprefixed channel of that name.
+        int gray = image.find_channel(layer);
+        for (int c = 0; gray < 0 && c < image.channel_count(); ++c)
+            if (image.channel_names[static_cast<std::size_t>(c)].rfind(layer + ".", 0) == 0)
+                gray = c;
+        if (gray < 0) throw std::invalid_argument("no layer \"" + layer + "\" in the image");
+        source = {gray, gray, gray};
+    }
+    Image rgb(image.width, image.height);
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x)
+            rgb.at(x, y) = Rgb{image.at(source[0], x, y), image.at(source[1], x, y),
+                               image.at(source[2], x, y)};
+    return rgb;
+}
+
 CompareView load_compare_view(const std::string& path_a, const std::string& path_b,
                               const CompareOptions& options) {
     CompareView view;
@@ -36,7 +77,9 @@ CompareView load_compare_view(const std::string& path_a, const std::string& path
     view.figures_json = format_compare_json(view.result, options, path_a, path_b);
     view.rgb_a = display_rgb(view.a);
     view.rgb_b = display_rgb(view.b);
-    view.rgb_diff = display_rgb(difference_image(view.a, view.b, view.result));
+    view.diff = difference_image(view.a, view.b, view.result);
+    view.rgb_diff = display_rgb(view.diff);
+    view.layers = display_layers(view.a);
     view.heatmap = render_error_heatmap(view.a, view.b, view.result);
     return view;
 }

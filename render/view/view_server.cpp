@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -217,6 +218,10 @@ struct ViewServer::Impl {
     std::thread listener;
     std::atomic<bool> stopping{false};
     std::atomic<bool> listener_done{false};
+    // `octray view A B`: the pictures of layers other than the colour, by (picture, layer),
+    // made when first asked for (std::map: references to them stay valid).
+    std::mutex layer_mutex;
+    std::map<std::pair<std::string, std::string>, Image> layer_pictures;
     std::mutex stop_mutex;
 
     Impl(ViewSession* s, const CompareView* c, ServerOptions o)
@@ -473,6 +478,7 @@ void ViewServer::Impl::compare_routes() {
                           {"heatmap_legend", view.heatmap.legend},
                           {"heatmap_min", view.heatmap.scale_min},
                           {"heatmap_max", view.heatmap.scale_max},
+                          {"layers", view.layers},
                           {"compare", json::parse(view.figures_json)}};
         res.set_content(status.dump(), "application/json");
     });
@@ -480,10 +486,30 @@ void ViewServer::Impl::compare_routes() {
     server.Get("/api/compare", [&view](const httplib::Request&, httplib::Response& res) {
         res.set_content(view.figures_json, "application/json");
     });
-    // picture=a (default), b or diff: the linear RGB picture.
-    const auto picture = [&view](const httplib::Request& req) -> const Image& {
+    // picture=a (default), b or diff: the linear RGB picture; layer= one of the status's
+    // layers (default "": the colour), each made once when first asked for.
+    const auto picture = [this, &view](const httplib::Request& req) -> const Image& {
         const std::string name =
             req.has_param("picture") ? req.get_param_value("picture") : "a";
+        const std::string layer = req.has_param("layer") ? req.get_param_value("layer") : "";
+        if (std::find(view.layers.begin(), view.layers.end(), layer) == view.layers.end()) {
+            std::string known;
+            for (const std::string& l : view.layers)
+                known += (known.empty() ? "\"" : ", \"") + l + "\"";
+            throw BadRequest(400,
+                             "layer: expected one of " + known + ", found \"" + layer + "\"");
+        }
+        if (!layer.empty() && (name == "a" || name == "b" || name == "diff")) {
+            const std::lock_guard lock(layer_mutex);
+            auto [it, fresh] = layer_pictures.try_emplace({name, layer});
+            if (fresh) {
+                const ChannelImage& source = name == "a"   ? view.a
+                                             : name == "b" ? view.b
+                                                           : view.diff;
+                it->second = display_rgb(source, layer);
+            }
+            return it->second;
+        }
         if (name == "a") return view.rgb_a;
         if (name == "b") return view.rgb_b;
         if (name == "diff") return view.rgb_diff;

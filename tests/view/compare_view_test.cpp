@@ -186,6 +186,73 @@ TEST_F(CompareViewTest, BadRequestsAre400AndTheTokenIsNeeded) {
     EXPECT_EQ(camera->status, 404);
 }
 
+// AOVs (an image written with --aov): the page can show each layer of A, B and |A - B|:
+// N.X, N.Y, N.Z as colour, a single channel ("id") as gray; the value under the cursor
+// reads the layer; an unknown layer is 400 naming the known ones.
+TEST(CompareViewLayers, EachAovLayerIsAPicture) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("octray_compare_layers_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const auto with_aovs = [](float offset) {
+        ChannelImage image(8, 4, {"R", "G", "B", "N.X", "N.Y", "N.Z", "id"});
+        for (int c = 0; c < image.channel_count(); ++c)
+            for (int y = 0; y < 4; ++y)
+                for (int x = 0; x < 8; ++x)
+                    image.at(c, x, y) = 0.125f * static_cast<float>(c) +
+                                        0.0625f * static_cast<float>(x + 8 * y) / 32.0f +
+                                        (c == 4 ? offset : 0.0f);
+        return image;
+    };
+    const std::string a = (dir / "a.exr").string(), b = (dir / "b.exr").string();
+    octray::write_channel_exr(a, with_aovs(0.0f));
+    octray::write_channel_exr(b, with_aovs(0.25f));
+    const CompareView view = octray::view::load_compare_view(a, b);
+    EXPECT_EQ(view.layers, (std::vector<std::string>{"", "N", "id"}));
+    ViewServer server(view, ServerOptions{});
+    server.start();
+    httplib::Client client("127.0.0.1", server.port());
+    client.set_read_timeout(30, 0);
+    const auto get = [&](const std::string& path) {
+        return client.Get(path + "&token=" + server.token());
+    };
+    const auto status = get("/api/status?x=0");
+    ASSERT_TRUE(status);
+    EXPECT_EQ(json::parse(status->body)["layers"], json::array({"", "N", "id"}));
+
+    const ChannelImage file = octray::read_image(a);
+    const auto normal = get("/api/image.f32?picture=a&layer=N");
+    ASSERT_TRUE(normal);
+    ASSERT_EQ(normal->status, 200);
+    std::vector<float> served(file.pixel_count() * 3);
+    ASSERT_EQ(normal->body.size(), served.size() * sizeof(float));
+    std::memcpy(served.data(), normal->body.data(), normal->body.size());
+    const int nx = file.find_channel("N.X"), id = file.find_channel("id");
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(served[c], file.at(nx + c, 0, 0)) << c;
+    EXPECT_EQ(served[3 * 13 + 1], file.at(nx + 1, 5, 1));
+
+    const auto gray = get("/api/pixel?picture=b&layer=id&x=3&y=2");
+    ASSERT_TRUE(gray);
+    ASSERT_EQ(gray->status, 200);
+    const json rgb = json::parse(gray->body)["rgb"];
+    EXPECT_EQ(rgb[0].get<float>(), file.at(id, 3, 2));
+    EXPECT_EQ(rgb[1], rgb[0]);
+    EXPECT_EQ(rgb[2], rgb[0]);
+
+    const auto diff = get("/api/pixel?picture=diff&layer=N&x=1&y=1");
+    ASSERT_TRUE(diff);
+    ASSERT_EQ(diff->status, 200);
+    EXPECT_EQ(json::parse(diff->body)["rgb"], json::array({0.0f, 0.25f, 0.0f}));
+
+    const auto unknown = get("/api/image.png?picture=a&layer=albedo");
+    ASSERT_TRUE(unknown);
+    EXPECT_EQ(unknown->status, 400);
+    EXPECT_NE(unknown->body.find("expected one of \"\", \"N\", \"id\""), std::string::npos)
+        << unknown->body;
+    server.stop();
+    server.wait();
+    std::filesystem::remove_all(dir);
+}
+
 TEST(CompareViewLoad, FailsAsCompareFails) {
     const auto dir = std::filesystem::temp_directory_path() /
                      ("octray_compare_view_load_" + std::to_string(::getpid()));
