@@ -34,6 +34,18 @@ const char* embree_geometry_name(EmbreeGeometry geometry) {
     return geometry == EmbreeGeometry::user ? "user" : "sphere_point";
 }
 
+const char* embree_build_quality_name(EmbreeBuildQuality quality) {
+    switch (quality) {
+        case EmbreeBuildQuality::low:
+            return "low";
+        case EmbreeBuildQuality::medium:
+            return "medium";
+        case EmbreeBuildQuality::high:
+            return "high";
+    }
+    return "?";
+}
+
 namespace {
 
 // An infinite plane becomes one quad reaching at least this many times the scene's size
@@ -51,10 +63,12 @@ void throw_error(RTCDevice device, const char* what) {
 
 struct EmbreeScene::Impl {
     EmbreeGeometry geometry = EmbreeGeometry::user;
+    EmbreeBuildQuality quality = EmbreeBuildQuality::high;
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     RTCScene plane_scene = nullptr;  // user: the planes, instanced into `scene`
     EmbreeSphereData spheres{};      // user: what the sphere callbacks read
+    std::atomic<std::uint64_t> sphere_builds{0};
     // Per geometry ID of `scene`: primitive ID -> object file index; a hit through the
     // planes' instance: primitive ID -> object file index.
     std::vector<std::vector<std::int32_t>> object_of;
@@ -65,13 +79,25 @@ struct EmbreeScene::Impl {
     std::atomic<std::int64_t> live_bytes{0};
     std::int64_t bytes_after_build = 0;
 
+    // Every geometry attached, for rebuild(): its scene, handle (the scene holds a
+    // reference) and how to mark it modified.
+    enum class Kind { user, buffers, instance };
+    struct Attached {
+        RTCScene scene;
+        RTCGeometry geometry;
+        Kind kind;
+        unsigned primitives;
+    };
+    std::vector<Attached> attached;
+
     std::int32_t object(unsigned geom_id, unsigned prim_id, unsigned inst_id) const {
         if (geom_id == RTC_INVALID_GEOMETRY_ID) return kernels::kNoHit;
         if (inst_id != RTC_INVALID_GEOMETRY_ID) return instanced_plane_object[prim_id];
         return object_of[geom_id][prim_id];
     }
 
-    void attach(RTCScene target, RTCGeometry g, std::vector<std::int32_t> objects) {
+    void attach(RTCScene target, RTCGeometry g, std::vector<std::int32_t> objects, Kind kind) {
+        attached.push_back({target, g, kind, static_cast<unsigned>(objects.size())});
         rtcCommitGeometry(g);
         const unsigned id = rtcAttachGeometry(target, g);
         rtcReleaseGeometry(g);
@@ -85,10 +111,15 @@ struct EmbreeScene::Impl {
 };
 
 EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads,
-                         EmbreeGeometry geometry)
+                         EmbreeGeometry geometry, EmbreeBuildQuality quality)
     : impl_(std::make_unique<Impl>()) {
     Impl& im = *impl_;
     im.geometry = geometry;
+    im.quality = quality;
+    const RTCBuildQuality build_quality =
+        quality == EmbreeBuildQuality::low      ? RTC_BUILD_QUALITY_LOW
+        : quality == EmbreeBuildQuality::medium ? RTC_BUILD_QUALITY_MEDIUM
+                                                : RTC_BUILD_QUALITY_HIGH;
     const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
     im.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (!im.device) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -106,7 +137,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         },
         &im);
     im.scene = rtcNewScene(im.device);
-    rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(im.scene, build_quality);
 
     const CompiledSpheres& s = compiled.spheres;
     if (s.count > 0 && geometry == EmbreeGeometry::user) {
@@ -114,7 +145,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         // c -+ r widened by a few ulps so that rounding never clips a sphere.
         RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_USER);
         if (!g) throw_error(im.device, "rtcNewGeometry(USER)");
-        im.spheres = {s.cx.data(), s.cy.data(), s.cz.data(), s.r2.data()};
+        im.spheres = {s.cx.data(), s.cy.data(), s.cz.data(), s.r2.data(), &im.sphere_builds};
         rtcSetGeometryUserPrimitiveCount(g, s.count);
         rtcSetGeometryUserData(g, &im.spheres);
         rtcSetGeometryBoundsFunction(
@@ -122,6 +153,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
             [](const RTCBoundsFunctionArguments* args) {
                 const auto& d = *static_cast<const EmbreeSphereData*>(args->geometryUserPtr);
                 const unsigned i = args->primID;
+                if (i == 0) d.builds->fetch_add(1, std::memory_order_relaxed);
                 const float r = std::sqrt(d.r2[i]) * (1.0f + 0x1.0p-20f);
                 const auto lo = [r](float c) { return (c - r) - std::fabs(c) * 0x1.0p-22f; };
                 const auto hi = [r](float c) { return (c + r) + std::fabs(c) * 0x1.0p-22f; };
@@ -133,7 +165,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         rtcSetGeometryIntersectFunction(g, callbacks.intersect);
         rtcSetGeometryOccludedFunction(g, callbacks.occluded);
         im.attach(im.scene, g,
-                  std::vector<std::int32_t>(s.object.begin(), s.object.begin() + s.count));
+                  std::vector<std::int32_t>(s.object.begin(), s.object.begin() + s.count),
+                  Impl::Kind::user);
     } else if (s.count > 0) {
         // Spheres: one SPHERE_POINT geometry, (x, y, z, r) per sphere, in file order.
         RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
@@ -146,7 +179,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
             v[4 * i + 3] = s.radius[i];
             objects[i] = static_cast<std::int32_t>(s.object[i]);
         }
-        im.attach(im.scene, g, std::move(objects));
+        im.attach(im.scene, g, std::move(objects), Impl::Kind::buffers);
     }
 
     // Planes: one QUAD geometry, a square per plane spanned by the checker basis; with user
@@ -191,17 +224,17 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         }
         if (geometry == EmbreeGeometry::user) {
             im.plane_scene = rtcNewScene(im.device);
-            rtcSetSceneBuildQuality(im.plane_scene, RTC_BUILD_QUALITY_HIGH);
-            im.attach(im.plane_scene, g, std::move(objects));
+            rtcSetSceneBuildQuality(im.plane_scene, build_quality);
+            im.attach(im.plane_scene, g, std::move(objects), Impl::Kind::buffers);
             rtcCommitScene(im.plane_scene);
             RTCGeometry instance = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
             if (!instance) throw_error(im.device, "rtcNewGeometry(INSTANCE)");
             rtcSetGeometryInstancedScene(instance, im.plane_scene);
             const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
             rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
-            im.attach(im.scene, instance, {});
+            im.attach(im.scene, instance, {}, Impl::Kind::instance);
         } else {
-            im.attach(im.scene, g, std::move(objects));
+            im.attach(im.scene, g, std::move(objects), Impl::Kind::buffers);
         }
     }
 
@@ -221,6 +254,33 @@ EmbreeScene::~EmbreeScene() {
 }
 
 double EmbreeScene::build_seconds() const { return impl_->build_seconds; }
+
+EmbreeBuildQuality EmbreeScene::build_quality() const { return impl_->quality; }
+
+std::uint64_t EmbreeScene::sphere_builds() const { return impl_->sphere_builds.load(); }
+
+double EmbreeScene::rebuild() {
+    Impl& im = *impl_;
+    const auto start = std::chrono::steady_clock::now();
+    // The planes' scene first (the instance refers to it), then the top scene.
+    for (RTCScene target : {im.plane_scene, im.scene}) {
+        if (!target) continue;
+        for (const Impl::Attached& a : im.attached) {
+            if (a.scene != target) continue;
+            if (a.kind == Impl::Kind::user)
+                rtcSetGeometryUserPrimitiveCount(a.geometry, a.primitives);
+            else if (a.kind == Impl::Kind::buffers)
+                rtcUpdateGeometryBuffer(a.geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+            rtcCommitGeometry(a.geometry);
+        }
+        rtcCommitScene(target);
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (rtcGetDeviceError(im.device) != RTC_ERROR_NONE || !im.last_error.empty())
+        throw std::runtime_error("Embree: scene rebuild failed: " + im.last_error);
+    return seconds;
+}
 
 std::int64_t EmbreeScene::memory_bytes() const { return impl_->bytes_after_build; }
 
