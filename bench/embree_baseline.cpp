@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -312,13 +313,39 @@ RTCIntersectContext make_context(bool coherent) {
     return context;
 }
 
-// Lanes [first, first + K) into a K-wide packet. Lanes past `end` are off and carry a
-// harmless ray (origin 0, direction +z, empty interval): Embree 3.13's emulated 16-wide
-// calls assert that every ray of an 8-wide half is valid, off lanes included, and the
-// kernels' streams hold garbage past their count.
+// Lanes [first, first + K) into a K-wide packet. A full packet is K consecutive rays of
+// the SoA arrays: each field one block copy (what an expert's harness does; lane-by-lane
+// selects cost as much as Embree's whole traversal of a small scene). In a last, partial
+// packet the lanes past `end` are off and carry a harmless ray (origin 0, direction +z,
+// empty interval): Embree 3.13's emulated 16-wide calls assert that every ray of an
+// 8-wide half is valid, off lanes included, and the kernels' streams hold garbage past
+// their count.
 template <int K, class RayK>
 void set_ray_packet(RayK& r, int (&valid)[K], const EmbreeScene::RayArrays& rays,
                     std::uint32_t first, std::uint32_t end) {
+    if (first + K <= end) {
+        constexpr std::size_t bytes = K * sizeof(float);
+        std::memcpy(r.org_x, rays.ox + first, bytes);
+        std::memcpy(r.org_y, rays.oy + first, bytes);
+        std::memcpy(r.org_z, rays.oz + first, bytes);
+        std::memcpy(r.dir_x, rays.dx + first, bytes);
+        std::memcpy(r.dir_y, rays.dy + first, bytes);
+        std::memcpy(r.dir_z, rays.dz + first, bytes);
+        if (rays.t_max) {
+            std::memcpy(r.tfar, rays.t_max + first, bytes);
+        } else {
+            for (int k = 0; k < K; ++k) r.tfar[k] = kInfinity;
+        }
+        for (int k = 0; k < K; ++k) {
+            valid[k] = -1;
+            r.tnear[k] = rays.t_min;
+            r.time[k] = 0.0f;
+            r.mask[k] = 0xFFFFFFFFu;
+            r.id[k] = first + static_cast<std::uint32_t>(k);
+            r.flags[k] = 0;
+        }
+        return;
+    }
     for (int k = 0; k < K; ++k) {
         const std::uint32_t i = first + static_cast<std::uint32_t>(k);
         const bool on = i < end;
@@ -392,12 +419,12 @@ void intersect_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context
     alignas(64) int valid[K];
     for (std::uint32_t base = 0; base < count; base += K) {
         set_ray_packet<K>(rh.ray, valid, rays, base, count);
-        for (int k = 0; k < K; ++k) {
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        static_assert(RTC_INVALID_GEOMETRY_ID == 0xFFFFFFFFu);
+        std::memset(rh.hit.geomID, 0xFF, sizeof rh.hit.geomID);
+        std::memset(rh.hit.instID[0], 0xFF, sizeof rh.hit.instID[0]);
         Packet<K>::intersect(valid, im.scene, &context, &rh);
-        for (std::uint32_t k = 0; k < K && base + k < count; ++k) {
+        const std::uint32_t lanes = std::min<std::uint32_t>(K, count - base);
+        for (std::uint32_t k = 0; k < lanes; ++k) {
             const std::int32_t o =
                 im.object(rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k]);
             object[base + k] = o;
