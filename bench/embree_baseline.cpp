@@ -313,6 +313,20 @@ RTCIntersectContext make_context(bool coherent) {
     return context;
 }
 
+// What stays the same from packet to packet (Embree writes only tfar and the hit): set
+// once before the first. The ID is not read back, so it stays 0.
+template <int K, class RayK>
+void init_packet(RayK& r, int (&valid)[K], float t_min) {
+    for (int k = 0; k < K; ++k) {
+        valid[k] = -1;
+        r.tnear[k] = t_min;
+        r.time[k] = 0.0f;
+        r.mask[k] = 0xFFFFFFFFu;
+        r.id[k] = 0;
+        r.flags[k] = 0;
+    }
+}
+
 // Lanes [first, first + K) into a K-wide packet. A full packet is K consecutive rays of
 // the SoA arrays: each field one block copy (what an expert's harness does; lane-by-lane
 // selects cost as much as Embree's whole traversal of a small scene). In a last, partial
@@ -336,15 +350,7 @@ void set_ray_packet(RayK& r, int (&valid)[K], const EmbreeScene::RayArrays& rays
         } else {
             for (int k = 0; k < K; ++k) r.tfar[k] = kInfinity;
         }
-        for (int k = 0; k < K; ++k) {
-            valid[k] = -1;
-            r.tnear[k] = rays.t_min;
-            r.time[k] = 0.0f;
-            r.mask[k] = 0xFFFFFFFFu;
-            r.id[k] = first + static_cast<std::uint32_t>(k);
-            r.flags[k] = 0;
-        }
-        return;
+        return;  // the rest as init_packet left it
     }
     for (int k = 0; k < K; ++k) {
         const std::uint32_t i = first + static_cast<std::uint32_t>(k);
@@ -417,6 +423,7 @@ void intersect_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context
                        std::int32_t* object) {
     alignas(64) typename Packet<K>::RayHit rh;
     alignas(64) int valid[K];
+    init_packet<K>(rh.ray, valid, rays.t_min);
     for (std::uint32_t base = 0; base < count; base += K) {
         set_ray_packet<K>(rh.ray, valid, rays, base, count);
         static_assert(RTC_INVALID_GEOMETRY_ID == 0xFFFFFFFFu);
@@ -439,6 +446,7 @@ void occluded_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context,
                       std::uint32_t* occluded) {
     alignas(64) typename Packet<K>::Ray r;
     alignas(64) int valid[K];
+    init_packet<K>(r, valid, rays.t_min);
     for (std::uint32_t base = 0; base < count; base += K) {
         set_ray_packet<K>(r, valid, rays, base, count);
         Packet<K>::occluded(valid, im.scene, &context, &r);
