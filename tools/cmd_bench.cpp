@@ -107,7 +107,7 @@ void write_csv_file(const bench::BenchReport& report, const std::string& path) {
     std::string text =
         "scene,ray_kind,system,mode,isa,accel,packet_min_lanes,order,tile,threads,rays,"
         "mrays_median,mrays_min,mrays_max,seconds_median,frames_per_second,hit_fraction,"
-        "ratio_octray_over_embree,valid\n";
+        "ratio_octray_over_embree,valid,spread,steady,build_quality\n";
     for (const bench::BenchRow& r : report.rows) {
         const std::vector<std::string> fields = {
             r.scene,
@@ -128,7 +128,10 @@ void write_csv_file(const bench::BenchReport& report, const std::string& path) {
             bench::whole_frame(r.workload) ? csv_number(r.frames_per_second) : "",
             std::isnan(r.hit_fraction) ? "" : csv_number(r.hit_fraction),
             r.ratio ? csv_number(*r.ratio) : "",
-            r.valid ? "true" : "false"};
+            r.valid ? "true" : "false",
+            csv_number(r.timing.spread),
+            r.steady ? "true" : "false",
+            r.build_quality == "-" ? "" : r.build_quality};
         std::string line;
         for (const std::string& f : fields) line += (line.empty() ? "" : ",") + csv_field(f);
         text += line + "\n";

@@ -172,6 +172,47 @@ TEST(Report, JsonHasTheContextAndRowsSchema) {
     EXPECT_NE(table.str().find("octray"), std::string::npos);
 }
 
+// Issue 42: a row whose repetitions spread past the bound is marked unsteady in the table
+// (its spread with "~", "yes, unsteady", "~" after a headline figure it holds), and a
+// headline ratio below 1 is marked LOSS.
+TEST(Report, UnsteadyRowsAndLossesAreMarkedInTheTable) {
+    BenchReport report;
+    BenchOptions o;
+    const auto add = [&](const char* system, std::vector<double> seconds) {
+        BenchRow r;
+        r.scene = "s";
+        r.system = system;
+        r.mode = "packet16";
+        r.isa = "x";
+        r.order = "tiled";
+        r.tile = "16x16";
+        r.threads = 2;
+        r.rays = 1000000;
+        r.seconds = std::move(seconds);
+        r.runs.assign(r.seconds.size(), 3);
+        r.timing = summarize(r.seconds, r.rays);
+        r.steady = r.timing.spread <= o.max_spread;
+        r.valid = true;
+        report.rows.push_back(r);
+    };
+    add("octray", {1.0, 1.5, 1.1});    // spread 1.5: unsteady; 0.91 Mrays/s
+    add("embree", {0.5, 0.51, 0.52});  // steady; 1.96 Mrays/s: octray loses
+    EXPECT_FALSE(report.rows[0].steady);
+    EXPECT_TRUE(report.rows[1].steady);
+    compute_ratios(report.rows);
+    std::ostringstream out;
+    print_table(report, out);
+    const std::string table = out.str();
+    EXPECT_NE(table.find("1.50~"), std::string::npos) << table;
+    EXPECT_NE(table.find("yes, unsteady"), std::string::npos) << table;
+    EXPECT_NE(table.find("0.91~"), std::string::npos) << table;       // the headline's octray
+    EXPECT_NE(table.find("0.464 LOSS"), std::string::npos) << table;  // 0.91 / 1.96
+    const nlohmann::json j = nlohmann::json::parse(report_json(report));
+    EXPECT_FALSE(j["rows"][0]["steady"].get<bool>());
+    EXPECT_DOUBLE_EQ(j["rows"][0]["spread"].get<double>(), 1.5);
+    EXPECT_EQ(j["rows"][0]["runs"], nlohmann::json::array({3, 3, 3}));
+}
+
 // Issue 42: the run says where its time went: the timed repetitions and the validation
 // apart, both within the wall clock.
 TEST(Report, TimedAndValidationSecondsAreAccountedApart) {
