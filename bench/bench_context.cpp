@@ -3,6 +3,8 @@
 
 #include <oneapi/tbb/info.h>
 
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -76,6 +78,7 @@ BenchContext make_context(const BenchOptions& o) {
 #endif
     ctx.load_average = load_average();
     ctx.width = o.width, ctx.height = o.height, ctx.reps = o.reps, ctx.warmup = o.warmup;
+    ctx.min_time = o.min_time, ctx.max_spread = o.max_spread;
     ctx.validate_rays = o.validate_rays;
     ctx.command_line = o.command_line;
     return ctx;
@@ -91,4 +94,27 @@ std::string format(const char* fmt, double a) {
     return buffer;
 }
 
+namespace {
+std::int64_t now_ns() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+}  // namespace
+
+Stopwatch::Stopwatch(double& total) : total_(total), start_ns_(now_ns()) {}
+Stopwatch::~Stopwatch() { total_ += 1e-9 * static_cast<double>(now_ns() - start_ns_); }
+
 }  // namespace octray::bench::detail
+
+namespace octray::bench {
+
+std::string format_duration(double seconds) {
+    if (seconds < 10.0) return detail::format("%.1f s", seconds);
+    const long s = std::lround(seconds);
+    if (s < 60) return std::to_string(s) + " s";
+    if (s < 3600) return std::to_string(s / 60) + " min " + std::to_string(s % 60) + " s";
+    return std::to_string(s / 3600) + " h " + std::to_string(s % 3600 / 60) + " min";
+}
+
+}  // namespace octray::bench

@@ -28,9 +28,9 @@ namespace octray::bench::detail {
 // One way of tracing a ray set into a hit set.
 using Tracer = std::function<void(const RaySet&, HitSet&)>;
 
-// Warm-up runs, then `reps` timed runs; the hits of the last run stay in `hits`.
-std::vector<double> time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits, int warmup,
-                              int reps);
+// The set traced in repetitions (repeat_timed); the hits of the last run stay in `hits`.
+Repetitions time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits,
+                      const BenchOptions& o);
 
 // octray's packet kernels over the set: closest_hit, or any_hit into the occluded flags.
 Tracer octray_simd_tracer(tbb::task_arena& arena, const kernels::KernelTable& table,
@@ -43,10 +43,13 @@ Tracer octray_scalar_tracer(tbb::task_arena& arena, const ReferenceTracer& trace
 Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMode mode);
 #endif
 
-// A whole-frame row: warm-up frames, then o.reps timed ones (each frame's own seconds),
-// the last frame's ray counts, the rates and frames per second.
+// A whole-frame row: warm-up frames, then o.reps timed repetitions of frames (each
+// frame's own seconds, repeat_timed), the last frame's ray counts, the rates and frames
+// per second, the spread.
 void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
                  const BenchOptions& o);
+// The row's timing from its seconds and rays, its spread against o.max_spread.
+void set_timing(BenchRow& row, const BenchOptions& o);
 
 // ---- bench_validation.cpp: scenes and their checks ----
 
@@ -60,10 +63,11 @@ double time_to_first_pixel_ms(const std::string& spec, const BenchOptions& o,
                               tbb::task_arena& arena, int threads);
 // The scene at the validation size of whole renders.
 Scene validation_scene(const std::string& spec, const BenchOptions& o);
-// The packet render of the scene at the validation size equals the reference render,
-// image and ray counts: sets `valid`, returns what was checked and how it came out.
+// The packet render of the scene at the validation size (of the Scene, or with `prepared`
+// of a PreparedScene) equals the reference render, image and ray counts: sets `valid`,
+// returns what was checked and how it came out.
 std::string validate_render(const std::string& spec, const BenchOptions& o, Isa isa,
-                            Accel accel, bool& valid);
+                            Accel accel, bool prepared, bool& valid);
 #if OCTRAY_HAVE_EMBREE
 // An Embree frame at the validation size against the reference render, within tolerances.
 std::string validate_embree_render(const Scene& small, const EmbreeFrames& frames,
@@ -80,5 +84,18 @@ BenchContext make_context(const BenchOptions& o);
 void log_line(std::ostream* log, const std::string& line);
 // printf of one number.
 std::string format(const char* fmt, double a);
+
+// Adds the wall-clock time of its life to `total` (the run's time accounts).
+class Stopwatch {
+  public:
+    explicit Stopwatch(double& total);
+    ~Stopwatch();
+    Stopwatch(const Stopwatch&) = delete;
+    Stopwatch& operator=(const Stopwatch&) = delete;
+
+  private:
+    double& total_;
+    std::int64_t start_ns_;
+};
 
 }  // namespace octray::bench::detail

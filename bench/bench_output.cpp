@@ -44,6 +44,7 @@ std::string format_threads(const std::string& text) {
 void print_headline(const BenchReport& report, bool sweep, std::ostream& out) {
     struct Best {
         std::optional<double> octray, embree;
+        bool octray_steady = true, embree_steady = true;  // the best rows'
     };
     std::vector<std::string> order;  // keys as first measured
     std::map<std::string, Best> best;
@@ -57,28 +58,39 @@ void print_headline(const BenchReport& report, bool sweep, std::ostream& out) {
             label[key] = {r.scene, workload_name(r.workload), r.threads};
         }
         if (!r.valid) continue;
-        std::optional<double>& b = r.system == "embree" ? best[key].embree : best[key].octray;
-        b = std::max(b.value_or(0.0), r.timing.mrays_median);
+        const bool embree = r.system == "embree";
+        std::optional<double>& b = embree ? best[key].embree : best[key].octray;
+        if (b && *b >= r.timing.mrays_median) continue;
+        b = r.timing.mrays_median;
+        (embree ? best[key].embree_steady : best[key].octray_steady) = r.steady;
     }
     out << "Mrays/s, median of the repetitions; the best valid row of each system (the detail\n"
-           "below has every configuration). octray/Embree > 1: octray is faster.\n";
+           "below has every configuration). octray/Embree > 1: octray is faster; below 1 it "
+           "is\n"
+           "marked LOSS. ~: that row is unsteady (its repetitions spread past the bound).\n"
+           "still: scene made ready (compile + BVH build; Embree at its faster build quality)\n"
+           "+ first frame; frame: a frame of a scene made ready before.\n";
     char line[256];
     std::snprintf(line, sizeof line, "%-14s %-9s %s%12s %12s %14s\n", "scene", "rays",
                   sweep ? "threads " : "", "octray", "Embree", "octray/Embree");
+    // (a LOSS ratio is wider than its column; it is the last one)
     out << line;
     for (const std::string& key : order) {
         const Best& b = best[key];
         const auto& [scene, rays, threads] = label[key];
-        const auto cell = [](const std::optional<double>& v) {
-            return v ? format("%.2f", *v) : std::string("-");
+        const auto cell = [](const std::optional<double>& v, bool steady) {
+            return v ? format("%.2f", *v) + (steady ? "" : "~") : std::string("-");
         };
-        const std::string ratio = b.octray && b.embree && *b.embree > 0.0
-                                      ? format("%.3f", *b.octray / *b.embree)
-                                      : std::string("-");
+        const bool compared = b.octray && b.embree && *b.embree > 0.0;
+        const std::string ratio =
+            compared ? format("%.3f", *b.octray / *b.embree) +
+                           (*b.octray < *b.embree ? std::string(" LOSS") : std::string())
+                     : std::string("-");
         const std::string thread_cell = sweep ? format_threads(std::to_string(threads)) : "";
         std::snprintf(line, sizeof line, "%-14s %-9s %s%12s %12s %14s\n", scene.c_str(),
-                      rays.c_str(), thread_cell.c_str(), cell(b.octray).c_str(),
-                      cell(b.embree).c_str(), ratio.c_str());
+                      rays.c_str(), thread_cell.c_str(),
+                      cell(b.octray, b.octray_steady).c_str(),
+                      cell(b.embree, b.embree_steady).c_str(), ratio.c_str());
         out << line;
     }
     out << "\n";
@@ -101,15 +113,28 @@ void print_table(const BenchReport& report, std::ostream& out) {
         << join_counts(counts) << ", octray ISA " << c.isa << ", " << c.compiler << "\n"
         << "Embree: " << c.embree << "\n"
         << "frame " << c.width << "x" << c.height << ", " << c.reps << " timed reps after "
-        << c.warmup << " warm-up, load average at start " << format("%.2f", c.load_average)
-        << "\n";
+        << c.warmup << " warm-up, each rep at least " << format("%.3g s", c.min_time)
+        << " (runs repeated), unsteady past max/min " << format("%.3g", c.max_spread)
+        << ", load average at start " << format("%.2f", c.load_average) << "\n";
+    if (c.wall_seconds > 0.0)
+        out << "time: " << format_duration(c.wall_seconds) << " in all: timed "
+            << format_duration(c.timed_seconds) << ", validation "
+            << format_duration(c.validation_seconds) << ", setup and the rest "
+            << format_duration(
+                   std::max(0.0, c.wall_seconds - c.timed_seconds - c.validation_seconds))
+            << "\n";
     if (!c.command_line.empty()) out << "command: " << c.command_line << "\n";
     for (const SceneInfo& s : report.scenes) {
         out << "scene " << s.spec << ": " << s.objects << " objects (" << s.spheres
             << " spheres, " << s.planes << " planes), " << s.lights << " lights; compile "
             << format("%.3f ms", s.compile_ms) << ", first pixel "
             << format("%.1f ms", s.first_pixel_ms);
-        if (s.embree_build_ms) out << ", Embree BVH " << format("%.3f ms", *s.embree_build_ms);
+        if (s.embree_build_ms)
+            out << ", Embree BVH " << format("%.3f ms", *s.embree_build_ms) << " (HIGH)";
+        if (s.embree_build_low_ms && s.embree_build_medium_ms)
+            out << ", LOW " << format("%.3f ms", *s.embree_build_low_ms) << ", MEDIUM "
+                << format("%.3f ms", *s.embree_build_medium_ms) << " (stills use "
+                << s.embree_still_quality << ")";
         if (s.embree_bytes_per_sphere)
             out << " (" << format("%.1f", *s.embree_bytes_per_sphere) << " bytes/sphere)";
         if (s.bvh_build_ms)
@@ -125,27 +150,36 @@ void print_table(const BenchReport& report, std::ostream& out) {
     print_headline(report, sweep, out);
     out << "Detail:\n";
     char line[512];
-    std::snprintf(line, sizeof line,
-                  "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9s %6s %9s %9s %9s %8s %s\n",
-                  "scene", "rays", "system", "mode", "isa", "accel", "order", "tile", "count",
-                  "hit%", "Mrays/s", "min", "max", "oct/emb", "valid");
+    std::snprintf(
+        line, sizeof line,
+        "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9s %6s %9s %9s %9s %7s %6s %8s %s\n",
+        "scene", "rays", "system", "mode", "isa", "accel", "order", "tile", "count", "hit%",
+        "Mrays/s", "min", "max", "spread", "runs", "oct/emb", "valid");
     if (sweep) out << format_threads("threads");
     out << line;
     for (const BenchRow& r : report.rows) {
         const std::string ratio = r.ratio ? format("%.3f", *r.ratio) : "-";
         const std::string hit =
             std::isnan(r.hit_fraction) ? "-" : format("%.1f", 100.0 * r.hit_fraction);
-        std::snprintf(
-            line, sizeof line,
-            "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9llu %6s %9.2f %9.2f %9.2f %8s %s\n",
-            r.scene.c_str(), workload_name(r.workload), r.system.c_str(), r.mode.c_str(),
-            r.isa.c_str(), r.accel_label().c_str(), r.order.c_str(), r.tile.c_str(),
-            static_cast<unsigned long long>(r.rays), hit.c_str(), r.timing.mrays_median,
-            r.timing.mrays_min, r.timing.mrays_max, ratio.c_str(), r.valid ? "yes" : "NO");
+        const std::string spread = format("%.2f", r.timing.spread) + (r.steady ? " " : "~");
+        const std::uint32_t runs =
+            r.runs.empty() ? 0u : *std::min_element(r.runs.begin(), r.runs.end());
+        std::snprintf(line, sizeof line,
+                      "%-14s %-9s %-6s %-7s %-6s %-6s %-8s %-5s %9llu %6s %9.2f %9.2f %9.2f "
+                      "%7s %6u %8s %s\n",
+                      r.scene.c_str(), workload_name(r.workload), r.system.c_str(),
+                      r.mode.c_str(), r.isa.c_str(), r.accel_label().c_str(), r.order.c_str(),
+                      r.tile.c_str(), static_cast<unsigned long long>(r.rays), hit.c_str(),
+                      r.timing.mrays_median, r.timing.mrays_min, r.timing.mrays_max,
+                      spread.c_str(), runs, ratio.c_str(),
+                      !r.valid   ? "NO"
+                      : r.steady ? "yes"
+                                 : "yes, unsteady");
         if (sweep) out << format_threads(std::to_string(r.threads));
         out << line;
-        if (r.workload == Workload::whitted)
+        if (whole_frame(r.workload))
             out << "               frames/s " << format("%.3f", r.frames_per_second)
+                << (r.build_quality != "-" ? "; Embree build " + r.build_quality : "")
                 << "; rays: " << r.counts.primary << " primary, " << r.counts.shadow
                 << " shadow, " << r.counts.reflected << " reflected, " << r.counts.refracted
                 << " refracted\n";
@@ -180,6 +214,11 @@ std::string report_json(const BenchReport& report) {
         {"height", c.height},
         {"reps", c.reps},
         {"warmup", c.warmup},
+        {"min_time", c.min_time},
+        {"max_spread", c.max_spread},
+        {"wall_seconds", c.wall_seconds},
+        {"timed_seconds", c.timed_seconds},
+        {"validation_seconds", c.validation_seconds},
         {"validate_rays", c.validate_rays},
         {"command", c.command_line},
     };
@@ -197,6 +236,12 @@ std::string report_json(const BenchReport& report) {
                    {"shadow_rays", s.shadow_rays},
                    {"secondary_rays", s.secondary_rays}};
         js["embree_build_ms"] = s.embree_build_ms ? json(*s.embree_build_ms) : json(nullptr);
+        js["embree_build_low_ms"] =
+            s.embree_build_low_ms ? json(*s.embree_build_low_ms) : json(nullptr);
+        js["embree_build_medium_ms"] =
+            s.embree_build_medium_ms ? json(*s.embree_build_medium_ms) : json(nullptr);
+        js["embree_still_quality"] =
+            s.embree_still_quality.empty() ? json(nullptr) : json(s.embree_still_quality);
         js["embree_bytes_per_sphere"] =
             s.embree_bytes_per_sphere ? json(*s.embree_bytes_per_sphere) : json(nullptr);
         js["bvh_build_ms"] = s.bvh_build_ms ? json(*s.bvh_build_ms) : json(nullptr);
@@ -225,6 +270,10 @@ std::string report_json(const BenchReport& report) {
             {"mrays_min", r.timing.mrays_min},
             {"mrays_max", r.timing.mrays_max},
             {"seconds", r.seconds},
+            {"runs", r.runs},
+            {"spread", r.timing.spread},
+            {"steady", r.steady},
+            {"whole_frame", whole_frame(r.workload)},
             {"valid", r.valid},
             {"validation", r.validation},
             {"counts",
@@ -235,7 +284,8 @@ std::string report_json(const BenchReport& report) {
         };
         jr["hit_fraction"] = std::isnan(r.hit_fraction) ? json(nullptr) : json(r.hit_fraction);
         jr["frames_per_second"] =
-            r.workload == Workload::whitted ? json(r.frames_per_second) : json(nullptr);
+            whole_frame(r.workload) ? json(r.frames_per_second) : json(nullptr);
+        jr["build_quality"] = r.build_quality == "-" ? json(nullptr) : json(r.build_quality);
         jr["ratio_octray_over_embree"] = r.ratio ? json(*r.ratio) : json(nullptr);
         j["rows"].push_back(std::move(jr));
     }

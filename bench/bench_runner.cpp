@@ -10,12 +10,14 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
+#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -38,17 +40,29 @@ const char* workload_name(Workload workload) {
             return "shadow";
         case Workload::secondary:
             return "secondary";
-        case Workload::whitted:
-            return "whitted";
+        case Workload::still:
+            return "still";
+        case Workload::frame:
+            return "frame";
     }
     return "?";
 }
 
 std::optional<Workload> parse_workload(std::string_view name) {
-    for (Workload w :
-         {Workload::primary, Workload::shadow, Workload::secondary, Workload::whitted})
+    for (Workload w : {Workload::primary, Workload::shadow, Workload::secondary,
+                       Workload::still, Workload::frame})
         if (name == workload_name(w)) return w;
     return std::nullopt;
+}
+
+std::vector<Workload> parse_workloads(std::string_view name) {
+    if (name == "whitted") return {Workload::still, Workload::frame};
+    const std::optional<Workload> w = parse_workload(name);
+    return w ? std::vector<Workload>{*w} : std::vector<Workload>{};
+}
+
+bool whole_frame(Workload workload) {
+    return workload == Workload::still || workload == Workload::frame;
 }
 
 Timing summarize(std::vector<double> seconds, std::uint64_t rays) {
@@ -63,6 +77,7 @@ Timing summarize(std::vector<double> seconds, std::uint64_t rays) {
     const auto rate = [rays](double s) {
         return s > 0.0 ? static_cast<double>(rays) / s / 1e6 : 0.0;
     };
+    t.spread = t.seconds_min > 0.0 ? t.seconds_max / t.seconds_min : 1.0;
     t.mrays_median = rate(t.seconds_median);
     t.mrays_min = rate(t.seconds_max);
     t.mrays_max = rate(t.seconds_min);
@@ -99,7 +114,12 @@ struct BenchRun {
     std::ostream* log;
     BenchReport& report;
     tbb::task_arena& arena;
-    std::vector<Isa> isas;  // resolved, without duplicates
+    std::vector<Isa> isas;     // resolved, without duplicates
+    std::size_t variants = 1;  // pixel orders and tiles of the ray-set rows
+    // Progress: rows measured, and rows planned (the scenes not yet set up are guessed to
+    // have as many rows as the last one that was).
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+    int rows_done = 0, rows_planned = 0;
     bool wants(Workload w) const {
         return std::find(o.workloads.begin(), o.workloads.end(), w) != o.workloads.end();
     }
@@ -128,6 +148,8 @@ struct BenchScene {
     // Embree's best configuration (user geometry: its build is the one timed), and its
     // built-in sphere primitive, built once.
     std::unique_ptr<EmbreeScene> embree, embree_point;
+    // The still rows' scene: Embree's faster build quality for this scene, LOW or MEDIUM.
+    std::unique_ptr<EmbreeScene> embree_still;
 #endif
     // Primary hits (the origins of shadow and mirror rays) come from the fastest view.
     kernels::SceneView fast_view;
@@ -170,7 +192,8 @@ void build_bvhs(BenchRun& run, BenchScene& bs) {
     std::vector<double> embree_builds, octray_builds;
 #if OCTRAY_HAVE_EMBREE
     const bool with_embree =
-        run.report.context.embree_available && (run.ray_sets() || run.wants(Workload::whitted));
+        run.report.context.embree_available &&
+        (run.ray_sets() || run.wants(Workload::still) || run.wants(Workload::frame));
     if (with_embree)
         run.arena.execute([&] {
             bs.embree_point = std::make_unique<EmbreeScene>(bs.scene, compiled, run.o.threads,
@@ -196,6 +219,28 @@ void build_bvhs(BenchRun& run, BenchScene& bs) {
     }
     SceneInfo& info = bs.info;
 #if OCTRAY_HAVE_EMBREE
+    // The still rows charge Embree a build per frame: at its faster quality, LOW or MEDIUM,
+    // for this scene (the median of kBuildReps builds of each, rebuilt as a frame would).
+    if (with_embree && run.wants(Workload::still)) {
+        double best = 0.0;
+        for (EmbreeBuildQuality q : {EmbreeBuildQuality::low, EmbreeBuildQuality::medium}) {
+            std::unique_ptr<EmbreeScene> e;
+            std::vector<double> builds;
+            run.arena.execute([&] {
+                e = std::make_unique<EmbreeScene>(bs.scene, compiled, run.o.threads,
+                                                  EmbreeGeometry::user, q);
+                for (int build = 0; build < kBuildReps; ++build) builds.push_back(e->rebuild());
+            });
+            const double ms = summarize(builds, 0).seconds_median * 1e3;
+            (q == EmbreeBuildQuality::low ? info.embree_build_low_ms
+                                          : info.embree_build_medium_ms) = ms;
+            if (!bs.embree_still || ms < best) {
+                best = ms;
+                bs.embree_still = std::move(e);
+                info.embree_still_quality = embree_build_quality_name(q);
+            }
+        }
+    }
     if (bs.embree) {
         info.embree_build_ms = summarize(embree_builds, 0).seconds_median * 1e3;
         if (run.report.scenes.empty()) run.report.context.embree = bs.embree->device_info();
@@ -261,6 +306,56 @@ void log_scene(const BenchRun& run, const BenchScene& bs) {
                           (info.embree_build_ms ? ", Embree BVH built in " +
                                                       format("%.3f ms", *info.embree_build_ms)
                                                 : std::string()));
+    if (!info.embree_still_quality.empty())
+        log_line(run.log, spec + ": Embree builds LOW " +
+                              format("%.3f ms", *info.embree_build_low_ms) + ", MEDIUM " +
+                              format("%.3f ms", *info.embree_build_medium_ms) +
+                              ": its stills use " + info.embree_still_quality);
+}
+
+// The rows a scene will have (for the progress line).
+int planned_rows(const BenchRun& run, const BenchScene& bs) {
+    const BenchOptions& o = run.o;
+    bool embree = false;
+#if OCTRAY_HAVE_EMBREE
+    embree = bs.embree != nullptr;
+#endif
+    const int isas = static_cast<int>(run.isas.size());
+    int octray_set = 0, octray_still = 0, octray_frame = 0;
+    // Whole frames: one row per BVH-or-not among the SIMD configurations.
+    bool with_bvh = false, without = false;
+    for (const SimdConfig& c : bs.simd_configs) (c.bvh ? with_bvh : without) = true;
+    const int frame_configs = int{with_bvh} + int{without};
+    for (RenderPath path : o.paths) {
+        if (path == RenderPath::scalar) {
+            ++octray_set, ++octray_still;
+            continue;
+        }
+        octray_set += isas * static_cast<int>(bs.simd_configs.size());
+        octray_still += isas * std::max(1, frame_configs);
+        octray_frame += isas * std::max(1, frame_configs);
+    }
+    int rows = 0;
+    for (Workload w : {Workload::primary, Workload::shadow, Workload::secondary})
+        if (run.wants(w))
+            rows += static_cast<int>(run.variants) * ((embree ? 5 : 0) + octray_set);
+    const int tiles = static_cast<int>(o.tiles.size());
+    if (run.wants(Workload::still)) rows += tiles * ((embree ? 2 : 0) + octray_still);
+    if (run.wants(Workload::frame)) rows += tiles * ((embree ? 2 : 0) + octray_frame);
+    return rows;
+}
+
+// "  [12/48 rows, 42 s, about 2 min 10 s left]" after each row's log line.
+std::string progress(const BenchRun& run) {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
+    std::string text = "  [" + std::to_string(run.rows_done) + "/" +
+                       std::to_string(std::max(run.rows_planned, run.rows_done)) + " rows, " +
+                       format_duration(elapsed);
+    const int left = run.rows_planned - run.rows_done;
+    if (left > 0 && run.rows_done > 0)
+        text += ", about " + format_duration(elapsed / run.rows_done * left) + " left";
+    return text + "]";
 }
 
 // Everything a scene's rows need: the scene info (sizes, compile and first-pixel times),
@@ -296,9 +391,8 @@ BenchRow base_row(const BenchRun& run, const std::string& spec, Workload w, cons
     BenchRow row;
     row.scene = spec;
     row.workload = w;
-    row.order = w == Workload::whitted ? "tiled" : pixel_order_name(v.order);
-    row.tile =
-        w == Workload::whitted || v.order == PixelOrder::tiled ? tile_size_name(v.tile) : "-";
+    row.order = whole_frame(w) ? "tiled" : pixel_order_name(v.order);
+    row.tile = whole_frame(w) || v.order == PixelOrder::tiled ? tile_size_name(v.tile) : "-";
     row.threads = run.report.context.threads;
     return row;
 }
@@ -320,19 +414,30 @@ void measure_ray_set(BenchRun& run, const RaySetRun& rs, BenchRow row, const Tra
     (w == Workload::primary  ? row.counts.primary
      : w == Workload::shadow ? row.counts.shadow
                              : row.counts.reflected) = set.count;
-    row.seconds = detail::time_runs(trace, set, hits, run.o.warmup, run.o.reps);
+    {
+        detail::Stopwatch timed(run.report.context.timed_seconds);
+        Repetitions reps = detail::time_runs(trace, set, hits, run.o);
+        row.seconds = std::move(reps.seconds);
+        row.runs = std::move(reps.runs);
+    }
     if (octray_any_hit) detail::occluded_to_hits(hits, set.count);
-    row.timing = summarize(row.seconds, row.rays);
+    detail::set_timing(row, run.o);
     row.hit_fraction = hit_fraction(hits, set.count);
-    const Validation val = validate_hits(hits, truth, rule);
+    Validation val;
+    {
+        detail::Stopwatch checking(run.report.context.validation_seconds);
+        val = validate_hits(hits, truth, rule);
+    }
     row.valid = val.valid;
+    ++run.rows_done;
     row.validation = std::string(rule.exact ? "exact vs scalar oracle, "
                                             : "tolerance vs double-precision oracle, ") +
                      val.summary();
     log_line(run.log, "  " + std::string(workload_name(w)) + " " + row.system + " " + row.mode +
                           " " + row.isa + " " + row.accel_label() + " " + row.order + " " +
                           row.tile + ": " + format("%.2f Mrays/s", row.timing.mrays_median) +
-                          (row.valid ? "" : " (INVALID: " + val.summary() + ")"));
+                          (row.valid ? "" : " (INVALID: " + val.summary() + ")") +
+                          progress(run));
     run.report.rows.push_back(std::move(row));
 }
 
@@ -342,10 +447,13 @@ void measure_ray_set(BenchRun& run, const RaySetRun& rs, BenchRow row, const Tra
 void measure_embree_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun& rs,
                             const Variant& v, const OracleHits& oracle) {
     OracleHits truth;
-    run.arena.execute([&] {
-        truth = oracle_hits_double(bs.scene, rs.set,
-                                   detail::double_oracle_rays(oracle, bs.scene.objects.size()));
-    });
+    {
+        detail::Stopwatch checking(run.report.context.validation_seconds);
+        run.arena.execute([&] {
+            truth = oracle_hits_double(
+                bs.scene, rs.set, detail::double_oracle_rays(oracle, bs.scene.objects.size()));
+        });
+    }
     for (const EmbreeScene* e : {bs.embree.get(), bs.embree_point.get()}) {
         const bool user = e->geometry() == EmbreeGeometry::user;
         for (EmbreeMode mode :
@@ -422,7 +530,11 @@ void measure_ray_sets(BenchRun& run, BenchScene& bs, const Variant& v) {
          : w == Workload::shadow ? bs.info.shadow_rays
                                  : bs.info.secondary_rays) = set.count;
         OracleHits oracle;
-        run.arena.execute([&] { oracle = oracle_hits(bs.reference, set, bs.validate_rays); });
+        {
+            detail::Stopwatch checking(run.report.context.validation_seconds);
+            run.arena.execute(
+                [&] { oracle = oracle_hits(bs.reference, set, bs.validate_rays); });
+        }
         const RaySetRun rs{w, set};
 #if OCTRAY_HAVE_EMBREE
         if (bs.embree) measure_embree_ray_set(run, bs, rs, v, oracle);
@@ -433,8 +545,10 @@ void measure_ray_sets(BenchRun& run, BenchScene& bs, const Variant& v) {
 
 // ---- Whole renders ----
 
-// Validation of whole packet renders, by ISA and BVH or not: checked once per scene.
-using RenderValidation = std::map<std::pair<Isa, bool>, std::pair<bool, std::string>>;
+// Validation of whole packet renders, by workload, ISA and BVH or not: checked once per
+// scene.
+using RenderValidation =
+    std::map<std::tuple<Workload, Isa, bool>, std::pair<bool, std::string>>;
 
 RenderOptions frame_options(const BenchRun& run, TileSize tile) {
     RenderOptions ro;
@@ -444,26 +558,45 @@ RenderOptions frame_options(const BenchRun& run, TileSize tile) {
     return ro;
 }
 
-// octray's whole-render rows of one tile size: each path, ISA and --accel value (one row
-// each; the packet switch is the renderer's default).
-void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile,
+// The distinct BVH-or-not configurations of the scene's SIMD rows (the packet switch is
+// the renderer's default in whole frames).
+std::vector<const SimdConfig*> frame_configs(const BenchScene& bs) {
+    std::vector<const SimdConfig*> configs;
+    for (const SimdConfig& c : bs.simd_configs)
+        if (std::none_of(configs.begin(), configs.end(),
+                         [&](const SimdConfig* k) { return k->bvh == c.bvh; }))
+            configs.push_back(&c);
+    return configs;
+}
+
+void log_frame_row(BenchRun& run, const BenchRow& row) {
+    log_line(run.log, "  " + std::string(workload_name(row.workload)) + " " + row.system + " " +
+                          row.mode + " " + row.isa + " " + row.accel +
+                          (row.build_quality != "-" ? " build " + row.build_quality : "") +
+                          " tile " + row.tile + ": " +
+                          format("%.3f frames/s", row.frames_per_second) + ", " +
+                          format("%.2f Mrays/s", row.timing.mrays_median) +
+                          (row.valid ? "" : " (" + row.validation + ")") + progress(run));
+}
+
+// octray's whole-frame rows of one tile size and workload: each path, ISA and --accel
+// value. A still renders the Scene (render_packet compiles it and builds the BVH, both
+// inside its seconds); a frame renders a PreparedScene made once. The scalar reference is
+// measured as a still only (it has no prepared form).
+void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile, Workload w,
                             RenderValidation& render_validation) {
     const BenchOptions& o = run.o;
     for (RenderPath path : o.paths) {
+        if (path == RenderPath::scalar && w == Workload::frame) continue;
         const std::vector<Isa> path_isas =
             path == RenderPath::simd ? run.isas : std::vector<Isa>{Isa::automatic};
-        std::vector<const SimdConfig*> configs;
-        for (const SimdConfig& c : bs.simd_configs)
-            if (std::none_of(configs.begin(), configs.end(),
-                             [&](const SimdConfig* k) { return k->bvh == c.bvh; }))
-                configs.push_back(&c);
+        std::vector<const SimdConfig*> configs = frame_configs(bs);
         if (path == RenderPath::scalar || configs.empty()) configs = {nullptr};
         for (Isa isa : path_isas)
             for (const SimdConfig* config : configs) {
                 // The scalar path finds its spheres through the reference's own BVH.
                 const Accel accel = config ? config->accel : Accel::automatic;
-                BenchRow row =
-                    base_row(run, bs.spec, Workload::whitted, Variant{PixelOrder::tiled, tile});
+                BenchRow row = base_row(run, bs.spec, w, Variant{PixelOrder::tiled, tile});
                 row.system = "octray";
                 row.mode = path == RenderPath::simd ? octray_mode(isa, config && config->bvh)
                                                     : "single";
@@ -471,11 +604,13 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile,
                 if (config) row.accel = config->bvh ? "bvh" : "none";
                 if (path == RenderPath::scalar) row.accel = "bvh";
                 if (path == RenderPath::simd) {
-                    const auto key = std::make_pair(isa, config && config->bvh);
+                    const auto key = std::make_tuple(w, isa, config && config->bvh);
                     auto it = render_validation.find(key);
                     if (it == render_validation.end()) {
+                        detail::Stopwatch checking(run.report.context.validation_seconds);
                         bool ok = false;
-                        std::string text = detail::validate_render(bs.spec, o, isa, accel, ok);
+                        std::string text = detail::validate_render(bs.spec, o, isa, accel,
+                                                                   w == Workload::frame, ok);
                         it = render_validation.emplace(key, std::make_pair(ok, text)).first;
                     }
                     row.valid = it->second.first;
@@ -486,66 +621,85 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile,
                 }
                 RenderOptions ro = frame_options(run, tile);
                 ro.accel = accel;
+                std::optional<PreparedScene> prepared;
+                if (w == Workload::frame)
+                    run.arena.execute([&] { prepared.emplace(bs.scene, accel, ro.threads); });
                 const auto render = [&] {
-                    return path == RenderPath::simd ? render_packet(bs.compiled, ro, isa)
-                                                    : render_reference(bs.scene, ro);
+                    if (path == RenderPath::scalar) return render_reference(bs.scene, ro);
+                    return prepared ? render_packet(*prepared, ro, isa)
+                                    : render_packet(bs.scene, ro, isa);
                 };
-                detail::time_frames(row, render, o);
-                log_line(run.log, "  whitted octray " + row.mode + " " + row.isa + " " +
-                                      row.accel + " tile " + row.tile + ": " +
-                                      format("%.3f frames/s", row.frames_per_second) + ", " +
-                                      format("%.2f Mrays/s", row.timing.mrays_median));
+                {
+                    detail::Stopwatch timed(run.report.context.timed_seconds);
+                    detail::time_frames(row, render, o);
+                }
                 run.report.rows.push_back(std::move(row));
+                ++run.rows_done;
+                log_frame_row(run, run.report.rows.back());
             }
     }
 }
 
 #if OCTRAY_HAVE_EMBREE
 // The same frames with Embree answering the hit queries (user geometry, 16- and 8-wide
-// packets of each generation's rays).
-void measure_embree_renders(BenchRun& run, const BenchScene& bs, TileSize tile) {
+// packets of each generation's rays). A still is charged what octray's is: compiling the
+// scene, then Embree's BVH build at its faster quality for this scene (EmbreeScene::rebuild,
+// every repetition), then the frame. A frame traces the HIGH-quality scene built before.
+void measure_embree_renders(BenchRun& run, BenchScene& bs, TileSize tile, Workload w) {
     const Scene small = detail::validation_scene(bs.spec, run.o);
+    EmbreeScene& scene = w == Workload::still ? *bs.embree_still : *bs.embree;
     for (EmbreeMode mode : {EmbreeMode::packet16, EmbreeMode::packet8}) {
-        const EmbreeFrames frames(*bs.embree, mode, run.isas.back());
-        BenchRow row =
-            base_row(run, bs.spec, Workload::whitted, Variant{PixelOrder::tiled, tile});
+        const EmbreeFrames frames(scene, mode, run.isas.back());
+        BenchRow row = base_row(run, bs.spec, w, Variant{PixelOrder::tiled, tile});
         row.system = "embree";
         row.mode = embree_mode_name(mode);
-        row.isa = embree_geometry_name(bs.embree->geometry());
+        row.isa = embree_geometry_name(scene.geometry());
+        if (w == Workload::still)
+            row.build_quality = embree_build_quality_name(scene.build_quality());
         bool ok = false;
-        row.validation = detail::validate_embree_render(small, frames, run.o, ok);
+        {
+            detail::Stopwatch checking(run.report.context.validation_seconds);
+            row.validation = detail::validate_embree_render(small, frames, run.o, ok);
+        }
         row.valid = ok;
         const RenderOptions ro = frame_options(run, tile);
-        // octray's frames build their BVH inside render_packet (an animation rebuilds it
-        // every frame); Embree's scene was built once before. So each Embree frame is
-        // charged one build, the median of the bench's builds of this scene, as octray's is.
-        const double build = bs.info.embree_build_ms.value_or(0.0) * 1e-3;
-        detail::time_frames(
-            row,
-            [&] {
-                RenderResult r = frames.render(bs.compiled, ro);
-                r.seconds += build;
-                return r;
-            },
-            run.o);
-        log_line(run.log, "  whitted embree " + row.mode + " " + row.isa + " tile " + row.tile +
-                              ": " + format("%.3f frames/s", row.frames_per_second) + ", " +
-                              format("%.2f Mrays/s", row.timing.mrays_median) +
-                              (row.valid ? "" : " (" + row.validation + ")"));
+        const auto render = [&] {
+            if (w == Workload::frame) return frames.render(bs.compiled, ro);
+            const auto start = std::chrono::steady_clock::now();
+            const CompiledScene compiled = compile_scene(bs.scene);  // as octray's still
+            const double compile =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            double build = 0.0;
+            run.arena.execute([&] { build = scene.rebuild(); });
+            RenderResult r = frames.render(bs.compiled, ro);
+            r.compile_seconds = compile;
+            r.bvh_seconds = build;
+            r.seconds += compile + build;
+            return r;
+        };
+        {
+            detail::Stopwatch timed(run.report.context.timed_seconds);
+            detail::time_frames(row, render, run.o);
+        }
         run.report.rows.push_back(std::move(row));
+        ++run.rows_done;
+        log_frame_row(run, run.report.rows.back());
     }
 }
 #endif
 
-// Whole renders: the full Whitted workload, frame after frame, per tile size.
-void measure_whole_renders(BenchRun& run, const BenchScene& bs) {
+// Whole renders: the full Whitted workload, frame after frame, per tile size, as stills
+// and as frames of a prepared scene.
+void measure_whole_renders(BenchRun& run, BenchScene& bs) {
     RenderValidation render_validation;
-    for (TileSize tile : run.o.tiles) {
-        measure_octray_renders(run, bs, tile, render_validation);
+    for (TileSize tile : run.o.tiles)
+        for (Workload w : {Workload::still, Workload::frame}) {
+            if (!run.wants(w)) continue;
+            measure_octray_renders(run, bs, tile, w, render_validation);
 #if OCTRAY_HAVE_EMBREE
-        if (bs.embree) measure_embree_renders(run, bs, tile);
+            if (bs.embree) measure_embree_renders(run, bs, tile, w);
 #endif
-    }
+        }
 }
 
 }  // namespace
@@ -579,15 +733,22 @@ BenchReport run_bench(const BenchOptions& o, std::ostream* log) {
     tbb::task_arena arena(report.context.threads);
     BenchRun run{o, log, report, arena, resolve_isas(o)};
     const std::vector<Variant> variants = pixel_variants(o);
-    for (const std::string& spec : o.scenes) {
+    run.variants = variants.size();
+    for (std::size_t k = 0; k < o.scenes.size(); ++k) {
+        const std::string& spec = o.scenes[k];
         BenchScene bs(spec, o);
         set_up_scene(run, bs);
+        run.rows_planned =
+            run.rows_done + planned_rows(run, bs) * static_cast<int>(o.scenes.size() - k);
         if (run.ray_sets())
             for (const Variant& v : variants) measure_ray_sets(run, bs, v);
-        if (run.wants(Workload::whitted)) measure_whole_renders(run, bs);
+        if (run.wants(Workload::still) || run.wants(Workload::frame))
+            measure_whole_renders(run, bs);
         report.scenes.push_back(std::move(bs.info));
     }
     compute_ratios(report.rows);
+    report.context.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
     return report;
 }
 

@@ -5,6 +5,7 @@
 // How to run it and what each figure means: bench/README.md.
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -19,18 +20,36 @@
 
 namespace octray::bench {
 
-// What a row measures: one kind of ray set, or the whole Whitted render of the frame.
-enum class Workload { primary, shadow, secondary, whitted };
+// What a row measures: one kind of ray set, or a whole Whitted frame, measured two ways:
+// - still: a picture from the scene as it comes: the scene made ready (octray: compile and
+//   BVH build; Embree: the same compile and its BVH build at its faster quality for the
+//   scene, LOW or MEDIUM) and its first frame rendered, every repetition from scratch;
+// - frame: a frame of a scene made ready once before (octray: render_packet of a
+//   PreparedScene; Embree: its HIGH-quality BVH built before), the render alone.
+enum class Workload { primary, shadow, secondary, still, frame };
 const char* workload_name(Workload workload);
 std::optional<Workload> parse_workload(std::string_view name);
+// A --rays word: a workload's name, or "whitted" for both whole-frame kinds ({} if unknown).
+std::vector<Workload> parse_workloads(std::string_view name);
+// Whole frames (still, frame) rather than ray sets.
+bool whole_frame(Workload workload);
 
 struct BenchOptions {
     std::vector<std::string> scenes{"whitted", "random:16", "random:1024", "sphereflake:4"};
     std::vector<Workload> workloads{Workload::primary, Workload::shadow, Workload::secondary,
-                                    Workload::whitted};
+                                    Workload::still, Workload::frame};
     int threads = 0;  // 0: every core TBB sees
     int reps = 5;     // timed repetitions per row
     int warmup = 1;  // untimed runs before them (0 allowed: the timed runs' hits are validated)
+    // Each timed repetition repeats its ray set or frame until at least this many seconds
+    // have passed, and counts the mean of its runs (Google Benchmark's min time, per
+    // repetition): a 0.3 ms ray set is timed over ~300 runs, not one. 0: one run each.
+    double min_time = kDefaultMinTime;
+    static constexpr double kDefaultMinTime = 0.1;
+    // A row whose slowest repetition took more than this many times its fastest is marked
+    // unsteady (BenchRow::steady): its median is not to be trusted to a few percent.
+    double max_spread = kDefaultMaxSpread;
+    static constexpr double kDefaultMaxSpread = 1.25;
     int width = 1920, height = 1080;
     // Knobs; each list is measured in one run, every value a row of its own. The first
     // value of each list is the default configuration.
@@ -60,10 +79,23 @@ struct BenchOptions {
 struct Timing {
     double seconds_median = 0.0, seconds_min = 0.0, seconds_max = 0.0;
     double mrays_median = 0.0, mrays_min = 0.0, mrays_max = 0.0;
+    double spread = 1.0;  // seconds_max / seconds_min (1 for a single repetition)
 };
 // Median / min / max over repetitions of `rays` rays each (the median of an even count is
 // the mean of the middle two). Mrays/s min comes from the slowest repetition.
 Timing summarize(std::vector<double> seconds, std::uint64_t rays);
+
+// Timed repetitions: the seconds each counts (the mean of its runs) and its runs.
+struct Repetitions {
+    std::vector<double> seconds;
+    std::vector<std::uint32_t> runs;
+};
+// o.warmup untimed runs, then o.reps repetitions, each repeating `run` until the seconds
+// its runs count add up to o.min_time (at least one run; Google Benchmark's min time).
+// `run` does one run and returns the seconds it counts (its wall clock, or a render's own
+// figure). A repetition also ends after 2 * o.min_time + 1 s of wall clock, should the
+// runs count (nearly) nothing.
+Repetitions repeat_timed(const std::function<double()>& run, const BenchOptions& o);
 
 struct BenchRow {
     std::string scene;
@@ -83,9 +115,15 @@ struct BenchRow {
     std::uint64_t rays = 0;  // per repetition
     RayCounts counts;        // the rays of one repetition by kind
     double hit_fraction = 0.0;
-    std::vector<double> seconds;  // per timed repetition
+    std::vector<double> seconds;  // per timed repetition: the mean of its runs
+    // Runs per timed repetition (BenchOptions::min_time): more than 1 where one run is short.
+    std::vector<std::uint32_t> runs;
     Timing timing;
+    // timing.spread <= BenchOptions::max_spread: the repetitions agree.
+    bool steady = true;
     double frames_per_second = 0.0;  // whole renders: 1 / median seconds
+    // Embree's still rows: the build quality timed ("low" or "medium"); "-" elsewhere.
+    std::string build_quality = "-";
     bool valid = false;
     std::string validation;  // what was checked, and how it came out
     // octray rows: this row's median over the best valid Embree row of the same scene,
@@ -97,8 +135,12 @@ struct SceneInfo {
     std::string spec;
     std::uint32_t objects = 0, spheres = 0, planes = 0, lights = 0;
     float epsilon = 0.0f;
-    double compile_ms = 0.0;                        // compile_scene()
-    std::optional<double> embree_build_ms;          // rtcCommitScene()
+    double compile_ms = 0.0;                // compile_scene()
+    std::optional<double> embree_build_ms;  // rtcCommitScene(), HIGH quality
+    // Still rows (Workload::still): Embree's LOW and MEDIUM builds (the median of the
+    // bench's builds) and the faster of the two, which its still rows use.
+    std::optional<double> embree_build_low_ms, embree_build_medium_ms;
+    std::string embree_still_quality;               // "low", "medium"; empty without still rows
     std::optional<double> embree_bytes_per_sphere;  // Embree's device memory after the build
     // octray's sphere BVH (kernels/bvh_build.h): build time, bytes per sphere (nodes and its
     // copy of the spheres), 8-wide nodes, leaves, depth. Absent without spheres.
@@ -123,6 +165,11 @@ struct BenchContext {
     bool embree_available = false;
     double load_average = 0.0;  // 1-minute load when the run started
     int width = 0, height = 0, reps = 0, warmup = 0;
+    double min_time = 0.0, max_spread = 0.0;
+    // Where the run's wall-clock time went: timed repetitions (warm-up runs included),
+    // validation (the oracles' hits, checking hits and images), the rest (loading and
+    // compiling scenes, building BVHs, time to first pixel, making ray sets).
+    double wall_seconds = 0.0, timed_seconds = 0.0, validation_seconds = 0.0;
     std::uint32_t validate_rays = 0;
     std::string command_line;
 };
@@ -143,6 +190,9 @@ void compute_ratios(std::vector<BenchRow>& rows);
 
 void print_table(const BenchReport& report, std::ostream& out);
 std::string report_json(const BenchReport& report);
+// A duration for people: "0.4 s", "42 s", "7 min 32 s", "1 h 5 min".
+std::string format_duration(double seconds);
+
 // Written atomically; throws IoError naming the file.
 void write_json_file(const BenchReport& report, const std::string& path);
 

@@ -47,17 +47,41 @@ void for_chunks(tbb::task_arena& arena, std::uint32_t count,
 
 }  // namespace
 
-// Warm-up runs, then `reps` timed runs; the hits of the last run stay in `hits`.
-std::vector<double> time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits, int warmup,
-                              int reps) {
-    for (int i = 0; i < warmup; ++i) trace(rays, hits);
-    std::vector<double> seconds;
-    for (int i = 0; i < reps; ++i) {
+}  // namespace octray::bench::detail
+
+namespace octray::bench {
+
+Repetitions repeat_timed(const std::function<double()>& run, const BenchOptions& o) {
+    using detail::Clock;
+    for (int i = 0; i < o.warmup; ++i) (void)run();
+    Repetitions reps;
+    for (int i = 0; i < o.reps; ++i) {
         const auto start = Clock::now();
-        trace(rays, hits);
-        seconds.push_back(seconds_since(start));
+        double counted = 0.0;
+        std::uint32_t runs = 0;
+        do {
+            counted += run();
+            ++runs;
+        } while (counted < o.min_time && detail::seconds_since(start) < 2.0 * o.min_time + 1.0);
+        reps.seconds.push_back(counted / runs);
+        reps.runs.push_back(runs);
     }
-    return seconds;
+    return reps;
+}
+
+}  // namespace octray::bench
+
+namespace octray::bench::detail {
+
+Repetitions time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits,
+                      const BenchOptions& o) {
+    return repeat_timed(
+        [&] {
+            const auto start = Clock::now();
+            trace(rays, hits);
+            return seconds_since(start);
+        },
+        o);
 }
 
 // octray's packet kernels over the set: closest_hit, or any_hit into the occluded flags.
@@ -119,22 +143,30 @@ Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMod
 }
 #endif
 
-// A whole-frame row: warm-up frames, then o.reps timed ones (each frame's own seconds),
-// the last frame's ray counts, the rates and frames per second.
+// A whole-frame row: warm-up frames, then o.reps timed repetitions (each frame's own
+// seconds), the last frame's ray counts, the rates and frames per second.
 void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
                  const BenchOptions& o) {
     RenderResult last;
-    for (int i = 0; i < o.warmup; ++i) last = render();
-    for (int i = 0; i < o.reps; ++i) {
-        last = render();
-        row.seconds.push_back(last.seconds);
-    }
+    Repetitions reps = repeat_timed(
+        [&] {
+            last = render();
+            return last.seconds;
+        },
+        o);
+    row.seconds = std::move(reps.seconds);
+    row.runs = std::move(reps.runs);
     row.counts = last.rays;
     row.rays = last.rays.total();
     row.hit_fraction = std::nan("");
-    row.timing = summarize(row.seconds, row.rays);
+    set_timing(row, o);
     row.frames_per_second =
         row.timing.seconds_median > 0.0 ? 1.0 / row.timing.seconds_median : 0.0;
+}
+
+void set_timing(BenchRow& row, const BenchOptions& o) {
+    row.timing = summarize(row.seconds, row.rays);
+    row.steady = row.timing.spread <= o.max_spread;
 }
 
 }  // namespace octray::bench::detail

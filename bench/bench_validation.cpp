@@ -90,15 +90,18 @@ Scene validation_scene(const std::string& spec, const BenchOptions& o) {
 // The packet render of the scene at the validation size equals the reference render,
 // image and ray counts.
 std::string validate_render(const std::string& spec, const BenchOptions& o, Isa isa,
-                            Accel accel, bool& valid) {
+                            Accel accel, bool prepared, bool& valid) {
     const Scene small = validation_scene(spec, o);
     RenderOptions ro;
     ro.threads = o.threads;
     const RenderResult ref = render_reference(small, ro);  // through the reference's BVH
     ro.accel = accel;
-    const RenderResult simd = render_packet(small, ro, isa);
+    const RenderResult simd =
+        prepared ? render_packet(PreparedScene(small, accel, o.threads), ro, isa)
+                 : render_packet(small, ro, isa);
     valid = ref.image == simd.image && ref.rays.total() == simd.rays.total();
-    return std::string(valid ? "valid" : "INVALID") + ": packet image " +
+    return std::string(valid ? "valid" : "INVALID") + ": " +
+           (prepared ? "prepared-scene" : "packet") + " image " +
            (ref.image == simd.image ? "equals" : "differs from") + " the reference image at " +
            std::to_string(small.image.width) + "x" + std::to_string(small.image.height) +
            ", ray counts " + (ref.rays.total() == simd.rays.total() ? "equal" : "differ");

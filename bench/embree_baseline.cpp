@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +35,18 @@ const char* embree_geometry_name(EmbreeGeometry geometry) {
     return geometry == EmbreeGeometry::user ? "user" : "sphere_point";
 }
 
+const char* embree_build_quality_name(EmbreeBuildQuality quality) {
+    switch (quality) {
+        case EmbreeBuildQuality::low:
+            return "low";
+        case EmbreeBuildQuality::medium:
+            return "medium";
+        case EmbreeBuildQuality::high:
+            return "high";
+    }
+    return "?";
+}
+
 namespace {
 
 // An infinite plane becomes one quad reaching at least this many times the scene's size
@@ -51,10 +64,12 @@ void throw_error(RTCDevice device, const char* what) {
 
 struct EmbreeScene::Impl {
     EmbreeGeometry geometry = EmbreeGeometry::user;
+    EmbreeBuildQuality quality = EmbreeBuildQuality::high;
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     RTCScene plane_scene = nullptr;  // user: the planes, instanced into `scene`
     EmbreeSphereData spheres{};      // user: what the sphere callbacks read
+    std::atomic<std::uint64_t> sphere_builds{0};
     // Per geometry ID of `scene`: primitive ID -> object file index; a hit through the
     // planes' instance: primitive ID -> object file index.
     std::vector<std::vector<std::int32_t>> object_of;
@@ -65,13 +80,25 @@ struct EmbreeScene::Impl {
     std::atomic<std::int64_t> live_bytes{0};
     std::int64_t bytes_after_build = 0;
 
+    // Every geometry attached, for rebuild(): its scene, handle (the scene holds a
+    // reference) and how to mark it modified.
+    enum class Kind { user, buffers, instance };
+    struct Attached {
+        RTCScene scene;
+        RTCGeometry geometry;
+        Kind kind;
+        unsigned primitives;
+    };
+    std::vector<Attached> attached;
+
     std::int32_t object(unsigned geom_id, unsigned prim_id, unsigned inst_id) const {
         if (geom_id == RTC_INVALID_GEOMETRY_ID) return kernels::kNoHit;
         if (inst_id != RTC_INVALID_GEOMETRY_ID) return instanced_plane_object[prim_id];
         return object_of[geom_id][prim_id];
     }
 
-    void attach(RTCScene target, RTCGeometry g, std::vector<std::int32_t> objects) {
+    void attach(RTCScene target, RTCGeometry g, std::vector<std::int32_t> objects, Kind kind) {
+        attached.push_back({target, g, kind, static_cast<unsigned>(objects.size())});
         rtcCommitGeometry(g);
         const unsigned id = rtcAttachGeometry(target, g);
         rtcReleaseGeometry(g);
@@ -85,10 +112,15 @@ struct EmbreeScene::Impl {
 };
 
 EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads,
-                         EmbreeGeometry geometry)
+                         EmbreeGeometry geometry, EmbreeBuildQuality quality)
     : impl_(std::make_unique<Impl>()) {
     Impl& im = *impl_;
     im.geometry = geometry;
+    im.quality = quality;
+    const RTCBuildQuality build_quality =
+        quality == EmbreeBuildQuality::low      ? RTC_BUILD_QUALITY_LOW
+        : quality == EmbreeBuildQuality::medium ? RTC_BUILD_QUALITY_MEDIUM
+                                                : RTC_BUILD_QUALITY_HIGH;
     const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
     im.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (!im.device) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -106,7 +138,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         },
         &im);
     im.scene = rtcNewScene(im.device);
-    rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(im.scene, build_quality);
 
     const CompiledSpheres& s = compiled.spheres;
     if (s.count > 0 && geometry == EmbreeGeometry::user) {
@@ -114,7 +146,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         // c -+ r widened by a few ulps so that rounding never clips a sphere.
         RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_USER);
         if (!g) throw_error(im.device, "rtcNewGeometry(USER)");
-        im.spheres = {s.cx.data(), s.cy.data(), s.cz.data(), s.r2.data()};
+        im.spheres = {s.cx.data(), s.cy.data(), s.cz.data(), s.r2.data(), &im.sphere_builds};
         rtcSetGeometryUserPrimitiveCount(g, s.count);
         rtcSetGeometryUserData(g, &im.spheres);
         rtcSetGeometryBoundsFunction(
@@ -122,6 +154,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
             [](const RTCBoundsFunctionArguments* args) {
                 const auto& d = *static_cast<const EmbreeSphereData*>(args->geometryUserPtr);
                 const unsigned i = args->primID;
+                if (i == 0) d.builds->fetch_add(1, std::memory_order_relaxed);
                 const float r = std::sqrt(d.r2[i]) * (1.0f + 0x1.0p-20f);
                 const auto lo = [r](float c) { return (c - r) - std::fabs(c) * 0x1.0p-22f; };
                 const auto hi = [r](float c) { return (c + r) + std::fabs(c) * 0x1.0p-22f; };
@@ -133,7 +166,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         rtcSetGeometryIntersectFunction(g, callbacks.intersect);
         rtcSetGeometryOccludedFunction(g, callbacks.occluded);
         im.attach(im.scene, g,
-                  std::vector<std::int32_t>(s.object.begin(), s.object.begin() + s.count));
+                  std::vector<std::int32_t>(s.object.begin(), s.object.begin() + s.count),
+                  Impl::Kind::user);
     } else if (s.count > 0) {
         // Spheres: one SPHERE_POINT geometry, (x, y, z, r) per sphere, in file order.
         RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
@@ -146,7 +180,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
             v[4 * i + 3] = s.radius[i];
             objects[i] = static_cast<std::int32_t>(s.object[i]);
         }
-        im.attach(im.scene, g, std::move(objects));
+        im.attach(im.scene, g, std::move(objects), Impl::Kind::buffers);
     }
 
     // Planes: one QUAD geometry, a square per plane spanned by the checker basis; with user
@@ -191,17 +225,17 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         }
         if (geometry == EmbreeGeometry::user) {
             im.plane_scene = rtcNewScene(im.device);
-            rtcSetSceneBuildQuality(im.plane_scene, RTC_BUILD_QUALITY_HIGH);
-            im.attach(im.plane_scene, g, std::move(objects));
+            rtcSetSceneBuildQuality(im.plane_scene, build_quality);
+            im.attach(im.plane_scene, g, std::move(objects), Impl::Kind::buffers);
             rtcCommitScene(im.plane_scene);
             RTCGeometry instance = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_INSTANCE);
             if (!instance) throw_error(im.device, "rtcNewGeometry(INSTANCE)");
             rtcSetGeometryInstancedScene(instance, im.plane_scene);
             const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
             rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
-            im.attach(im.scene, instance, {});
+            im.attach(im.scene, instance, {}, Impl::Kind::instance);
         } else {
-            im.attach(im.scene, g, std::move(objects));
+            im.attach(im.scene, g, std::move(objects), Impl::Kind::buffers);
         }
     }
 
@@ -221,6 +255,33 @@ EmbreeScene::~EmbreeScene() {
 }
 
 double EmbreeScene::build_seconds() const { return impl_->build_seconds; }
+
+EmbreeBuildQuality EmbreeScene::build_quality() const { return impl_->quality; }
+
+std::uint64_t EmbreeScene::sphere_builds() const { return impl_->sphere_builds.load(); }
+
+double EmbreeScene::rebuild() {
+    Impl& im = *impl_;
+    const auto start = std::chrono::steady_clock::now();
+    // The planes' scene first (the instance refers to it), then the top scene.
+    for (RTCScene target : {im.plane_scene, im.scene}) {
+        if (!target) continue;
+        for (const Impl::Attached& a : im.attached) {
+            if (a.scene != target) continue;
+            if (a.kind == Impl::Kind::user)
+                rtcSetGeometryUserPrimitiveCount(a.geometry, a.primitives);
+            else if (a.kind == Impl::Kind::buffers)
+                rtcUpdateGeometryBuffer(a.geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+            rtcCommitGeometry(a.geometry);
+        }
+        rtcCommitScene(target);
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (rtcGetDeviceError(im.device) != RTC_ERROR_NONE || !im.last_error.empty())
+        throw std::runtime_error("Embree: scene rebuild failed: " + im.last_error);
+    return seconds;
+}
 
 std::int64_t EmbreeScene::memory_bytes() const { return impl_->bytes_after_build; }
 
@@ -252,13 +313,45 @@ RTCIntersectContext make_context(bool coherent) {
     return context;
 }
 
-// Lanes [first, first + K) into a K-wide packet. Lanes past `end` are off and carry a
-// harmless ray (origin 0, direction +z, empty interval): Embree 3.13's emulated 16-wide
-// calls assert that every ray of an 8-wide half is valid, off lanes included, and the
-// kernels' streams hold garbage past their count.
+// What stays the same from packet to packet (Embree writes only tfar and the hit): set
+// once before the first. The ID is not read back, so it stays 0.
+template <int K, class RayK>
+void init_packet(RayK& r, int (&valid)[K], float t_min) {
+    for (int k = 0; k < K; ++k) {
+        valid[k] = -1;
+        r.tnear[k] = t_min;
+        r.time[k] = 0.0f;
+        r.mask[k] = 0xFFFFFFFFu;
+        r.id[k] = 0;
+        r.flags[k] = 0;
+    }
+}
+
+// Lanes [first, first + K) into a K-wide packet. A full packet is K consecutive rays of
+// the SoA arrays: each field one block copy (what an expert's harness does; lane-by-lane
+// selects cost as much as Embree's whole traversal of a small scene). In a last, partial
+// packet the lanes past `end` are off and carry a harmless ray (origin 0, direction +z,
+// empty interval): Embree 3.13's emulated 16-wide calls assert that every ray of an
+// 8-wide half is valid, off lanes included, and the kernels' streams hold garbage past
+// their count.
 template <int K, class RayK>
 void set_ray_packet(RayK& r, int (&valid)[K], const EmbreeScene::RayArrays& rays,
                     std::uint32_t first, std::uint32_t end) {
+    if (first + K <= end) {
+        constexpr std::size_t bytes = K * sizeof(float);
+        std::memcpy(r.org_x, rays.ox + first, bytes);
+        std::memcpy(r.org_y, rays.oy + first, bytes);
+        std::memcpy(r.org_z, rays.oz + first, bytes);
+        std::memcpy(r.dir_x, rays.dx + first, bytes);
+        std::memcpy(r.dir_y, rays.dy + first, bytes);
+        std::memcpy(r.dir_z, rays.dz + first, bytes);
+        if (rays.t_max) {
+            std::memcpy(r.tfar, rays.t_max + first, bytes);
+        } else {
+            for (int k = 0; k < K; ++k) r.tfar[k] = kInfinity;
+        }
+        return;  // the rest as init_packet left it
+    }
     for (int k = 0; k < K; ++k) {
         const std::uint32_t i = first + static_cast<std::uint32_t>(k);
         const bool on = i < end;
@@ -330,14 +423,15 @@ void intersect_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context
                        std::int32_t* object) {
     alignas(64) typename Packet<K>::RayHit rh;
     alignas(64) int valid[K];
+    init_packet<K>(rh.ray, valid, rays.t_min);
     for (std::uint32_t base = 0; base < count; base += K) {
         set_ray_packet<K>(rh.ray, valid, rays, base, count);
-        for (int k = 0; k < K; ++k) {
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        static_assert(RTC_INVALID_GEOMETRY_ID == 0xFFFFFFFFu);
+        std::memset(rh.hit.geomID, 0xFF, sizeof rh.hit.geomID);
+        std::memset(rh.hit.instID[0], 0xFF, sizeof rh.hit.instID[0]);
         Packet<K>::intersect(valid, im.scene, &context, &rh);
-        for (std::uint32_t k = 0; k < K && base + k < count; ++k) {
+        const std::uint32_t lanes = std::min<std::uint32_t>(K, count - base);
+        for (std::uint32_t k = 0; k < lanes; ++k) {
             const std::int32_t o =
                 im.object(rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k]);
             object[base + k] = o;
@@ -352,6 +446,7 @@ void occluded_packets(const EmbreeScene::Impl& im, RTCIntersectContext& context,
                       std::uint32_t* occluded) {
     alignas(64) typename Packet<K>::Ray r;
     alignas(64) int valid[K];
+    init_packet<K>(r, valid, rays.t_min);
     for (std::uint32_t base = 0; base < count; base += K) {
         set_ray_packet<K>(r, valid, rays, base, count);
         Packet<K>::occluded(valid, im.scene, &context, &r);

@@ -44,6 +44,11 @@ enum class EmbreeMode {
 
 enum class EmbreeGeometry { user, sphere_point };
 
+// rtcSetSceneBuildQuality: LOW (Embree's Morton builder, the fastest build), MEDIUM (its
+// default, binned SAH), HIGH (SAH with spatial splits where it applies; the ray-set rows).
+enum class EmbreeBuildQuality { low, medium, high };
+const char* embree_build_quality_name(EmbreeBuildQuality quality);
+
 const char* embree_mode_name(EmbreeMode mode);
 // "user" or "sphere_point": the bench's `isa` column for Embree rows.
 const char* embree_geometry_name(EmbreeGeometry geometry);
@@ -52,12 +57,12 @@ constexpr bool embree_compiled() { return OCTRAY_HAVE_EMBREE != 0; }
 
 class EmbreeScene {
   public:
-    // Builds the device and the scene (BVH build quality high: the scene is static).
-    // `threads` (0: all) caps Embree's own TBB use. Throws std::runtime_error with
+    // Builds the device and the scene (BVH build quality high by default: the scene is
+    // static). `threads` (0: all) caps Embree's own TBB use. Throws std::runtime_error with
     // Embree's message on failure.
     // `compiled` must outlive this object (user geometry reads its sphere arrays).
     EmbreeScene(const Scene& scene, const CompiledScene& compiled, int threads,
-                EmbreeGeometry geometry);
+                EmbreeGeometry geometry, EmbreeBuildQuality quality = EmbreeBuildQuality::high);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -88,6 +93,14 @@ class EmbreeScene {
 
     // Seconds rtcCommitScene took (the BVH build), in the calling thread's TBB arena.
     double build_seconds() const;
+    // Builds the BVH again from scratch, as a new frame of an animation would (every
+    // geometry marked modified, the planes' scene and the top scene committed again; the
+    // device and geometry buffers kept): returns the seconds the commits took.
+    double rebuild();
+    EmbreeBuildQuality build_quality() const;
+    // User geometry: how many builds have asked for the spheres' bounds so far (1 after
+    // the constructor, one more per rebuild), the proof that rebuild() builds.
+    std::uint64_t sphere_builds() const;
 
     // Bytes the device held once the scene was committed (its memory monitor callback:
     // geometry buffers, BVH and build leftovers).

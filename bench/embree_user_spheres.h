@@ -13,6 +13,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <atomic>
 #include <cstdint>
 
 namespace octray::bench {
@@ -21,6 +22,9 @@ namespace octray::bench {
 // sphere order). Must outlive the Embree scene.
 struct EmbreeSphereData {
     const float *cx, *cy, *cz, *r2;
+    // Counts the builds that asked for the spheres' bounds (the bounds callback of primitive
+    // 0, once per build): EmbreeScene::sphere_builds.
+    std::atomic<std::uint64_t>* builds = nullptr;
 };
 
 struct EmbreeSphereCallbacks {

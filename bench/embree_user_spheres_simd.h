@@ -66,7 +66,7 @@ Lanes sphere_lanes(const EmbreeSphereData& s, unsigned prim, const int* valid, f
     const auto near_ok = t_near > tnear && t_near < tfar;
     const auto far_ok = t_far > tnear && t_far < tfar;
     // valid[] is -1 for an active lane, 0 otherwise.
-    const auto active = xsimd::to_float(I::load_unaligned(valid + i)) != F(0.0f);
+    const auto active = xsimd::bool_cast(I::load_unaligned(valid + i) != I(0));
     return {xsimd::select(near_ok, t_near, t_far), active && (near_ok || far_ok)};
 }
 
@@ -89,20 +89,10 @@ void intersect_spheres(const RTCIntersectFunctionNArguments* args) {
     for (unsigned i = 0; i < n; i += W) {
         const Lanes l = sphere_lanes(s, prim, args->valid, ray, n, i);
         if (xsimd::none(l.hit)) continue;
-        const auto ihit =
-            xsimd::bitwise_cast<I>(xsimd::select(l.hit, F(1.0f), F(0.0f))) != I(0);
+        const auto ihit = xsimd::bool_cast(l.hit);
+        // tfar and the IDs: all the bench reads of a hit (EmbreeScene::intersect), so all
+        // an expert's callback writes; the geometric normal and u, v are left alone.
         merge(ray + 8 * n, i, l.hit, l.t);
-        const F px = F::load_unaligned(ray + 0 * n + i) +
-                     l.t * F::load_unaligned(ray + 4 * n + i),
-                py = F::load_unaligned(ray + 1 * n + i) +
-                     l.t * F::load_unaligned(ray + 5 * n + i),
-                pz = F::load_unaligned(ray + 2 * n + i) +
-                     l.t * F::load_unaligned(ray + 6 * n + i);
-        merge(hit + 0 * n, i, l.hit, px - F(s.cx[prim]));
-        merge(hit + 1 * n, i, l.hit, py - F(s.cy[prim]));
-        merge(hit + 2 * n, i, l.hit, pz - F(s.cz[prim]));
-        merge(hit + 3 * n, i, l.hit, F(0.0f));
-        merge(hit + 4 * n, i, l.hit, F(0.0f));
         merge(hit + 5 * n, i, ihit, I(static_cast<std::int32_t>(prim)));
         merge(hit + 6 * n, i, ihit, I(static_cast<std::int32_t>(args->geomID)));
         merge(hit + 7 * n, i, ihit, I(static_cast<std::int32_t>(args->context->instID[0])));

@@ -6,8 +6,11 @@
 Writes into DIR (default: the current directory), each as PNG and SVG unless --format
 says otherwise:
 
-  mrays.{png,svg}    Mrays/s by scene and ray kind, octray against Embree (each system's
-                     best valid row at the largest thread count, the ratio above the pair)
+  mrays.{png,svg}    Mrays/s, a panel per ray kind, scenes side by side, octray against
+                     Embree (each system's best valid row at the largest thread count, a
+                     min-max bar over its repetitions, octray / Embree above the pair: a
+                     loss in red, a row whose repetitions spread too far marked "~"); the
+                     subtitle says where and how it was measured
   scaling.{png,svg}  Mrays/s against threads, one panel per ray kind (only when the rows
                      hold more than one thread count: `octray bench --threads 1,2,4`)
   isa.{png,svg}      octray's Mrays/s by instruction set (only when the rows hold more than
@@ -29,7 +32,19 @@ import os
 import sys
 
 FORMATS = ("png", "svg")
-RAY_KINDS = ("primary", "shadow", "secondary", "whitted")
+RAY_KINDS = ("primary", "shadow", "secondary", "still", "frame", "whitted")
+# What each ray kind's panel is called ("whitted": whole frames in reports before there
+# were two kinds of them).
+KIND_TITLES = {
+    "primary": "primary rays",
+    "shadow": "shadow rays",
+    "secondary": "mirror rays",
+    "still": "whole frame: scene made ready + first frame",
+    "frame": "whole frame of a scene made ready before",
+    "whitted": "whole frame",
+}
+KIND_SHORT = {"secondary": "mirror", "whitted": "whole frame"}
+LOSS_COLOR = "#C00000"
 # Colors that read apart in print and for the common color-vision deficiencies.
 OCTRAY_COLOR = "#0072B2"
 EMBREE_COLOR = "#E69F00"
@@ -52,8 +67,9 @@ class InputError(Exception):
     """A file that is not a bench report; the message names the file and what is wrong."""
 
 
-def load_rows(path):
-    """The rows of one `octray bench --json` file, checked for the keys the charts use."""
+def load_report(path):
+    """(rows, context) of one `octray bench --json` file, the rows checked for the keys the
+    charts use."""
     try:
         with open(path, encoding="utf-8") as f:
             text = f.read()
@@ -83,7 +99,8 @@ def load_rows(path):
             raise InputError(f"{path}: rows[{i}].mrays_median: expected a number >= 0, "
                              f"found {row['mrays_median']}")
         rows.append(row)
-    return rows
+    context = report.get("context")
+    return rows, context if isinstance(context, dict) else {}
 
 
 def type_name(kind):
@@ -126,54 +143,131 @@ def use_log_scale(axis, values):
         axis.set_yscale("log")
 
 
-def label_bars(axis, bars, texts):
-    for bar, text in zip(bars, texts):
-        axis.annotate(text, (bar.get_x() + bar.get_width() / 2, bar.get_height()),
-                      xytext=(0, 2), textcoords="offset points", ha="center",
-                      va="bottom", fontsize=7)
+def subtitle(context, threads):
+    """Where and how a report was measured, in one line: CPU, ISA, size, threads, reps,
+    date, load."""
+    parts = []
+    if context.get("cpu"):
+        cpus = context.get("logical_cpus")
+        parts.append(f"{context['cpu']}" + (f" ({cpus} logical)" if cpus else ""))
+    if context.get("isa"):
+        parts.append(f"octray {context['isa']}")
+    if context.get("width") and context.get("height"):
+        parts.append(f"{context['width']}×{context['height']}")
+    parts.append(f"{threads} thread{'s' if threads != 1 else ''}")
+    if context.get("reps"):
+        reps = f"{context['reps']} reps"
+        if context.get("min_time"):
+            reps += f" ≥ {context['min_time']:g} s each"
+        parts.append(reps)
+    if context.get("date"):
+        parts.append(str(context["date"]).replace("T", " ").replace("Z", " UTC"))
+    if "load_average" in context:
+        parts.append(f"load {context['load_average']:.2f}")
+    return " · ".join(parts)
 
 
-def mrays_chart(plt, rows):
-    """Grouped bars: octray's and Embree's best Mrays/s per scene and ray kind."""
+def spread_of(row):
+    """(below, above) the median for a min-max bar, or None without the figures."""
+    lo, hi = row.get("mrays_min"), row.get("mrays_max")
+    if not isinstance(lo, (int, float)) or not isinstance(hi, (int, float)):
+        return None
+    mid = row["mrays_median"]
+    return max(0.0, mid - lo), max(0.0, hi - mid)
+
+
+def mrays_chart(plt, rows, context=None):
+    """A panel per ray kind: octray's and Embree's best Mrays/s per scene, min-max bars,
+    octray / Embree above each pair (losses in red)."""
+    context = context or {}
     threads = max(r["threads"] for r in rows)
     at = [r for r in rows if r["threads"] == threads]
     top = best(at, lambda r: (r["scene"], r["ray_kind"], r["system"]))
-    groups = groups_of(at)
+    scenes = ordered(r["scene"] for r in at)
+    kinds = ordered((r["ray_kind"] for r in at), RAY_KINDS)
     systems = [s for s in ("octray", "embree") if any(k[2] == s for k in top)]
-    fig, axis = plt.subplots(figsize=(max(6.0, 0.9 * len(groups) + 2), 4.2))
+    columns = 1 if len(kinds) == 1 else 2 if len(kinds) <= 4 else 3
+    panel_rows = math.ceil(len(kinds) / columns)
+    panel_width = max(3.6, 0.95 * len(scenes) + 1.2)
+    fig, axes = plt.subplots(panel_rows, columns,
+                             figsize=(panel_width * columns, 2.9 * panel_rows + 1.1),
+                             squeeze=False)
     width = 0.8 / len(systems)
-    values = []
-    for n, system in enumerate(systems):
-        xs, ys = [], []
-        for g, (scene, kind) in enumerate(groups):
-            row = top.get((scene, kind, system))
-            if row:
+    # Scene names side by side at 7.5 pt take about 0.06 in a character: turned when the
+    # longest would reach its neighbours.
+    pitch = (panel_width - 1.2) / max(1, len(scenes))
+    rotate = max(len(s) for s in scenes) * 0.06 > 0.85 * pitch
+    losses = 0
+    for index, kind in enumerate(kinds):
+        axis = axes[index // columns][index % columns]
+        values = []
+        for n, system in enumerate(systems):
+            xs, ys, errors = [], [], [[], []]
+            for g, scene in enumerate(scenes):
+                row = top.get((scene, kind, system))
+                if not row:
+                    continue
                 xs.append(g + (n - (len(systems) - 1) / 2) * width)
                 ys.append(row["mrays_median"])
-        color = OCTRAY_COLOR if system == "octray" else EMBREE_COLOR
-        name = "octray" if system == "octray" else "Embree 3 (best configuration)"
-        bars = axis.bar(xs, ys, width, label=name, color=color)
-        values += ys
-        if system == "octray" and "embree" in systems:
-            ratios = []
-            for scene, kind in groups:
+                spread = spread_of(row) or (0.0, 0.0)
+                errors[0].append(spread[0])
+                errors[1].append(spread[1])
+                values += [row["mrays_median"] - spread[0], row["mrays_median"] + spread[1]]
+            color = OCTRAY_COLOR if system == "octray" else EMBREE_COLOR
+            name = "octray" if system == "octray" else "Embree 3 (best configuration)"
+            axis.bar(xs, ys, width, label=name, color=color, yerr=errors,
+                     error_kw={"elinewidth": 0.8, "capsize": 2, "ecolor": "#333333"})
+        if len(systems) == 2:
+            for g, scene in enumerate(scenes):
                 o, e = top.get((scene, kind, "octray")), top.get((scene, kind, "embree"))
-                if o and e and e["mrays_median"] > 0:
-                    ratios.append(f"{o['mrays_median'] / e['mrays_median']:.2f}×")
-                elif o:
-                    ratios.append("")
-            label_bars(axis, bars, ratios)
-    axis.set_xticks(range(len(groups)))
-    axis.set_xticklabels([f"{s}\n{k}" for s, k in groups], fontsize=8)
-    axis.set_ylabel("Mrays/s (median of the repetitions)")
-    use_log_scale(axis, values)
-    title = f"Rays per second, {threads} thread{'s' if threads != 1 else ''}"
-    if "embree" in systems:
-        title += " (labels: octray / Embree)"
-    axis.set_title(title)
-    axis.legend(fontsize=8)
-    axis.grid(axis="y", alpha=0.3)
-    fig.tight_layout()
+                if not (o and e and e["mrays_median"] > 0):
+                    continue
+                ratio = o["mrays_median"] / e["mrays_median"]
+                loss = ratio < 1.0
+                losses += loss
+                unsteady = o.get("steady") is False or e.get("steady") is False
+                text = f"{ratio:.2f}×" + ("~" if unsteady else "") + (" loss" if loss else "")
+                peak = max(o["mrays_median"] + (spread_of(o) or (0, 0))[1],
+                           e["mrays_median"] + (spread_of(e) or (0, 0))[1])
+                axis.annotate(text, (g, peak), xytext=(0, 3), textcoords="offset points",
+                              ha="center", va="bottom", fontsize=7,
+                              color=LOSS_COLOR if loss else "black",
+                              fontweight="bold" if loss else "normal")
+        axis.set_title(KIND_TITLES.get(kind, kind), fontsize=9)
+        axis.set_xticks(range(len(scenes)))
+        axis.set_xticklabels(scenes, fontsize=7.5, rotation=20 if rotate else 0,
+                             ha="right" if rotate else "center")
+        axis.set_xlim(-0.6, len(scenes) - 0.4)
+        use_log_scale(axis, [v for v in values if v > 0])
+        if axis.get_yscale() == "linear":
+            axis.set_ylim(0, max(values or [1]) * 1.18)
+        else:
+            axis.set_ylim(top=max(values or [1]) * 2.0)
+        axis.grid(axis="y", alpha=0.3)
+        axis.tick_params(axis="y", labelsize=7)
+        if index % columns == 0:
+            axis.set_ylabel("Mrays/s", fontsize=8)
+    for index in range(len(kinds), panel_rows * columns):
+        axes[index // columns][index % columns].axis("off")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    title = "Rays per second: octray against Embree"
+    if len(systems) == 1:
+        title = "Rays per second: octray"
+    fig.suptitle(title, fontsize=11, y=0.995)
+    fig.text(0.5, 1.0 - 0.36 / fig.get_figheight(), subtitle(context, threads), ha="center",
+             va="top", fontsize=7.5, color="#444444")
+    note = "bars: median of the repetitions, whiskers: min to max"
+    if len(systems) == 2:
+        note += ("; above each pair: octray / Embree" + ("\n" if fig.get_figwidth() < 9 else
+                                                         " ") +
+                 "(red: a loss; ~: a row's repetitions spread past the bound)")
+    # The legend, then the note below it: their own strip under the panels.
+    bottom = (0.75 if "\n" in note else 0.6) / fig.get_figheight()
+    fig.legend(handles, labels, loc="lower left", bbox_to_anchor=(0.0, bottom - 0.3 /
+                                                                  fig.get_figheight()),
+               fontsize=7.5, ncol=2, frameon=False)
+    fig.text(0.01, 0.01, note, ha="left", va="bottom", fontsize=6.5, color="#444444")
+    fig.tight_layout(rect=(0, bottom, 1, 1.0 - 0.45 / fig.get_figheight()))
     return fig
 
 
@@ -238,7 +332,7 @@ def isa_chart(plt, rows):
         axis.bar(xs, ys, width, label=isa, color=ISA_COLORS[n % len(ISA_COLORS)])
         values += ys
     axis.set_xticks(range(len(groups)))
-    axis.set_xticklabels([f"{s}\n{k}" for s, k in groups], fontsize=8)
+    axis.set_xticklabels([f"{s}\n{KIND_SHORT.get(k, k)}" for s, k in groups], fontsize=8)
     axis.set_ylabel("Mrays/s")
     use_log_scale(axis, values)
     axis.set_title(f"octray by instruction set, {threads} thread{'s' if threads != 1 else ''}")
@@ -276,9 +370,11 @@ def main(argv):
     args = parser.parse_args(argv)
 
     try:
-        rows = []
+        rows, contexts = [], []
         for path in args.files:
-            rows += load_rows(path)
+            file_rows, context = load_report(path)
+            rows += file_rows
+            contexts.append(context)
     except InputError as e:
         print(f"plot.py: error: {e}", file=sys.stderr)
         return 1
@@ -302,7 +398,7 @@ def main(argv):
     matplotlib.rcParams["svg.fonttype"] = "none"  # text stays text: searchable, smaller
     import matplotlib.pyplot as plt
 
-    charts = [("mrays", mrays_chart(plt, valid))]
+    charts = [("mrays", mrays_chart(plt, valid, contexts[0]))]
     if len({r["threads"] for r in valid}) > 1:
         charts.append(("scaling", scaling_chart(plt, valid)))
     if len({r["isa"] for r in valid if r["system"] == "octray"}) > 1:

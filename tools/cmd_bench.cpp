@@ -2,6 +2,7 @@
 // Thin: parse, call bench/bench_runner.h, report.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -34,6 +35,8 @@ struct BenchArguments {
     std::vector<std::uint32_t> packet_lanes;
     std::vector<int> threads;  // a scaling sweep; empty: every core
     int reps = 5, warmup = 1, width = 1920, height = 1080;
+    double min_time = bench::BenchOptions::kDefaultMinTime;
+    double max_spread = bench::BenchOptions::kDefaultMaxSpread;
     std::uint32_t validate_rays = 1u << 16;
     bool no_embree = false;
     std::string json;
@@ -58,6 +61,13 @@ std::string command_line(const BenchArguments& a) {
     }
     c += " --reps " + std::to_string(a.reps);
     if (a.warmup != 1) c += " --warmup " + std::to_string(a.warmup);
+    char number[64];
+    std::snprintf(number, sizeof number, "%g", a.min_time);
+    c += std::string(" --min-time ") + number;
+    if (a.max_spread != bench::BenchOptions::kDefaultMaxSpread) {
+        std::snprintf(number, sizeof number, "%g", a.max_spread);
+        c += std::string(" --max-spread ") + number;
+    }
     c += " --width " + std::to_string(a.width) + " --height " + std::to_string(a.height);
     if (!a.tiles.empty()) c += " --tile " + join(a.tiles);
     if (!a.orders.empty()) c += " --order " + join(a.orders);
@@ -97,7 +107,7 @@ void write_csv_file(const bench::BenchReport& report, const std::string& path) {
     std::string text =
         "scene,ray_kind,system,mode,isa,accel,packet_min_lanes,order,tile,threads,rays,"
         "mrays_median,mrays_min,mrays_max,seconds_median,frames_per_second,hit_fraction,"
-        "ratio_octray_over_embree,valid\n";
+        "ratio_octray_over_embree,valid,spread,steady,build_quality\n";
     for (const bench::BenchRow& r : report.rows) {
         const std::vector<std::string> fields = {
             r.scene,
@@ -115,10 +125,13 @@ void write_csv_file(const bench::BenchReport& report, const std::string& path) {
             csv_number(r.timing.mrays_min),
             csv_number(r.timing.mrays_max),
             csv_number(r.timing.seconds_median),
-            r.workload == bench::Workload::whitted ? csv_number(r.frames_per_second) : "",
+            bench::whole_frame(r.workload) ? csv_number(r.frames_per_second) : "",
             std::isnan(r.hit_fraction) ? "" : csv_number(r.hit_fraction),
             r.ratio ? csv_number(*r.ratio) : "",
-            r.valid ? "true" : "false"};
+            r.valid ? "true" : "false",
+            csv_number(r.timing.spread),
+            r.steady ? "true" : "false",
+            r.build_quality == "-" ? "" : r.build_quality};
         std::string line;
         for (const std::string& f : fields) line += (line.empty() ? "" : ",") + csv_field(f);
         text += line + "\n";
@@ -151,8 +164,16 @@ void run_bench_command(const BenchArguments& a) {
     if (a.threads.empty()) check_threads_can_start(0);
     bench::BenchOptions o;
     if (!a.scenes.empty()) o.scenes = a.scenes;
-    o.workloads =
-        parse_list<bench::Workload>(a.rays, "--rays", bench::parse_workload, o.workloads);
+    if (!a.rays.empty()) {
+        o.workloads.clear();
+        for (const std::string& word : a.rays) {
+            const std::vector<bench::Workload> ws = bench::parse_workloads(word);
+            if (ws.empty()) throw UsageError("--rays: unknown value '" + word + "'");
+            for (bench::Workload w : ws)
+                if (std::find(o.workloads.begin(), o.workloads.end(), w) == o.workloads.end())
+                    o.workloads.push_back(w);
+        }
+    }
     o.tiles = parse_list<TileSize>(
         a.tiles, "--tile", [](std::string_view s) { return parse_tile_size(s); }, o.tiles);
     o.orders =
@@ -170,6 +191,8 @@ void run_bench_command(const BenchArguments& a) {
                              ": this CPU does not support it");
     o.reps = a.reps;
     o.warmup = a.warmup;
+    o.min_time = a.min_time;
+    o.max_spread = a.max_spread;
     o.width = a.width;
     o.height = a.height;
     o.validate_rays = a.validate_rays;
@@ -191,9 +214,23 @@ void run_bench_command(const BenchArguments& a) {
             report = std::move(part);
         } else {
             report.rows.insert(report.rows.end(), part.rows.begin(), part.rows.end());
+            report.context.wall_seconds += part.context.wall_seconds;
+            report.context.timed_seconds += part.context.timed_seconds;
+            report.context.validation_seconds += part.context.validation_seconds;
         }
     }
     bench::compute_ratios(report.rows);
+    const bench::BenchContext& c = report.context;
+    std::size_t unsteady = 0;
+    for (const bench::BenchRow& r : report.rows) unsteady += r.steady ? 0 : 1;
+    std::cerr << "octray bench: " << report.rows.size() << " rows in "
+              << bench::format_duration(c.wall_seconds) << ": timed "
+              << bench::format_duration(c.timed_seconds) << ", validation "
+              << bench::format_duration(c.validation_seconds) << ", setup and the rest "
+              << bench::format_duration(
+                     std::max(0.0, c.wall_seconds - c.timed_seconds - c.validation_seconds))
+              << "; " << unsteady << " unsteady (max/min of the repetitions past "
+              << a.max_spread << ")\n";
     std::cout << '\n';
     bench::print_table(report, std::cout);
     if (!a.json.empty()) {
@@ -209,6 +246,14 @@ void run_bench_command(const BenchArguments& a) {
 // Limits of bench's own integer options (the shared ones are in cli_checks.h).
 constexpr std::uint64_t kMaxPacketLanes = 9;  // 8 lanes: 9 means no packet is traced
 constexpr std::uint64_t kMaxValidateRays = std::numeric_limits<std::uint32_t>::max();
+constexpr double kMaxMinTime = 3600.0;  // an hour per repetition
+constexpr double kMaxSpreadLimit = 1000.0;
+
+std::string detail_number(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
 
 }  // namespace
 
@@ -223,8 +268,9 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         ->type_name("SCENE...")
         ->check(completes(builtin_scene_words()));
     cmd->add_option("--rays", a->rays,
-                    "Workloads: primary,shadow,secondary (ray sets), whitted (whole renders) "
-                    "[default: all]")
+                    "Workloads: primary,shadow,secondary (ray sets); still (scene made ready + "
+                    "first frame), frame (a frame of a scene made ready before), whitted (both "
+                    "whole-frame kinds) [default: all]")
         ->delimiter(',')
         ->type_name("LIST");
     cmd->add_option("--threads", a->threads,
@@ -243,6 +289,21 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                         "; 0 for none (the hits of the last timed run are validated) "
                         "[default: 1]")
         ->transform(decimal_integer(0, kNoIntegerLimit));
+    cmd->add_option("--min-time", a->min_time,
+                    "Seconds each timed repetition lasts at least: its ray set or frame is run "
+                    "again until then, and the repetition counts their mean, " +
+                        real_range_text(0.0, kMaxMinTime, false) +
+                        "; 0 for one run [default: " +
+                        detail_number(bench::BenchOptions::kDefaultMinTime) + "]")
+        ->type_name("SECONDS")
+        ->transform(real_number(0.0, kMaxMinTime, false));
+    cmd->add_option("--max-spread", a->max_spread,
+                    "A row whose slowest repetition took more than this many times its "
+                    "fastest is marked unsteady, " +
+                        real_range_text(1.0, kMaxSpreadLimit, false) + " [default: " +
+                        detail_number(bench::BenchOptions::kDefaultMaxSpread) + "]")
+        ->type_name("X")
+        ->transform(real_number(1.0, kMaxSpreadLimit, false));
     cmd->add_option("--width", a->width,
                     "Frame width, " + integer_range_text(1, kMaxImageSide) + " [default: 1920]")
         ->transform(decimal_integer(1, kMaxImageSide));

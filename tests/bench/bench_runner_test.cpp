@@ -25,6 +25,34 @@ TEST(Summarize, MedianMinMaxOverRepetitions) {
     EXPECT_DOUBLE_EQ(t.mrays_max, 1.0);
     EXPECT_DOUBLE_EQ(summarize({1.0, 3.0}, 1000000).seconds_median, 2.0);
     EXPECT_DOUBLE_EQ(summarize({}, 10).mrays_median, 0.0);
+    // The spread: the slowest repetition over the fastest.
+    EXPECT_DOUBLE_EQ(t.spread, 4.0);
+    EXPECT_DOUBLE_EQ(summarize({2.0}, 10).spread, 1.0);
+}
+
+// Issue 42: each timed repetition repeats its run until the seconds its runs count reach
+// the minimum time, and counts their mean (a run here "takes" 3 ms: it only says so, so
+// nothing depends on this machine's speed).
+TEST(RepeatTimed, EachRepetitionRunsUntilTheMinimumTime) {
+    BenchOptions o;
+    o.warmup = 2;
+    o.reps = 3;
+    o.min_time = 0.010;
+    int calls = 0;
+    const auto run = [&calls] {
+        ++calls;
+        return 0.003;
+    };
+    const Repetitions reps = repeat_timed(run, o);
+    EXPECT_EQ(reps.runs, (std::vector<std::uint32_t>{4, 4, 4}));  // 4 x 3 ms >= 10 ms
+    ASSERT_EQ(reps.seconds.size(), 3u);
+    for (double s : reps.seconds) EXPECT_DOUBLE_EQ(s, 0.003);
+    EXPECT_EQ(calls, 2 + 3 * 4);  // the warm-up runs are single runs
+
+    o.min_time = 0.0;  // one run per repetition
+    calls = 0;
+    EXPECT_EQ(repeat_timed(run, o).runs, (std::vector<std::uint32_t>{1, 1, 1}));
+    EXPECT_EQ(calls, 2 + 3);
 }
 
 BenchRow row(std::string system, Workload w, double mrays, bool valid = true) {
@@ -64,6 +92,7 @@ BenchReport small_run() {
     o.validate_width = 48;
     o.validate_height = 24;
     o.paths = {RenderPath::simd, RenderPath::scalar};
+    o.min_time = 0.002;
     o.command_line = "test";
     return run_bench(o);
 }
@@ -100,22 +129,31 @@ TEST(Report, JsonHasTheContextAndRowsSchema) {
         EXPECT_LE(r["mrays_median"].get<double>(), r["mrays_max"].get<double>());
         EXPECT_TRUE(r.at("valid").get<bool>()) << r.at("validation");
         EXPECT_EQ(r.at("seconds").size(), 2u);
+        // Each repetition's runs, and the spread of the repetitions against the bound.
+        ASSERT_EQ(r.at("runs").size(), 2u);
+        for (const auto& n : r["runs"]) EXPECT_GE(n.get<int>(), 1);
+        EXPECT_GE(r.at("spread").get<double>(), 1.0);
+        EXPECT_EQ(r.at("steady").get<bool>(),
+                  r["spread"].get<double>() <= c.at("max_spread").get<double>());
         EXPECT_TRUE(r.at("counts").is_object());
         kinds.insert(r["ray_kind"].get<std::string>());
         systems.insert(r["system"].get<std::string>());
         modes.insert(r["mode"].get<std::string>());
-        if (r["ray_kind"] == "whitted") {
+        EXPECT_EQ(r.at("whole_frame").get<bool>(),
+                  r["ray_kind"] == "still" || r["ray_kind"] == "frame");
+        if (r["whole_frame"].get<bool>()) {
             EXPECT_GT(r.at("frames_per_second").get<double>(), 0.0);
             EXPECT_EQ(r["counts"]["primary"].get<int>(), 48 * 24);
         }
     }
-    EXPECT_EQ(kinds, (std::set<std::string>{"primary", "shadow", "secondary", "whitted"}));
+    EXPECT_EQ(kinds,
+              (std::set<std::string>{"primary", "shadow", "secondary", "still", "frame"}));
     EXPECT_TRUE(modes.count("packet8") && modes.count("single"));
     EXPECT_EQ(systems.count("embree") == 1, embree_compiled());
     if (embree_compiled()) {
         // Every octray ray-set row has its ratio against Embree.
         for (const nlohmann::json& r : rows) {
-            if (r["system"] == "octray" && r["ray_kind"] != "whitted") {
+            if (r["system"] == "octray" && !r["whole_frame"].get<bool>()) {
                 EXPECT_TRUE(r.at("ratio_octray_over_embree").is_number());
             }
         }
@@ -132,6 +170,103 @@ TEST(Report, JsonHasTheContextAndRowsSchema) {
     print_table(report, table);
     EXPECT_NE(table.str().find("random:16"), std::string::npos);
     EXPECT_NE(table.str().find("octray"), std::string::npos);
+}
+
+// Issue 42: a row whose repetitions spread past the bound is marked unsteady in the table
+// (its spread with "~", "yes, unsteady", "~" after a headline figure it holds), and a
+// headline ratio below 1 is marked LOSS.
+TEST(Report, UnsteadyRowsAndLossesAreMarkedInTheTable) {
+    BenchReport report;
+    BenchOptions o;
+    const auto add = [&](const char* system, std::vector<double> seconds) {
+        BenchRow r;
+        r.scene = "s";
+        r.system = system;
+        r.mode = "packet16";
+        r.isa = "x";
+        r.order = "tiled";
+        r.tile = "16x16";
+        r.threads = 2;
+        r.rays = 1000000;
+        r.seconds = std::move(seconds);
+        r.runs.assign(r.seconds.size(), 3);
+        r.timing = summarize(r.seconds, r.rays);
+        r.steady = r.timing.spread <= o.max_spread;
+        r.valid = true;
+        report.rows.push_back(r);
+    };
+    add("octray", {1.0, 1.5, 1.1});    // spread 1.5: unsteady; 0.91 Mrays/s
+    add("embree", {0.5, 0.51, 0.52});  // steady; 1.96 Mrays/s: octray loses
+    EXPECT_FALSE(report.rows[0].steady);
+    EXPECT_TRUE(report.rows[1].steady);
+    compute_ratios(report.rows);
+    std::ostringstream out;
+    print_table(report, out);
+    const std::string table = out.str();
+    EXPECT_NE(table.find("1.50~"), std::string::npos) << table;
+    EXPECT_NE(table.find("yes, unsteady"), std::string::npos) << table;
+    EXPECT_NE(table.find("0.91~"), std::string::npos) << table;       // the headline's octray
+    EXPECT_NE(table.find("0.464 LOSS"), std::string::npos) << table;  // 0.91 / 1.96
+    const nlohmann::json j = nlohmann::json::parse(report_json(report));
+    EXPECT_FALSE(j["rows"][0]["steady"].get<bool>());
+    EXPECT_DOUBLE_EQ(j["rows"][0]["spread"].get<double>(), 1.5);
+    EXPECT_EQ(j["rows"][0]["runs"], nlohmann::json::array({3, 3, 3}));
+}
+
+// Issue 42: the run says where its time went: the timed repetitions and the validation
+// apart, both within the wall clock.
+TEST(Report, TimedAndValidationSecondsAreAccountedApart) {
+    const BenchReport report = small_run();
+    const BenchContext& c = report.context;
+    EXPECT_GT(c.timed_seconds, 0.0);
+    EXPECT_GT(c.validation_seconds, 0.0);
+    EXPECT_LE(c.timed_seconds + c.validation_seconds, c.wall_seconds);
+    std::ostringstream table;
+    print_table(report, table);
+    EXPECT_NE(table.str().find("time: "), std::string::npos) << table.str();
+    EXPECT_NE(table.str().find(", validation "), std::string::npos) << table.str();
+}
+
+// Issue 42: whole frames both ways for both systems. A still (octray: compile, BVH and
+// first frame; Embree: the same compile, its build at its faster quality, LOW or MEDIUM,
+// and the frame) and a frame of a prepared scene (octray: a PreparedScene; Embree: its
+// HIGH build made before), every row validated against the reference render.
+TEST(Report, WholeFramesAreMeasuredAsStillsAndAsPreparedFramesForBothSystems) {
+    const BenchReport report = small_run();
+    std::set<std::pair<std::string, std::string>> seen;  // (system, kind)
+    for (const BenchRow& r : report.rows) {
+        if (!whole_frame(r.workload)) continue;
+        seen.insert({r.system, workload_name(r.workload)});
+        EXPECT_TRUE(r.valid) << r.validation;
+        if (r.system == "embree" && r.workload == Workload::still) {
+            EXPECT_EQ(r.build_quality, report.scenes[0].embree_still_quality);
+        } else {
+            EXPECT_EQ(r.build_quality, "-");
+        }
+        if (r.system == "octray" && r.isa != "scalar") {
+            EXPECT_NE(r.validation.find(r.workload == Workload::frame ? "prepared-scene"
+                                                                      : "packet image"),
+                      std::string::npos)
+                << r.validation;
+        }
+    }
+    EXPECT_TRUE(seen.count({"octray", "still"}));
+    EXPECT_TRUE(seen.count({"octray", "frame"}));
+    EXPECT_EQ(seen.count({"embree", "still"}) == 1, embree_compiled());
+    EXPECT_EQ(seen.count({"embree", "frame"}) == 1, embree_compiled());
+    const SceneInfo& scene = report.scenes[0];
+    if (embree_compiled()) {
+        ASSERT_TRUE(scene.embree_build_low_ms && scene.embree_build_medium_ms);
+        // The faster of the two, as measured.
+        EXPECT_EQ(
+            scene.embree_still_quality,
+            *scene.embree_build_low_ms <= *scene.embree_build_medium_ms ? "low" : "medium");
+    }
+    // --rays whitted asks for both kinds.
+    EXPECT_EQ(parse_workloads("whitted"),
+              (std::vector<Workload>{Workload::still, Workload::frame}));
+    EXPECT_EQ(parse_workloads("frame"), (std::vector<Workload>{Workload::frame}));
+    EXPECT_TRUE(parse_workloads("sideways").empty());
 }
 
 }  // namespace

@@ -120,6 +120,42 @@ TEST_P(EmbreeAgreement, WholeFramesMatchTheReference) {
 #endif
 }
 
+// Issue 42: the still rows charge Embree a BVH build per frame at LOW or MEDIUM quality
+// (EmbreeScene::rebuild). A rebuild must really build (the spheres' bounds are asked for
+// again) and leave a scene that traces as the first build did, at every quality.
+TEST_P(EmbreeAgreement, RebuildBuildsAgainAndTracesTheSame) {
+#if !OCTRAY_HAVE_EMBREE
+    GTEST_SKIP() << "Embree 3 was not found by CMake (or OCTRAY_WITH_EMBREE is OFF)";
+#else
+    const Scene scene = load_scene(std::string(GetParam()) + ",width=64,height=48");
+    const CompiledScene compiled = compile_scene(scene);
+    const ReferenceTracer tracer(scene);
+    const RaySet rays =
+        make_primary_rays(tracer, 64, 48, pixel_order(64, 48, PixelOrder::tiled));
+    for (EmbreeBuildQuality quality :
+         {EmbreeBuildQuality::low, EmbreeBuildQuality::medium, EmbreeBuildQuality::high}) {
+        SCOPED_TRACE(embree_build_quality_name(quality));
+        EmbreeScene embree(scene, compiled, 1, EmbreeGeometry::user, quality);
+        EXPECT_EQ(embree.build_quality(), quality);
+        EXPECT_EQ(embree.sphere_builds(), 1u);
+        HitSet before, after;
+        before.resize(static_cast<std::uint32_t>(rays.ox.size()));
+        after.resize(static_cast<std::uint32_t>(rays.ox.size()));
+        embree.intersect(EmbreeMode::packet16, rays, 0, rays.count, before, true);
+        EXPECT_GE(embree.rebuild(), 0.0);
+        EXPECT_GE(embree.rebuild(), 0.0);
+        EXPECT_EQ(embree.sphere_builds(), 3u);
+        embree.intersect(EmbreeMode::packet16, rays, 0, rays.count, after, true);
+        for (std::uint32_t i = 0; i < rays.count; ++i) {
+            ASSERT_EQ(before.object[i], after.object[i]) << "ray " << i;
+            if (before.hit(i)) {
+                ASSERT_EQ(before.t[i], after.t[i]) << "ray " << i;
+            }
+        }
+    }
+#endif
+}
+
 INSTANTIATE_TEST_SUITE_P(DefaultScenes, EmbreeAgreement,
                          ::testing::Values("whitted", "random:16", "random:1024",
                                            "sphereflake:4"),

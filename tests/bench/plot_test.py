@@ -25,6 +25,17 @@ def plot(*args):
                           timeout=120)
 
 
+def load_plot_module():
+    """bench/plot.py as a module, to look at its figures before they are files."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("octray_plot", PLOT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    import matplotlib
+    matplotlib.use("Agg")
+    return module
+
+
 def png_size(path):
     with open(path, "rb") as f:
         head = f.read(24)
@@ -75,6 +86,63 @@ class PlotTest(unittest.TestCase):
             svg = f.read()
         for word in ("sse2", "avx2"):
             self.assertIn(word, svg)
+
+    # Issue 42: a chart readable at a glance: a panel per ray kind (titled by what it
+    # measures, not "whitted whitted"), scene labels that do not overlap, a subtitle that
+    # says where and how it was measured, min-max bars, losses marked.
+    def synthetic_report(self):
+        """Five long scene names, every ray kind, one loss, one unsteady row."""
+        report = self.fixture()
+        template = next(r for r in report["rows"] if r["system"] == "octray")
+        rows = []
+        scenes = ["whitted", "random:1024", "random:65536", "random:1048576", "sphereflake:5"]
+        for n, scene in enumerate(scenes):
+            for kind in ("primary", "shadow", "secondary", "still", "frame"):
+                for system, rate in (("octray", 100.0 + n), ("embree", 50.0 + n)):
+                    if scene == "random:65536" and kind == "secondary" and system == "embree":
+                        rate = 150.0  # a loss
+                    row = dict(template, scene=scene, ray_kind=kind, system=system,
+                               threads=2, mrays_median=rate, mrays_min=0.9 * rate,
+                               mrays_max=1.1 * rate, valid=True,
+                               steady=not (scene == "whitted" and kind == "primary"))
+                    rows.append(row)
+        report["rows"] = rows
+        return report
+
+    def test_panels_labels_subtitle_spread_and_losses(self):
+        plot_module = load_plot_module()
+        import matplotlib.pyplot as plt
+        report = self.synthetic_report()
+        fig = plot_module.mrays_chart(plt, report["rows"], report["context"])
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        panels = [a for a in fig.axes if a.axison]
+        self.assertEqual(len(panels), 5)
+        titles = [a.get_title() for a in panels]
+        self.assertEqual(titles, [plot_module.KIND_TITLES[k] for k in
+                                  ("primary", "shadow", "secondary", "still", "frame")])
+        for axis in panels:
+            labels = [t for t in axis.get_xticklabels() if t.get_text()]
+            self.assertEqual([t.get_text() for t in labels][:2], ["whitted", "random:1024"])
+            boxes = [t.get_window_extent(renderer) for t in labels]
+            for a, b in zip(boxes, boxes[1:]):
+                self.assertFalse(a.overlaps(b), f"{axis.get_title()}: scene labels overlap")
+            # Every bar pair has its min-max whiskers.
+            bars = [c for c in axis.containers if hasattr(c, "errorbar")]
+            self.assertEqual(len(bars), 2)
+            for c in bars:
+                self.assertIsNotNone(c.errorbar)
+        texts = [t.get_text() for t in fig.texts]
+        context = report["context"]
+        subtitle = next(t for t in texts if context["cpu"] in t)
+        for part in (context["isa"], f"{context['width']}×{context['height']}", "2 threads",
+                     f"{context['reps']} reps", context["date"][:10]):
+            self.assertIn(part, subtitle)
+        annotations = [c.get_text() for a in panels for c in a.texts]
+        losses = [t for t in annotations if t.endswith("loss")]
+        self.assertEqual(losses, ["0.68× loss"])  # 102 / 150
+        self.assertTrue(any(t.endswith("×~") for t in annotations), annotations)
+        plt.close(fig)
 
     def test_format_and_only_the_charts_the_data_calls_for(self):
         report = self.fixture()

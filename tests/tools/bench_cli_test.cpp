@@ -43,10 +43,11 @@ nlohmann::json read_json(const fs::path& path) {
 }
 
 TEST_F(BenchCliTest, JsonReportHasContextAndValidatedRowsForEveryRayKind) {
-    const auto r = run_octray({"bench", "random:16", "--width", "48", "--height", "32",
-                               "--reps", "2", "--warmup", "1", "--threads", "2", "--rays",
-                               "primary,shadow,secondary,whitted", "--json", "report.json"},
-                              dir_);
+    const auto r = run_octray(
+        {"bench", "random:16", "--width", "48", "--height", "32", "--reps", "2", "--warmup",
+         "1", "--threads", "2", "--rays", "primary,shadow,secondary,whitted", "--min-time",
+         "0.002", "--json", "report.json"},
+        dir_);
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_TRUE(contains(r.output, "Mrays/s") || contains(r.output, "mrays")) << r.output;
     const nlohmann::json report = read_json(dir_ / "report.json");
@@ -70,8 +71,11 @@ TEST_F(BenchCliTest, JsonReportHasContextAndValidatedRowsForEveryRayKind) {
         EXPECT_LE(lo, mid);
         EXPECT_LE(mid, hi);
     }
-    EXPECT_EQ(kinds, (std::set<std::string>{"primary", "shadow", "secondary", "whitted"}));
+    // --rays whitted: whole frames both ways, a still and a frame of a prepared scene.
+    EXPECT_EQ(kinds,
+              (std::set<std::string>{"primary", "shadow", "secondary", "still", "frame"}));
     EXPECT_TRUE(systems.count("octray"));
+    EXPECT_EQ(report["context"]["min_time"], 0.002);
     if (bench::embree_compiled()) {
         EXPECT_TRUE(systems.count("embree")) << "Embree was built in but has no rows";
     } else {
@@ -129,6 +133,37 @@ TEST_F(BenchCliTest, ThreadListIsAScalingSweepAndWarmupZeroIsAllowed) {
         }
     }
     EXPECT_EQ(threads, (std::set<int>{1, 2}));
+}
+
+// Issue 42: progress with an estimate of the time left while it runs, the total and where
+// it went at the end (stderr), the minimum time per repetition in the report and the
+// command, and bad values refused.
+TEST_F(BenchCliTest, ProgressTotalAndMinimumTime) {
+    const auto r = run_octray(
+        {"bench", "random:16", "--width", "32", "--height", "24", "--reps", "2", "--rays",
+         "primary,shadow", "--min-time", "0.001", "--max-spread", "1.5", "--json", "r.json"},
+        dir_);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, " left]")) << r.output;  // "[1/12 rows, 0.1 s, about..."
+    EXPECT_TRUE(contains(r.output, " rows, ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "rows in ")) << r.output;  // the total at the end
+    EXPECT_TRUE(contains(r.output, ", validation ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "--min-time 0.001 --max-spread 1.5")) << r.output;
+    const nlohmann::json report = read_json(dir_ / "r.json");
+    EXPECT_EQ(report["context"]["max_spread"], 1.5);
+    for (const char* key : {"wall_seconds", "timed_seconds", "validation_seconds"})
+        EXPECT_TRUE(report["context"].at(key).is_number()) << key;
+    for (const auto& row : report["rows"]) {
+        EXPECT_EQ(row.at("runs").size(), 2u) << row.dump(2);
+        EXPECT_EQ(row.at("steady").get<bool>(), row.at("spread").get<double>() <= 1.5);
+    }
+    for (const std::vector<std::string>& bad : {std::vector<std::string>{"--min-time", "-1"},
+                                                {"--min-time", "x"},
+                                                {"--max-spread", "0.5"}}) {
+        std::vector<std::string> command = {"bench", "--no-embree"};
+        command.insert(command.end(), bad.begin(), bad.end());
+        EXPECT_EQ(run_octray(command, dir_).status, 2) << bad[0] << " " << bad[1];
+    }
 }
 
 // Issue 26: range errors say what the option takes, not a 300-digit number or 2^31 - 1.
