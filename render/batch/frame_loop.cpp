@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <system_error>
@@ -113,7 +114,7 @@ struct PendingWrite {
     FrameFiles files;
     Image pixels;
     double seconds = 0.0;
-    std::exception_ptr error;
+    std::exception_ptr report_error;  // what reporting it threw, rethrown when joined
     std::thread writer;
 };
 
@@ -150,6 +151,7 @@ class BatchRunner {
     FrameFiles files(const BatchScene& scene, const BatchJob& job, const Scene& posed,
                      const RenderResult& result, const AovImages& aovs, int samples_so_far);
     void finish(const FrameResult& out, std::uint64_t work);
+    void write_behind(PendingWrite& p);
 
     const std::vector<BatchScene>& scenes_;
     const BatchSettings& settings_;
@@ -167,8 +169,10 @@ class BatchRunner {
     // (A pointer: g++ 12 takes an optional holding an optional for maybe-uninitialized.)
     std::unique_ptr<FrameRenderer> renderer_;
     std::size_t renderer_index_ = 0;
-    // The frame being written behind (settings_.write_behind), at most one.
+    // The frame being written behind (settings_.write_behind), at most one; its writer
+    // reports it, so the observer and the account are called under report_mutex_.
     std::unique_ptr<PendingWrite> pending_;
+    std::mutex report_mutex_;
 };
 
 }  // namespace
@@ -241,25 +245,45 @@ FrameFiles BatchRunner::files(const BatchScene& scene, const BatchJob& job, cons
 }
 
 void BatchRunner::finish(const FrameResult& out, std::uint64_t work) {
+    const std::lock_guard lock(report_mutex_);
     if (out.failure != FailureKind::interrupted) observer_.frame_finished(out.report, work);
     account_(out);
+}
+
+// On the writer's thread: writes the frame's files, then reports the frame at once (a
+// farm manager reading the lines sees every frame on disk, even when the run is killed
+// while the next frame renders).
+void BatchRunner::write_behind(PendingWrite& p) {
+    const auto write_started = Clock::now();
+    std::exception_ptr error;
+    try {
+        p.files.write(p.pixels);
+    } catch (...) {
+        error = std::current_exception();
+    }
+    FrameResult& out = p.result;
+    out.report.write_seconds +=
+        p.seconds + std::chrono::duration<double>(Clock::now() - write_started).count();
+    try {
+        if (error) {
+            record_failure(out, error);
+            if (!p.claimed.empty()) release_claim(p.claimed);
+        }
+        out.report.seconds = std::chrono::duration<double>(Clock::now() - p.started).count();
+        finish(out, p.work);
+    } catch (...) {
+        p.report_error = std::current_exception();
+    }
 }
 
 void BatchRunner::finish_pending() {
     if (!pending_) return;
     const std::unique_ptr<PendingWrite> p = std::move(pending_);
     p->writer.join();
-    FrameResult& out = p->result;
-    out.report.write_seconds += p->seconds;
-    if (p->error) {
-        record_failure(out, p->error);
-        if (!p->claimed.empty()) release_claim(p->claimed);
-    }
-    out.report.seconds = std::chrono::duration<double>(Clock::now() - p->started).count();
     // Its storage serves the frame after the next.
     spare_frame_ = std::move(p->pixels);
     spare_channels_ = std::move(p->files.exr.channels);
-    finish(out, p->work);
+    if (p->report_error) std::rethrow_exception(p->report_error);
 }
 
 bool BatchRunner::run(std::size_t index, const BatchJob& job) {
@@ -344,7 +368,10 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         }
         remove_stale_temporaries(job.output);
         if (!job.png.empty()) remove_stale_temporaries(job.png);
-        observer_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
+        {
+            const std::lock_guard lock(report_mutex_);  // the writer may be reporting
+            observer_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);
+        }
 
         // The frame posed and prepared (frame_renderer.h): a scene's first frame compiles
         // it and builds its BVH (simd path); a next frame of a still or camera-only
@@ -427,16 +454,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
             p->work = work;
             p->claimed = claimed;
             p->started = started;
-            p->writer = std::thread([w = p.get()] {
-                const auto write_started = Clock::now();
-                try {
-                    w->files.write(w->pixels);
-                } catch (...) {
-                    w->error = std::current_exception();
-                }
-                w->seconds +=
-                    std::chrono::duration<double>(Clock::now() - write_started).count();
-            });
+            p->writer = std::thread([this, w = p.get()] { write_behind(*w); });
             pending_ = std::move(p);
             return true;
         }

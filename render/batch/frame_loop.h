@@ -30,8 +30,8 @@ struct BatchSettings {
     bool placeholders = false;
     // Write behind: a frame's files are written while the next frame renders (at most one
     // frame in flight; its image and encoded channels are memory a run holds twice:
-    // RenderMemoryParams::write_behind). Its report comes once its files are on disk,
-    // which may be after the next frame started. Not for --progressive, whose passes are
+    // RenderMemoryParams::write_behind). The writer reports it once its files are on
+    // disk, which may be after the next frame started. Not for --progressive, whose passes are
     // written as they finish.
     bool write_behind = false;
 };
@@ -50,11 +50,12 @@ ExrAttributes render_exr_attributes(const BatchScene& scene, const Scene& posed,
 
 // Renders every job in order on at most settings.options.threads threads (0: every core)
 // and returns the summary. Each frame is reported to the observer once, in job order; with
-// settings.write_behind a frame's frame_finished may come after the next frame's
-// frame_started (its files were written while that one rendered). A frame that fails is
-// reported and the others go on. Once *cancel is set (a signal handler may set it), the frame
-// in progress is abandoned at its next tile, leaving nothing half-written and its claim
-// released, and no further frame starts; `cancel` may be nullptr.
+// settings.write_behind a frame is reported by the thread that wrote it, as soon as its
+// files are on disk, which may be while the next frame renders (after its frame_started;
+// the observer's calls never overlap). A frame that fails is reported and the others go
+// on. Once *cancel is set (a signal handler may set it), the frame in progress is
+// abandoned at its next tile, leaving nothing half-written and its claim released, and no
+// further frame starts; `cancel` may be nullptr.
 BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
                        const BatchSettings& settings, BatchObserver& observer,
                        const std::atomic<bool>* cancel);

@@ -404,6 +404,23 @@ TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBit
             << "frame " << f;
 }
 
+// The observer's events of `frames` frames: each started and finished once, every
+// frame's start before its finish, the finishes in frame order.
+void expect_reported_in_order(const std::vector<std::string>& events, std::size_t frames) {
+    ASSERT_EQ(events.size(), 2 * frames) << ::testing::PrintToString(events);
+    std::size_t next_finish = 1;
+    std::set<std::size_t> started;
+    for (const std::string& e : events) {
+        const std::size_t k = std::stoul(e.substr(e.find(' ') + 1));
+        if (e.rfind("start ", 0) == 0) {
+            EXPECT_TRUE(started.insert(k).second) << "started twice: " << e;
+        } else {
+            EXPECT_TRUE(started.count(k)) << "finished before it started: " << e;
+            EXPECT_EQ(k, next_finish++) << ::testing::PrintToString(events);
+        }
+    }
+}
+
 // Write behind (BatchSettings::write_behind): each frame's files are written while the
 // next frame renders. The frames are those written one by one (bit for bit the frame
 // rendered alone), each is reported once, in order, with its preview, and nothing else is
@@ -421,10 +438,9 @@ TEST_F(FrameLoopTest, WritingBehindGivesEveryFrameAsRenderedAloneReportedOnceInO
     const BatchSummary summary = run(observer);
     EXPECT_EQ(summary.rendered, 5u);
     EXPECT_FALSE(summary.io_failure || summary.internal_failure || summary.interrupted);
-    // Frame N is reported once its files are written, after frame N + 1 has rendered.
-    EXPECT_EQ(observer.events, (std::vector<std::string>{
-                                   "start 1", "start 2", "finish 1", "start 3", "finish 2",
-                                   "start 4", "finish 3", "start 5", "finish 4", "finish 5"}));
+    // Each frame is reported by its writer once its files are on disk: after its own
+    // start, in job order (while the next frame renders, or before it starts).
+    expect_reported_in_order(observer.events, 5);
     ASSERT_EQ(observer.started.size(), 5u);
     ASSERT_EQ(observer.finished.size(), 5u);
     std::set<std::string> expected;
@@ -472,9 +488,7 @@ TEST_F(FrameLoopTest, AWriteThatFailsWhileTheNextFrameRendersFailsThatFrameAlone
     setrlimit(RLIMIT_FSIZE, &before);
     std::signal(SIGXFSZ, previous_handler);
 
-    // The large frame's write failed while the last frame rendered.
-    EXPECT_EQ(observer.events, (std::vector<std::string>{"start 1", "start 2", "finish 1",
-                                                         "start 3", "finish 2", "finish 3"}));
+    expect_reported_in_order(observer.events, 3);
     ASSERT_EQ(observer.finished.size(), 3u);
     EXPECT_EQ(observer.finished[0].outcome, FrameOutcome::rendered);
     EXPECT_EQ(observer.finished[1].outcome, FrameOutcome::failed);
@@ -499,7 +513,7 @@ TEST_F(FrameLoopTest, CancelWhileAFrameIsWrittenBehindKeepsThatFrame) {
         if (frame == 1) cancel = true;
     };
     const BatchSummary summary = run(observer, &cancel);
-    EXPECT_EQ(observer.events, (std::vector<std::string>{"start 1", "start 2", "finish 1"}));
+    ASSERT_EQ(observer.started.size(), 2u);
     ASSERT_EQ(observer.finished.size(), 1u);
     EXPECT_EQ(observer.finished[0].frame, 0);
     EXPECT_EQ(observer.finished[0].outcome, FrameOutcome::rendered);
