@@ -7,8 +7,22 @@
 
 namespace octray::view {
 
-Image display_rgb(const ChannelImage& image) {
+namespace {
+
+// Channels `source` (red, green, blue) of `image` as a picture; black without channels.
+Image picture_of(const ChannelImage& image, const std::array<int, 3>& source) {
     Image rgb(image.width, image.height);
+    if (source[0] < 0) return rgb;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x)
+            rgb.at(x, y) = Rgb{image.at(source[0], x, y), image.at(source[1], x, y),
+                               image.at(source[2], x, y)};
+    return rgb;
+}
+
+}  // namespace
+
+Image display_rgb(const ChannelImage& image) {
     std::array<int, 3> source{image.find_channel("R"), image.find_channel("G"),
                               image.find_channel("B")};
     if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
@@ -16,14 +30,7 @@ Image display_rgb(const ChannelImage& image) {
         if (gray < 0) gray = image.channel_count() > 0 ? 0 : -1;
         source = {gray, gray, gray};
     }
-    if (source[0] < 0) return rgb;  // no channels: black
-    for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) {
-            rgb.at(x, y) = Rgb{image.at(source[0], x, y), image.at(source[1], x, y),
-                               image.at(source[2], x, y)};
-        }
-    }
-    return rgb;
+    return picture_of(image, source);
 }
 
 std::vector<std::string> display_layers(const ChannelImage& image) {
@@ -57,12 +64,7 @@ Image display_rgb(const ChannelImage& image, const std::string& layer) {
         if (gray < 0) throw std::invalid_argument("no layer \"" + layer + "\" in the image");
         source = {gray, gray, gray};
     }
-    Image rgb(image.width, image.height);
-    for (int y = 0; y < image.height; ++y)
-        for (int x = 0; x < image.width; ++x)
-            rgb.at(x, y) = Rgb{image.at(source[0], x, y), image.at(source[1], x, y),
-                               image.at(source[2], x, y)};
-    return rgb;
+    return picture_of(image, source);
 }
 
 CompareView load_compare_view(const std::string& path_a, const std::string& path_b,

@@ -150,6 +150,10 @@ class FrameLoopTest : public ::testing::Test {
         settings_.exr.float32 = true;
     }
 
+    // Frames 0 .. frames - 1 of the first scene, written as PREFIX.F.exr, are each the
+    // frame rendered on its own (pixels_unlike_alone), bit for bit.
+    void expect_frames_as_rendered_alone(const std::string& prefix, int frames) const;
+
     std::set<std::string> files() const {
         std::set<std::string> names;
         for (const auto& entry : fs::directory_iterator(dir_))
@@ -349,6 +353,15 @@ std::size_t pixels_unlike_alone(const Scene& scene, int frame, const fs::path& f
     return differ;
 }
 
+void FrameLoopTest::expect_frames_as_rendered_alone(const std::string& prefix,
+                                                    int frames) const {
+    for (int f = 0; f < frames; ++f)
+        EXPECT_EQ(pixels_unlike_alone(scenes_[0].scene, f,
+                                      dir_ / (prefix + "." + std::to_string(f) + ".exr")),
+                  0u)
+            << "frame " << f;
+}
+
 // Refit (frame_loop.cpp, PreparedScene::update): an animation of moving and growing
 // spheres is prepared for its first frame and updated in place for the next ones (no
 // compile); every frame is, bit for bit, the frame rendered on its own.
@@ -372,11 +385,7 @@ TEST_F(FrameLoopTest, AnAnimationOfMovingSpheresIsRefitAndEachFrameIsTheSameBits
         EXPECT_EQ(observer.finished[f].compile_seconds, 0.0) << "frame " << f;
         EXPECT_GT(observer.finished[f].prepare_seconds, 0.0) << "frame " << f;
     }
-    for (int f = 0; f < 4; ++f)
-        EXPECT_EQ(pixels_unlike_alone(scenes_[0].scene, f,
-                                      dir_ / ("m." + std::to_string(f) + ".exr")),
-                  0u)
-            << "frame " << f;
+    expect_frames_as_rendered_alone("m", 4);
 }
 
 // Prepare once (frame_loop.cpp): a camera-only animation on the simd path compiles the
@@ -397,11 +406,7 @@ TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBit
         EXPECT_EQ(observer.finished[f].prepare_seconds, 0.0) << "frame " << f;
         EXPECT_EQ(observer.finished[f].bvh_seconds, 0.0) << "frame " << f;
     }
-    for (int f = 0; f < 3; ++f)
-        EXPECT_EQ(pixels_unlike_alone(scenes_[0].scene, f,
-                                      dir_ / ("o." + std::to_string(f) + ".exr")),
-                  0u)
-            << "frame " << f;
+    expect_frames_as_rendered_alone("o", 3);
 }
 
 // The observer's events of `frames` frames: each started and finished once, every
@@ -451,11 +456,10 @@ TEST_F(FrameLoopTest, WritingBehindGivesEveryFrameAsRenderedAloneReportedOnceInO
         EXPECT_EQ(r.outcome, FrameOutcome::rendered);
         EXPECT_GT(r.write_seconds, 0.0) << "frame " << f;
         const std::string name = "b." + std::to_string(f);
-        EXPECT_EQ(pixels_unlike_alone(scenes_[0].scene, f, dir_ / (name + ".exr")), 0u)
-            << "frame " << f;
         expected.insert(name + ".exr");
         expected.insert(name + ".png");
     }
+    expect_frames_as_rendered_alone("b", 5);
     expected.insert("behind.json");
     EXPECT_EQ(files(), expected);
 }
