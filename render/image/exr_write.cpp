@@ -5,6 +5,7 @@
 #include <ImfDoubleAttribute.h>
 #include <ImfFloatAttribute.h>
 #include <ImfFrameBuffer.h>
+#include <ImfGenericOutputFile.h>
 #include <ImfHeader.h>
 #include <ImfIntAttribute.h>
 #include <ImfMatrixAttribute.h>
@@ -17,15 +18,24 @@
 #include <ImfThreading.h>
 #include <ImfVersion.h>
 #include <half.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
+#include "render/image/deflate.h"
 #include "render/image/half_bits.h"
 #include "render/image/image_io.h"
 
@@ -170,27 +180,264 @@ void check_exr_image(const ExrImage& image) {
     }
 }
 
-void write_exr_file(const std::string& path, const ExrImage& image) {
+Imf::Header make_header(const ExrImage& image) {
     // Line order INCREASING_Y: the file's first scan line is the top row.
     Imf::Header header(to_box(image.display_window), to_box(image.data_window));
     header.compression() = to_imf(image.compression);
     insert_attributes(header, image.attributes);
+    for (const ExrChannel& c : image.channels)
+        header.channels().insert(c.name, Imf::Channel(to_imf(c.type)));
+    return header;
+}
 
+// The other compressions: OpenEXR packs and compresses the chunks.
+void write_exr_with_openexr(const std::string& path, const ExrImage& image,
+                            const Imf::Header& header) {
     const Imath::Box2i window = to_box(image.data_window);
     const std::size_t width = static_cast<std::size_t>(image.data_window.width());
     Imf::FrameBuffer frame_buffer;
     for (const ExrChannel& c : image.channels) {
-        const Imf::PixelType type = to_imf(c.type);
-        header.channels().insert(c.name, Imf::Channel(type));
         // OpenEXR only reads through the frame buffer when writing.
         char* base = reinterpret_cast<char*>(const_cast<unsigned char*>(c.samples.data()));
         const std::size_t element = sample_size(c.type);
-        frame_buffer.insert(c.name,
-                            Imf::Slice::Make(type, base, window, element, element * width));
+        frame_buffer.insert(
+            c.name, Imf::Slice::Make(to_imf(c.type), base, window, element, element * width));
     }
     Imf::OutputFile file(path.c_str(), header);
     file.setFrameBuffer(frame_buffer);
     file.writePixels(image.data_window.height());
+}
+
+// ---- The chunks octray packs and compresses itself -------------------------------------
+//
+// Uncompressed, ZIPS and ZIP files, the ones octray writes by default, are written here:
+// OpenEXR 3.1 deflates each chunk with zlib on its thread pool, which cost more than the
+// trace of a 1280x720 frame; libdeflate makes the same zlib streams about 2.5 times as fast
+// at the size of zlib's level 4 (render/image/README.md, "Compression"). OpenEXR still
+// writes the magic number, version and header; the file reads back through any OpenEXR
+// reader (the tests read every compression back, and compare the uncompressed file with
+// OpenEXR's byte for byte).
+
+// libdeflate's level for ZIP and ZIPS chunks (see above).
+constexpr int kZipLevel = 1;
+
+bool packs_chunks_itself(ExrCompression compression) {
+    return compression == ExrCompression::none || compression == ExrCompression::zips ||
+           compression == ExrCompression::zip;
+}
+
+// The protected member of OpenEXR that writes a file's magic number and version field
+// (with the flag for long attribute or channel names).
+struct MagicAndVersion : Imf::GenericOutputFile {
+    void write(Imf::OStream& os, const Imf::Header& header) {
+        writeMagicNumberAndVersionField(os, header);
+    }
+};
+
+// OpenEXR stores the channels of a line sorted by name, byte by byte (its ChannelList is
+// ordered by strcmp), each line's samples of one channel together, little-endian.
+static_assert(std::endian::native == std::endian::little,
+              "the samples are copied as they lie in memory into a little-endian file");
+
+std::vector<const ExrChannel*> channels_in_file_order(const ExrImage& image) {
+    std::vector<const ExrChannel*> channels;
+    for (const ExrChannel& c : image.channels) channels.push_back(&c);
+    std::sort(channels.begin(), channels.end(),
+              [](const ExrChannel* a, const ExrChannel* b) { return a->name < b->name; });
+    return channels;
+}
+
+// Packs, and for ZIP and ZIPS compresses, one chunk of scan lines.
+class ChunkEncoder {
+  public:
+    ChunkEncoder(const ExrImage& image, int lines_per_chunk)
+        : channels_(channels_in_file_order(image)),
+          width_(static_cast<std::size_t>(image.data_window.width())),
+          height_(image.data_window.height()),
+          lines_per_chunk_(lines_per_chunk),
+          compression_(image.compression) {
+        for (const ExrChannel* c : channels_) line_bytes_ += width_ * sample_size(c->type);
+    }
+
+    int chunk_count() const { return (height_ + lines_per_chunk_ - 1) / lines_per_chunk_; }
+    int first_line(int chunk) const { return chunk * lines_per_chunk_; }
+    std::size_t raw_bytes(int chunk) const {
+        const int lines = std::min(lines_per_chunk_, height_ - first_line(chunk));
+        return static_cast<std::size_t>(lines) * line_bytes_;
+    }
+
+    // Chunk `chunk`'s data as the file stores it after its y and size: compressed when
+    // that makes it smaller, as OpenEXR's reader expects (it reads a chunk whose size is
+    // its raw size as raw).
+    void encode(int chunk, std::vector<unsigned char>& out) const {
+        const std::size_t raw = raw_bytes(chunk);
+        if (compression_ == ExrCompression::none) {
+            out.resize(raw);
+            pack(chunk, out.data());
+            return;
+        }
+        // OpenEXR's ZIP predictor: the chunk's bytes split into the even ones then the odd
+        // ones (the low and high bytes of the samples), then each byte replaced by its
+        // difference from the one before, plus 128. Every line of every channel holds an
+        // even number of bytes, so each is split on its own.
+        thread_local std::vector<unsigned char> split, predicted;
+        split.resize(raw);
+        predicted.resize(raw);
+        unsigned char* even = split.data();
+        unsigned char* odd = split.data() + raw / 2;
+        for_each_line(chunk, [&](const unsigned char* line, std::size_t bytes) {
+            const std::size_t pairs = bytes / 2;
+            for (std::size_t i = 0; i < pairs; ++i) {
+                even[i] = line[2 * i];
+                odd[i] = line[2 * i + 1];
+            }
+            even += pairs;
+            odd += pairs;
+        });
+        predicted[0] = split[0];
+        for (std::size_t i = 1; i < raw; ++i)
+            predicted[i] = static_cast<unsigned char>(split[i] - split[i - 1] + 128);
+        out.resize(raw);
+        const std::size_t size =
+            detail::zlib_compress(kZipLevel, predicted.data(), raw, out.data(), raw - 1);
+        if (size != 0) {
+            out.resize(size);
+        } else {
+            pack(chunk, out.data());  // it does not compress: stored raw
+        }
+    }
+
+  private:
+    template <class Visit>
+    void for_each_line(int chunk, Visit&& visit) const {
+        const int y0 = first_line(chunk);
+        const int y1 = std::min(height_, y0 + lines_per_chunk_);
+        for (int y = y0; y < y1; ++y)
+            for (const ExrChannel* c : channels_) {
+                const std::size_t bytes = width_ * sample_size(c->type);
+                visit(c->samples.data() + static_cast<std::size_t>(y) * bytes, bytes);
+            }
+    }
+
+    void pack(int chunk, unsigned char* out) const {
+        for_each_line(chunk, [&](const unsigned char* line, std::size_t bytes) {
+            std::memcpy(out, line, bytes);
+            out += bytes;
+        });
+    }
+
+    std::vector<const ExrChannel*> channels_;
+    std::size_t width_;
+    int height_;
+    int lines_per_chunk_;
+    ExrCompression compression_;
+    std::size_t line_bytes_ = 0;
+};
+
+// A file written with stdio; every failure throws with the OS's reason.
+class OutputBytes {
+  public:
+    explicit OutputBytes(const std::string& path) : file_(std::fopen(path.c_str(), "wb")) {
+        if (file_ == nullptr) throw std::runtime_error(std::strerror(errno));
+    }
+    ~OutputBytes() {
+        if (file_ != nullptr) std::fclose(file_);
+    }
+    OutputBytes(const OutputBytes&) = delete;
+    OutputBytes& operator=(const OutputBytes&) = delete;
+
+    void write(const void* data, std::size_t size) {
+        errno = 0;
+        if (size != 0 && std::fwrite(data, 1, size, file_) != size) fail();
+        position_ += size;
+    }
+    template <class T>
+    void write_le(T value) {  // the host is little-endian (static_assert above)
+        write(&value, sizeof value);
+    }
+    void seek(std::uint64_t position) {
+        if (std::fseek(file_, static_cast<long>(position), SEEK_SET) != 0) fail();
+        position_ = position;
+    }
+    std::uint64_t position() const { return position_; }
+    // A full disk may only show when buffered data is flushed, so the close is checked.
+    void close() {
+        const bool failed = std::ferror(file_) != 0;
+        std::FILE* file = std::exchange(file_, nullptr);
+        errno = 0;
+        if (std::fclose(file) != 0 || failed) fail();
+    }
+
+  private:
+    [[noreturn]] void fail() const {
+        throw std::runtime_error(std::strerror(errno != 0 ? errno : EIO));
+    }
+    std::FILE* file_;
+    std::uint64_t position_ = 0;
+};
+
+// The chunks are encoded in parallel, a group at a time (so that a huge image never holds
+// all of its compressed chunks at once), and written in order between groups, on
+// exr_thread_count() threads (none: the calling thread encodes them).
+constexpr std::size_t kRawBytesPerGroup = std::size_t{16} << 20;
+
+void write_exr_with_own_chunks(const std::string& path, const ExrImage& image,
+                               const Imf::Header& header) {
+    header.sanityCheck();
+    Imf::StdOSStream head;
+    MagicAndVersion().write(head, header);
+    header.writeTo(head);
+    const std::string head_bytes = head.str();
+
+    const ChunkEncoder encoder(image, exr_lines_per_chunk(image.compression));
+    const int chunks = encoder.chunk_count();
+    OutputBytes file(path);
+    file.write(head_bytes.data(), head_bytes.size());
+    // The chunk offset table, filled in once the chunks are written.
+    const std::uint64_t table_position = file.position();
+    std::vector<std::uint64_t> offsets(static_cast<std::size_t>(chunks), 0);
+    file.write(offsets.data(), offsets.size() * sizeof(std::uint64_t));
+
+    const int threads = Imf::globalThreadCount();
+    std::optional<tbb::task_arena> arena;
+    if (threads > 1) arena.emplace(threads);
+    std::vector<std::vector<unsigned char>> encoded;
+    for (int first = 0; first < chunks;) {
+        int last = first;
+        for (std::size_t bytes = 0;
+             last < chunks && (last == first || bytes < kRawBytesPerGroup); ++last)
+            bytes += encoder.raw_bytes(last);
+        encoded.resize(static_cast<std::size_t>(last - first));
+        const auto encode_range = [&](const tbb::blocked_range<int>& range) {
+            for (int k = range.begin(); k != range.end(); ++k)
+                encoder.encode(k, encoded[static_cast<std::size_t>(k - first)]);
+        };
+        if (arena)
+            arena->execute(
+                [&] { tbb::parallel_for(tbb::blocked_range<int>(first, last), encode_range); });
+        else
+            encode_range(tbb::blocked_range<int>(first, last));
+        for (int k = first; k < last; ++k) {
+            const std::vector<unsigned char>& data =
+                encoded[static_cast<std::size_t>(k - first)];
+            offsets[static_cast<std::size_t>(k)] = file.position();
+            file.write_le<std::int32_t>(image.data_window.y0 + encoder.first_line(k));
+            file.write_le<std::int32_t>(static_cast<std::int32_t>(data.size()));
+            file.write(data.data(), data.size());
+        }
+        first = last;
+    }
+    file.seek(table_position);
+    file.write(offsets.data(), offsets.size() * sizeof(std::uint64_t));
+    file.close();
+}
+
+void write_exr_file(const std::string& path, const ExrImage& image) {
+    const Imf::Header header = make_header(image);
+    if (packs_chunks_itself(image.compression))
+        write_exr_with_own_chunks(path, image, header);
+    else
+        write_exr_with_openexr(path, image, header);
 }
 
 void require_image(const Image& image) {
@@ -384,5 +631,10 @@ void write_exr(const std::string& path, const Image& image, const ExrWriteOption
 void set_exr_thread_count(int threads) { Imf::setGlobalThreadCount(threads); }
 
 int exr_thread_count() { return Imf::globalThreadCount(); }
+
+void detail::write_exr_by_openexr(const std::string& path, const ExrImage& image) {
+    check_exr_image(image);
+    write_exr_with_openexr(path, image, make_header(image));
+}
 
 }  // namespace octray

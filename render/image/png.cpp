@@ -1,12 +1,13 @@
 // Every PNG octray writes or reads: the sRGB preview of a render (write_png_preview), ready
 // sRGB bytes (write_png_rgb8: the compare heatmap; encode_png_rgb8: `octray view`'s
-// pictures, in memory), and the reader behind read_image().
-// One libpng error handler serves them all.
+// pictures, in memory), encoded here with libdeflate, and the reader behind read_image(),
+// which is libpng's.
 
 #include "render/image/png.h"
 
 #include <png.h>
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
@@ -20,6 +21,7 @@
 #include <system_error>
 #include <vector>
 
+#include "render/image/deflate.h"
 #include "render/image/image_io.h"
 
 namespace octray {
@@ -27,33 +29,24 @@ namespace {
 
 std::string errno_message(int error) { return std::generic_category().message(error); }
 
-// ---- The libpng error handler ----------------------------------------------------------
+// ---- The libpng error handler (reading) --------------------------------------------------
 // libpng reports errors by calling the handler and then longjmp-ing back to setjmp; the
 // message is kept so it can become an exception once we are back in ordinary C++ control
 // flow. The functions that call setjmp create no object with a destructor after it, so the
 // jump never skips one; everything that owns memory lives in their callers.
 
-// One libpng run: where the bytes go (writing) or come from (reading), and the error.
+// One libpng read: the whole file, how far it has been read, and the error.
 struct PngIo {
-    std::FILE* file = nullptr;            // writing: the open temporary
-    std::string* memory = nullptr;        // or writing into memory
-    const unsigned char* data = nullptr;  // reading: the whole file
+    const unsigned char* data = nullptr;
     std::size_t size = 0;
     std::size_t offset = 0;
     bool ran_out = false;  // reading past the end: a truncated file
-    // libpng's own writer says only "Write Error"; ours keeps the OS reason (errno) of a
-    // failed write so that the message can say it ("No space left on device").
-    int write_errno = 0;
     char message[256] = {};
 };
 
 void on_png_error(png_structp png, png_const_charp message) {
     auto* io = static_cast<PngIo*>(png_get_error_ptr(png));
-    if (io->write_errno != 0)
-        std::snprintf(io->message, sizeof io->message, "%s: %s", message,
-                      std::strerror(io->write_errno));
-    else
-        std::snprintf(io->message, sizeof io->message, "%s", message);
+    std::snprintf(io->message, sizeof io->message, "%s", message);
     png_longjmp(png, 1);
 }
 
@@ -61,100 +54,96 @@ void on_png_error(png_structp png, png_const_charp message) {
 void on_png_warning(png_structp, png_const_charp) {}
 
 // ---- Writing -----------------------------------------------------------------------------
+// octray encodes the PNGs it writes itself: a PNG octray writes is wanted soon rather than
+// small. Every row is filtered with one filter (each byte minus its left neighbour's,
+// SUB) and the rows are compressed as one zlib stream by libdeflate at its fastest level,
+// which compresses the pixels about twice as fast as zlib's fastest level did through
+// libpng, to a file of about the same size (render/image/README.md, "Compression").
+// libpng reads them back in the tests.
 
-void on_png_write(png_structp png, png_bytep data, png_size_t length) {
-    auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
-    errno = 0;
-    if (std::fwrite(data, 1, length, io->file) != length) {
-        io->write_errno = errno != 0 ? errno : EIO;
-        png_error(png, "Write Error");
-    }
-}
-
-void on_png_append(png_structp png, png_bytep data, png_size_t length) {
-    static_cast<PngIo*>(png_get_io_ptr(png))
-        ->memory->append(reinterpret_cast<char*>(data), length);
-}
-
-void on_png_flush(png_structp png) {
-    auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
-    errno = 0;
-    if (std::fflush(io->file) != 0) {
-        io->write_errno = errno != 0 ? errno : EIO;
-        png_error(png, "Write Error");
-    }
-}
+constexpr int kPngLevel = 1;
 
 // How the file says its pixels are sRGB: the sRGB chunk alone (the heatmap), or with the
 // gAMA and cHRM chunks that stand in for it in older viewers (the render preview).
 enum class SrgbChunks { srgb, srgb_gama_chrm };
 
-bool write_rgb8_rows(png_structp png, png_infop info, PngIo* io, png_uint_32 width,
-                     png_uint_32 height, png_bytepp rows, SrgbChunks chunks) {
-    if (setjmp(png_jmpbuf(png))) return false;
-    if (io->memory != nullptr)
-        png_set_write_fn(png, io, on_png_append, nullptr);
-    else
-        png_set_write_fn(png, io, on_png_write, on_png_flush);
-    // zlib's fastest level and one filter (each byte minus its left neighbour's): a PNG
-    // octray writes is wanted soon rather than small. On a 1280x720 whitted preview this
-    // writes 4x faster than libpng's defaults (level 6, a filter chosen per row), for a
-    // file 30 % larger (docs/performance-log.md, "The finished frame").
-    png_set_compression_level(png, 1);
-    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
-    png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    if (chunks == SrgbChunks::srgb_gama_chrm)
-        png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    else
-        png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    png_write_info(png, info);
-    png_write_image(png, rows);
-    png_write_end(png, info);
-    return true;
+void append_u32(std::string& out, std::uint32_t value) {  // big-endian, as PNG stores it
+    const char bytes[4] = {static_cast<char>(value >> 24), static_cast<char>(value >> 16),
+                           static_cast<char>(value >> 8), static_cast<char>(value)};
+    out.append(bytes, 4);
 }
 
-// Writes an 8-bit RGB PNG of `rows` (row 0 on top) through `io` (its file or its memory).
-// Returns the reason it failed, or "".
-std::string write_png(PngIo& io, int width, int height, png_bytepp rows, SrgbChunks chunks) {
-    png_structp png =
-        png_create_write_struct(PNG_LIBPNG_VER_STRING, &io, on_png_error, on_png_warning);
-    png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-    std::string failure;
-    if (png == nullptr)
-        failure = "libpng: cannot create the write structure";
-    else if (info == nullptr)
-        failure = "libpng: cannot create the info structure";
-    else if (!write_rgb8_rows(png, info, &io, static_cast<png_uint_32>(width),
-                              static_cast<png_uint_32>(height), rows, chunks))
-        failure = std::string("libpng: ") + io.message;
-    if (png != nullptr) png_destroy_write_struct(&png, info != nullptr ? &info : nullptr);
-    return failure;
+// A chunk: its length, type, data and the CRC-32 of type and data.
+void append_chunk(std::string& out, const char (&type)[5], const void* data, std::size_t size) {
+    append_u32(out, static_cast<std::uint32_t>(size));
+    const std::size_t start = out.size();
+    out.append(type, 4);
+    out.append(static_cast<const char*>(data), size);
+    append_u32(out, detail::crc32(0, out.data() + start, 4 + size));
 }
 
-// Writes an 8-bit RGB PNG of `rows` (row 0 on top) to a new file at `path`. Throws
-// std::runtime_error with the reason.
-void write_png_file(const std::string& path, int width, int height, png_bytepp rows,
-                    SrgbChunks chunks) {
+// The sRGB, gAMA and cHRM values libpng's png_set_sRGB_gAMA_and_cHRM writes: rendering
+// intent perceptual, gamma 1/2.2 (x 100000), the sRGB white point and primaries (x 100000).
+constexpr std::uint32_t kSrgbGamma = 45455;
+constexpr std::uint32_t kSrgbChromaticities[8] = {31270, 32900, 64000, 33000,
+                                                  30000, 60000, 15000, 6000};
+
+// An 8-bit RGB PNG of `rgb` (3 * width * height bytes, row 0 on top), in memory.
+std::string encode_png(int width, int height, const std::uint8_t* rgb, SrgbChunks chunks) {
+    const std::size_t row_bytes = 3 * static_cast<std::size_t>(width);
+    const std::size_t rows = static_cast<std::size_t>(height);
+    std::vector<std::uint8_t> filtered(rows * (1 + row_bytes));
+    for (std::size_t y = 0; y < rows; ++y) {
+        const std::uint8_t* in = rgb + y * row_bytes;
+        std::uint8_t* out = filtered.data() + y * (1 + row_bytes);
+        out[0] = 1;  // SUB
+        for (std::size_t i = 0; i < 3 && i < row_bytes; ++i) out[1 + i] = in[i];
+        for (std::size_t i = 3; i < row_bytes; ++i)
+            out[1 + i] = static_cast<std::uint8_t>(in[i] - in[i - 3]);
+    }
+    std::vector<std::uint8_t> compressed(
+        detail::zlib_compress_bound(kPngLevel, filtered.size()));
+    compressed.resize(detail::zlib_compress(kPngLevel, filtered.data(), filtered.size(),
+                                            compressed.data(), compressed.size()));
+
+    std::string out("\x89PNG\r\n\x1a\n", 8);
+    std::string header;
+    append_u32(header, static_cast<std::uint32_t>(width));
+    append_u32(header, static_cast<std::uint32_t>(height));
+    header +=
+        std::string("\x08\x02\x00\x00\x00", 5);  // 8 bits, RGB, deflate, filters, no interlace
+    append_chunk(out, "IHDR", header.data(), header.size());
+    const char intent = 0;  // perceptual
+    if (chunks == SrgbChunks::srgb_gama_chrm) {
+        std::string gamma, chromaticities;
+        append_u32(gamma, kSrgbGamma);
+        for (std::uint32_t v : kSrgbChromaticities) append_u32(chromaticities, v);
+        append_chunk(out, "gAMA", gamma.data(), gamma.size());
+        append_chunk(out, "sRGB", &intent, 1);
+        append_chunk(out, "cHRM", chromaticities.data(), chromaticities.size());
+    } else {
+        append_chunk(out, "sRGB", &intent, 1);
+    }
+    // IDAT chunks of at most 1 MiB each (any size up to 2^31 - 1 is valid).
+    constexpr std::size_t kIdatBytes = std::size_t{1} << 20;
+    for (std::size_t at = 0; at < compressed.size(); at += kIdatBytes)
+        append_chunk(out, "IDAT", compressed.data() + at,
+                     std::min(kIdatBytes, compressed.size() - at));
+    append_chunk(out, "IEND", nullptr, 0);
+    return out;
+}
+
+// Writes `bytes` to a new file at `path`. Throws std::runtime_error with the OS's reason.
+void write_bytes(const std::string& path, const std::string& bytes) {
     std::FILE* file = std::fopen(path.c_str(), "wb");
     if (file == nullptr) throw std::runtime_error(errno_message(errno));
-    PngIo io;
-    io.file = file;
-    std::string failure = write_png(io, width, height, rows, chunks);
+    errno = 0;
+    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+    int error = written ? 0 : (errno != 0 ? errno : EIO);
     // A full disk may only show when buffered data is flushed, so check the close too.
-    const bool stream_failed = std::ferror(file) != 0;
-    const int close_errno = std::fclose(file) != 0 ? errno : 0;
-    if (failure.empty() && close_errno != 0) failure = errno_message(close_errno);
-    if (failure.empty() && stream_failed) failure = "write error";
-    if (!failure.empty()) throw std::runtime_error(failure);
-}
-
-// The row pointers of packed RGB bytes; libpng wants mutable ones but only reads.
-std::vector<png_bytep> rgb8_rows(int width, int height, const std::vector<std::uint8_t>& rgb) {
-    std::vector<png_bytep> rows(static_cast<std::size_t>(height));
-    for (std::size_t y = 0; y < rows.size(); ++y)
-        rows[y] = const_cast<png_bytep>(rgb.data() + y * 3 * static_cast<std::size_t>(width));
-    return rows;
+    errno = 0;
+    if (std::fclose(file) != 0 && error == 0) error = errno != 0 ? errno : EIO;
+    if (error != 0) throw std::runtime_error(errno_message(error));
 }
 
 bool rgb8_size_matches(int width, int height, const std::vector<std::uint8_t>& rgb) {
@@ -313,24 +302,12 @@ void require_image(const std::string& path, const Image& image) {
 
 void write_png_preview(const std::string& path, const Image& image) {
     require_image(path, image);
-    const int width = image.width();
-    const int height = image.height();
-    const std::size_t row_bytes = static_cast<std::size_t>(width) * 3;
-    std::vector<png_byte> pixels(row_bytes * static_cast<std::size_t>(height));
-    std::vector<png_bytep> rows(static_cast<std::size_t>(height));
-    for (int y = 0; y < height; ++y) {
-        png_bytep row = pixels.data() + static_cast<std::size_t>(y) * row_bytes;
-        rows[static_cast<std::size_t>(y)] = row;
-        for (int x = 0; x < width; ++x) {
-            const Rgb c = image.at(x, y);
-            row[3 * x + 0] = srgb8(c.r);
-            row[3 * x + 1] = srgb8(c.g);
-            row[3 * x + 2] = srgb8(c.b);
-        }
-    }
-    write_file_atomically(path, [&](const std::string& tmp) {
-        write_png_file(tmp, width, height, rows.data(), SrgbChunks::srgb_gama_chrm);
-    });
+    const std::size_t values = 3 * image.pixel_count();
+    std::vector<std::uint8_t> rgb(values);
+    srgb8_scaled(reinterpret_cast<const float*>(image.data()), values, 1.0f, rgb.data());
+    const std::string bytes =
+        encode_png(image.width(), image.height(), rgb.data(), SrgbChunks::srgb_gama_chrm);
+    write_file_atomically(path, [&](const std::string& tmp) { write_bytes(tmp, bytes); });
 }
 
 void write_png_rgb8(const std::string& path, int width, int height,
@@ -339,10 +316,8 @@ void write_png_rgb8(const std::string& path, int width, int height,
         throw IoError("cannot write '" + path + "': " + std::to_string(rgb.size()) +
                       " bytes do not make a " + std::to_string(width) + "x" +
                       std::to_string(height) + " RGB image");
-    std::vector<png_bytep> rows = rgb8_rows(width, height, rgb);
-    write_file_atomically(path, [&](const std::string& tmp) {
-        write_png_file(tmp, width, height, rows.data(), SrgbChunks::srgb);
-    });
+    const std::string bytes = encode_png(width, height, rgb.data(), SrgbChunks::srgb);
+    write_file_atomically(path, [&](const std::string& tmp) { write_bytes(tmp, bytes); });
 }
 
 std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_t>& rgb) {
@@ -350,13 +325,7 @@ std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_
         throw IoError("cannot encode a PNG: " + std::to_string(rgb.size()) +
                       " bytes do not make a " + std::to_string(width) + "x" +
                       std::to_string(height) + " RGB image");
-    std::vector<png_bytep> rows = rgb8_rows(width, height, rgb);
-    std::string out;
-    PngIo io;
-    io.memory = &out;
-    const std::string failure = write_png(io, width, height, rows.data(), SrgbChunks::srgb);
-    if (!failure.empty()) throw IoError("cannot encode a PNG: " + failure);
-    return out;
+    return encode_png(width, height, rgb.data(), SrgbChunks::srgb);
 }
 
 ChannelImage read_png_channels(const std::string& path,

@@ -18,8 +18,10 @@
 #include <bit>
 #include <cerrno>
 #include <cmath>
+#include <csetjmp>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -506,6 +508,103 @@ TEST_F(ImageIoTest, PngOfLargerImageIsReadable) {
     EXPECT_LT(px(0, 0, 0), px(319, 0, 0));
     EXPECT_LT(px(0, 0, 1), px(0, 199, 1));
     EXPECT_EQ(px(100, 100, 2), 255);
+}
+
+// What libpng's low-level reader finds in a PNG's colour chunks (it checks every chunk's
+// CRC and fails on a wrong one).
+struct ColourChunks {
+    png_uint_32 srgb = 0, gama = 0, chrm = 0;  // the PNG_INFO_ bit when present
+    int intent = -1;
+    double gamma = 0.0;
+    double white_x = 0, white_y = 0, red_x = 0, red_y = 0, green_x = 0, green_y = 0, blue_x = 0,
+           blue_y = 0;
+    int bit_depth = 0, color_type = 0;
+};
+
+// setjmp's function holds nothing with a destructor, so libpng's longjmp skips none.
+bool read_colour_chunks(png_structp png, png_infop info, std::FILE* file, ColourChunks& out) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_init_io(png, file);
+    png_read_png(png, info, PNG_TRANSFORM_IDENTITY, nullptr);
+    out.srgb = png_get_sRGB(png, info, &out.intent);
+    out.gama = png_get_gAMA(png, info, &out.gamma);
+    out.chrm = png_get_cHRM(png, info, &out.white_x, &out.white_y, &out.red_x, &out.red_y,
+                            &out.green_x, &out.green_y, &out.blue_x, &out.blue_y);
+    out.bit_depth = png_get_bit_depth(png, info);
+    out.color_type = png_get_color_type(png, info);
+    return true;
+}
+
+// The preview says sRGB with gAMA and cHRM beside it (for older viewers), the heatmap
+// sRGB alone.
+TEST_F(ImageIoTest, PngsCarryTheirSrgbChunks) {
+    write_png_preview((dir_ / "preview.png").string(), gradient_image(9, 7));
+    write_png_rgb8((dir_ / "heatmap.png").string(), 2, 1, {0, 64, 128, 255, 32, 16});
+    for (const std::string name : {"preview.png", "heatmap.png"}) {
+        SCOPED_TRACE(name);
+        std::FILE* file = std::fopen((dir_ / name).c_str(), "rb");
+        ASSERT_NE(file, nullptr);
+        png_structp png =
+            png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+        png_infop info = png_create_info_struct(png);
+        ColourChunks chunks;
+        const bool read = read_colour_chunks(png, info, file, chunks);
+        png_destroy_read_struct(&png, &info, nullptr);
+        std::fclose(file);
+        ASSERT_TRUE(read);
+        EXPECT_EQ(chunks.srgb, PNG_INFO_sRGB);
+        EXPECT_EQ(chunks.intent, PNG_sRGB_INTENT_PERCEPTUAL);
+        EXPECT_EQ(chunks.bit_depth, 8);
+        EXPECT_EQ(chunks.color_type, PNG_COLOR_TYPE_RGB);
+        if (name == "preview.png") {
+            EXPECT_EQ(chunks.gama, PNG_INFO_gAMA);
+            EXPECT_NEAR(chunks.gamma, 0.45455, 1e-6);
+            EXPECT_EQ(chunks.chrm, PNG_INFO_cHRM);
+            EXPECT_NEAR(chunks.white_x, 0.3127, 1e-6);
+            EXPECT_NEAR(chunks.white_y, 0.3290, 1e-6);
+            EXPECT_NEAR(chunks.red_y, 0.33, 1e-6);
+            EXPECT_NEAR(chunks.green_x, 0.30, 1e-6);
+            EXPECT_NEAR(chunks.blue_x, 0.15, 1e-6);
+        }
+    }
+    // libpng derives gAMA and cHRM from sRGB when reading, so the chunks are listed.
+    const auto chunk_types = [](const fs::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        const std::string b((std::istreambuf_iterator<char>(in)),
+                            std::istreambuf_iterator<char>());
+        std::vector<std::string> types;
+        for (std::size_t at = 8; at + 12 <= b.size();) {
+            const std::size_t length =
+                (std::size_t{static_cast<unsigned char>(b[at])} << 24) |
+                (std::size_t{static_cast<unsigned char>(b[at + 1])} << 16) |
+                (std::size_t{static_cast<unsigned char>(b[at + 2])} << 8) |
+                static_cast<unsigned char>(b[at + 3]);
+            types.push_back(b.substr(at + 4, 4));
+            at += 12 + length;
+        }
+        return types;
+    };
+    EXPECT_EQ(chunk_types(dir_ / "preview.png"),
+              (std::vector<std::string>{"IHDR", "gAMA", "sRGB", "cHRM", "IDAT", "IEND"}));
+    EXPECT_EQ(chunk_types(dir_ / "heatmap.png"),
+              (std::vector<std::string>{"IHDR", "sRGB", "IDAT", "IEND"}));
+}
+
+// A picture whose compressed pixels span several IDAT chunks (1 MiB each): noise does not
+// compress, so 3 MB of it needs three; every byte comes back.
+TEST_F(ImageIoTest, PngOfSeveralIdatChunksReadsBack) {
+    const int width = 1000, height = 1000;
+    std::vector<std::uint8_t> bytes(3 * static_cast<std::size_t>(width) * height);
+    std::uint32_t state = 777;
+    for (std::uint8_t& b : bytes)
+        b = static_cast<std::uint8_t>((state = state * 1664525u + 1013904223u) >> 24);
+    const std::string path = (dir_ / "noise.png").string();
+    write_png_rgb8(path, width, height, bytes);
+    EXPECT_GT(fs::file_size(path), std::size_t{2} << 20);
+    const PngPixels png = read_png(path);
+    ASSERT_EQ(png.width, width);
+    ASSERT_EQ(png.height, height);
+    EXPECT_TRUE(png.rgb == bytes);
 }
 
 // OpenEXR's pool of compression threads, as `octray render` sets it; the bytes of a file
