@@ -17,6 +17,7 @@
 #include <ImfStringAttribute.h>
 #include <ImfThreading.h>
 #include <ImfVersion.h>
+#include <emmintrin.h>
 #include <half.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -247,6 +248,40 @@ std::vector<const ExrChannel*> channels_in_file_order(const ExrImage& image) {
     return channels;
 }
 
+// The byte pairs at in[0, 2 * pairs) split into their first bytes, to even, and their
+// second bytes, to odd. SSE2 (every x86-64) 16 pairs at a time.
+void split_even_odd(const unsigned char* in, std::size_t pairs, unsigned char* even,
+                    unsigned char* odd) {
+    std::size_t i = 0;
+    const __m128i low = _mm_set1_epi16(0x00ff);
+    for (; i + 16 <= pairs; i += 16) {
+        const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + 2 * i));
+        const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + 2 * i + 16));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(even + i),
+                         _mm_packus_epi16(_mm_and_si128(a, low), _mm_and_si128(b, low)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(odd + i),
+                         _mm_packus_epi16(_mm_srli_epi16(a, 8), _mm_srli_epi16(b, 8)));
+    }
+    for (; i < pairs; ++i) {
+        even[i] = in[2 * i];
+        odd[i] = in[2 * i + 1];
+    }
+}
+
+// OpenEXR's predictor: out[0] = in[0], out[i] = in[i] - in[i - 1] + 128 (mod 256).
+void predict(const unsigned char* in, std::size_t size, unsigned char* out) {
+    out[0] = in[0];
+    std::size_t i = 1;
+    const __m128i bias = _mm_set1_epi8(static_cast<char>(128));
+    for (; i + 16 <= size; i += 16) {
+        const __m128i now = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i));
+        const __m128i before = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i - 1));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
+                         _mm_add_epi8(_mm_sub_epi8(now, before), bias));
+    }
+    for (; i < size; ++i) out[i] = static_cast<unsigned char>(in[i] - in[i - 1] + 128);
+}
+
 // Packs, and for ZIP and ZIPS compresses, one chunk of scan lines.
 class ChunkEncoder {
   public:
@@ -286,17 +321,11 @@ class ChunkEncoder {
         unsigned char* even = split.data();
         unsigned char* odd = split.data() + raw / 2;
         for_each_line(chunk, [&](const unsigned char* line, std::size_t bytes) {
-            const std::size_t pairs = bytes / 2;
-            for (std::size_t i = 0; i < pairs; ++i) {
-                even[i] = line[2 * i];
-                odd[i] = line[2 * i + 1];
-            }
-            even += pairs;
-            odd += pairs;
+            split_even_odd(line, bytes / 2, even, odd);
+            even += bytes / 2;
+            odd += bytes / 2;
         });
-        predicted[0] = split[0];
-        for (std::size_t i = 1; i < raw; ++i)
-            predicted[i] = static_cast<unsigned char>(split[i] - split[i - 1] + 128);
+        predict(split.data(), raw, predicted.data());
         out.resize(raw);
         const std::size_t size =
             detail::zlib_compress(kZipLevel, predicted.data(), raw, out.data(), raw - 1);

@@ -5,6 +5,10 @@
 
 #include <cpuid.h>
 #include <half.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 
 namespace octray {
 namespace {
@@ -39,10 +43,23 @@ bool half_bits_use_f16c() {
 
 void floats_to_half_bits(const float* values, std::size_t count, std::size_t stride,
                          std::uint16_t* out) {
-    if (half_bits_use_f16c())
-        detail::floats_to_half_bits_f16c(values, count, stride, out);
-    else
-        detail::floats_to_half_bits_imath(values, count, stride, out);
+    const auto convert = half_bits_use_f16c() ? detail::floats_to_half_bits_f16c
+                                              : detail::floats_to_half_bits_imath;
+    // A frame's channel (a million samples) is converted on the threads of the caller's
+    // arena, in blocks of 64 Ki samples; a small one on the calling thread.
+    constexpr std::size_t kBlock = std::size_t{1} << 16;
+    if (count <= kBlock) {
+        convert(values, count, stride, out);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (count + kBlock - 1) / kBlock),
+                      [&](const tbb::blocked_range<std::size_t>& blocks) {
+                          for (std::size_t b = blocks.begin(); b != blocks.end(); ++b) {
+                              const std::size_t first = b * kBlock;
+                              convert(values + first * stride, std::min(kBlock, count - first),
+                                      stride, out + first);
+                          }
+                      });
 }
 
 }  // namespace octray

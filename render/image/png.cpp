@@ -6,6 +6,8 @@
 #include "render/image/png.h"
 
 #include <png.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <bit>
@@ -88,19 +90,27 @@ constexpr std::uint32_t kSrgbGamma = 45455;
 constexpr std::uint32_t kSrgbChromaticities[8] = {31270, 32900, 64000, 33000,
                                                   30000, 60000, 15000, 6000};
 
-// An 8-bit RGB PNG of `rgb` (3 * width * height bytes, row 0 on top), in memory.
-std::string encode_png(int width, int height, const std::uint8_t* rgb, SrgbChunks chunks) {
+// An 8-bit RGB PNG, in memory, of the rows `row(y, out)` writes (3 * width bytes each,
+// row 0 on top). The rows are made and filtered in parallel on the caller's arena; the
+// filtered rows are compressed as one zlib stream.
+template <class Row>
+std::string encode_png(int width, int height, const Row& row, SrgbChunks chunks) {
     const std::size_t row_bytes = 3 * static_cast<std::size_t>(width);
     const std::size_t rows = static_cast<std::size_t>(height);
     std::vector<std::uint8_t> filtered(rows * (1 + row_bytes));
-    for (std::size_t y = 0; y < rows; ++y) {
-        const std::uint8_t* in = rgb + y * row_bytes;
-        std::uint8_t* out = filtered.data() + y * (1 + row_bytes);
-        out[0] = 1;  // SUB
-        for (std::size_t i = 0; i < 3 && i < row_bytes; ++i) out[1 + i] = in[i];
-        for (std::size_t i = 3; i < row_bytes; ++i)
-            out[1 + i] = static_cast<std::uint8_t>(in[i] - in[i - 3]);
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, 32),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t y = range.begin(); y != range.end(); ++y) {
+                              std::uint8_t* out = filtered.data() + y * (1 + row_bytes);
+                              out[0] = 1;  // SUB
+                              row(y, out + 1);
+                              // In place from the right: each byte minus its left
+                              // neighbour's, read before it is changed.
+                              for (std::size_t i = row_bytes; i-- > 3;)
+                                  out[1 + i] =
+                                      static_cast<std::uint8_t>(out[1 + i] - out[i - 2]);
+                          }
+                      });
     std::vector<std::uint8_t> compressed(
         detail::zlib_compress_bound(kPngLevel, filtered.size()));
     compressed.resize(detail::zlib_compress(kPngLevel, filtered.data(), filtered.size(),
@@ -146,6 +156,14 @@ void write_bytes(const std::string& path, const std::string& bytes) {
     if (error != 0) throw std::runtime_error(errno_message(error));
 }
 
+// The rows of packed sRGB bytes, as encode_png takes them.
+auto rgb8_row(int width, const std::vector<std::uint8_t>& rgb) {
+    const std::size_t row_bytes = 3 * static_cast<std::size_t>(width);
+    return [row_bytes, &rgb](std::size_t y, std::uint8_t* out) {
+        std::memcpy(out, rgb.data() + y * row_bytes, row_bytes);
+    };
+}
+
 bool rgb8_size_matches(int width, int height, const std::vector<std::uint8_t>& rgb) {
     return width > 0 && height > 0 &&
            rgb.size() == 3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
@@ -176,7 +194,7 @@ namespace {
 // the floats of (0, 1) are cut into buckets by their top 16 bits (1/128 of a power of two
 // each): bucket_start holds the byte at each bucket's first float, and within a bucket the
 // byte steps up at most once (the OETF's slope times a bucket's width stays below one
-// step), which one comparison finds; the loop after it is for safety and never runs.
+// step, which the constructor checks), which one comparison finds.
 struct SrgbTable {
     static constexpr std::uint32_t kOneBits = 0x3F800000u;  // 1.0f
     float threshold[257];                                   // [256]: +inf, a sentinel
@@ -192,8 +210,18 @@ struct SrgbTable {
             }
             threshold[v] = std::bit_cast<float>(hi);
         }
-        for (std::uint32_t b = 0; b <= (kOneBits >> 16); ++b)
-            bucket_start[b] = srgb8_by_formula(std::bit_cast<float>(b << 16));
+        // The byte of a bucket's first float is the number of thresholds at or below it.
+        int v = 0;
+        for (std::uint32_t b = 0; b <= (kOneBits >> 16); ++b) {
+            const float first = std::bit_cast<float>(b << 16);
+            while (v < 255 && threshold[v + 1] <= first) ++v;
+            bucket_start[b] = static_cast<std::uint8_t>(v);
+        }
+        // Within a bucket the byte steps up at most once (so srgb8_in compares once): the
+        // next bucket's first byte is at most one above this one's.
+        for (std::uint32_t b = 0; b < (kOneBits >> 16); ++b)
+            if (bucket_start[b + 1] > bucket_start[b] + 1)
+                throw std::logic_error("srgb8: a bucket of the sRGB table holds two steps");
     }
 };
 
@@ -203,12 +231,12 @@ const SrgbTable& srgb_table() {
 }
 
 inline std::uint8_t srgb8_in(const SrgbTable& table, float linear) {
-    if (!(linear > 0.0f)) return 0;  // NaN too
-    if (linear >= 1.0f) return 255;
-    int v = table.bucket_start[std::bit_cast<std::uint32_t>(linear) >> 16];
-    v += linear >= table.threshold[v + 1] ? 1 : 0;
-    while (linear >= table.threshold[v + 1]) ++v;
-    return static_cast<std::uint8_t>(v);
+    // Clamped to [0, 1] without branches (NaN fails the first comparison and becomes 0);
+    // 1.0's bucket starts at 255, whose next threshold is +inf.
+    float x = linear > 0.0f ? linear : 0.0f;
+    x = x < 1.0f ? x : 1.0f;
+    const int v = table.bucket_start[std::bit_cast<std::uint32_t>(x) >> 16];
+    return static_cast<std::uint8_t>(v + (x >= table.threshold[v + 1] ? 1 : 0));
 }
 
 }  // namespace
@@ -302,11 +330,14 @@ void require_image(const std::string& path, const Image& image) {
 
 void write_png_preview(const std::string& path, const Image& image) {
     require_image(path, image);
-    const std::size_t values = 3 * image.pixel_count();
-    std::vector<std::uint8_t> rgb(values);
-    srgb8_scaled(reinterpret_cast<const float*>(image.data()), values, 1.0f, rgb.data());
-    const std::string bytes =
-        encode_png(image.width(), image.height(), rgb.data(), SrgbChunks::srgb_gama_chrm);
+    const std::string bytes = encode_png(
+        image.width(), image.height(),
+        [&](std::size_t y, std::uint8_t* out) {
+            const std::size_t values = 3 * static_cast<std::size_t>(image.width());
+            srgb8_scaled(reinterpret_cast<const float*>(image.data()) + y * values, values,
+                         1.0f, out);
+        },
+        SrgbChunks::srgb_gama_chrm);
     write_file_atomically(path, [&](const std::string& tmp) { write_bytes(tmp, bytes); });
 }
 
@@ -316,7 +347,7 @@ void write_png_rgb8(const std::string& path, int width, int height,
         throw IoError("cannot write '" + path + "': " + std::to_string(rgb.size()) +
                       " bytes do not make a " + std::to_string(width) + "x" +
                       std::to_string(height) + " RGB image");
-    const std::string bytes = encode_png(width, height, rgb.data(), SrgbChunks::srgb);
+    const std::string bytes = encode_png(width, height, rgb8_row(width, rgb), SrgbChunks::srgb);
     write_file_atomically(path, [&](const std::string& tmp) { write_bytes(tmp, bytes); });
 }
 
@@ -325,7 +356,7 @@ std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_
         throw IoError("cannot encode a PNG: " + std::to_string(rgb.size()) +
                       " bytes do not make a " + std::to_string(width) + "x" +
                       std::to_string(height) + " RGB image");
-    return encode_png(width, height, rgb.data(), SrgbChunks::srgb);
+    return encode_png(width, height, rgb8_row(width, rgb), SrgbChunks::srgb);
 }
 
 ChannelImage read_png_channels(const std::string& path,
