@@ -74,11 +74,12 @@ TEST(HalfBits, F16cGivesImathsBitsEverywhereRoundingIsHard) {
         }
 }
 
-// A frame's R, G and B: stride 3, lengths that leave 0 to 7 values after the 8-wide blocks,
-// a NaN inside a block; each out[k] written, nothing past count.
+// A frame's R, G and B: stride 3, lengths that leave 0 to 8 values after the 8-wide blocks,
+// a NaN inside a block; each out[k] written, nothing past count, nothing read past the
+// buffer (which holds exactly the count's pixels: ASan checks the reads).
 TEST(HalfBits, StridesAndTailsGiveEachValueItsHalf) {
-    for (std::size_t count = 0; count <= 27; ++count) {
-        std::vector<float> rgb(3 * count + 3);
+    for (std::size_t count = 1; count <= 35; ++count) {
+        std::vector<float> rgb(3 * count);
         for (std::size_t k = 0; k < rgb.size(); ++k)
             rgb[k] = 0.1f * static_cast<float>(k) - 2.0f;
         if (count > 5) rgb[3 * 5 + 1] = std::numeric_limits<float>::signaling_NaN();
@@ -89,6 +90,23 @@ TEST(HalfBits, StridesAndTailsGiveEachValueItsHalf) {
                 ASSERT_EQ(out[k], half(rgb[3 * k + channel]).bits()) << count << " " << k;
             EXPECT_EQ(out[count], 0xabcd) << "written past count " << count;
         }
+    }
+}
+
+// The F16C build on interleaved RGB (stride 3, 24 floats converted at a time and every
+// third half picked): every hard float, as R, as G and as B.
+TEST(HalfBits, F16cOnInterleavedRgbGivesImathsBits) {
+    if (!half_bits_use_f16c())
+        GTEST_SKIP() << "this CPU has no F16C (or no AVX state): nothing to compare";
+    const std::vector<float> v = hard_floats();
+    const std::size_t pixels = v.size() / 3;
+    for (std::size_t channel = 0; channel < 3; ++channel) {
+        std::vector<std::uint16_t> f16c(pixels), imath(pixels);
+        detail::floats_to_half_bits_f16c(v.data() + channel, pixels, 3, f16c.data());
+        detail::floats_to_half_bits_imath(v.data() + channel, pixels, 3, imath.data());
+        for (std::size_t k = 0; k < pixels; ++k)
+            ASSERT_EQ(f16c[k], imath[k]) << "channel " << channel << ", float bits " << std::hex
+                                         << std::bit_cast<std::uint32_t>(v[3 * k + channel]);
     }
 }
 
