@@ -21,7 +21,6 @@
 #include <half.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -406,8 +405,8 @@ class OutputBytes {
 };
 
 // The chunks are encoded in parallel, a group at a time (so that a huge image never holds
-// all of its compressed chunks at once), and written in order between groups, on
-// exr_thread_count() threads (none: the calling thread encodes them).
+// all of its compressed chunks at once), and written in order between groups; with an
+// exr_thread_count() of 0 or 1 the calling thread encodes them alone.
 constexpr std::size_t kRawBytesPerGroup = std::size_t{16} << 20;
 
 void write_exr_with_own_chunks(const std::string& path, const ExrImage& image,
@@ -427,9 +426,9 @@ void write_exr_with_own_chunks(const std::string& path, const ExrImage& image,
     std::vector<std::uint64_t> offsets(static_cast<std::size_t>(chunks), 0);
     file.write(offsets.data(), offsets.size() * sizeof(std::uint64_t));
 
-    const int threads = Imf::globalThreadCount();
-    std::optional<tbb::task_arena> arena;
-    if (threads > 1) arena.emplace(threads);
+    // In the caller's arena, whose threads the frame's other work (its PNG) shares: a
+    // task arena of its own here would wait for a worker the PNG holds.
+    const bool parallel = Imf::globalThreadCount() > 1;
     std::vector<std::vector<unsigned char>> encoded;
     for (int first = 0; first < chunks;) {
         int last = first;
@@ -441,9 +440,8 @@ void write_exr_with_own_chunks(const std::string& path, const ExrImage& image,
             for (int k = range.begin(); k != range.end(); ++k)
                 encoder.encode(k, encoded[static_cast<std::size_t>(k - first)]);
         };
-        if (arena)
-            arena->execute(
-                [&] { tbb::parallel_for(tbb::blocked_range<int>(first, last), encode_range); });
+        if (parallel)
+            tbb::parallel_for(tbb::blocked_range<int>(first, last), encode_range);
         else
             encode_range(tbb::blocked_range<int>(first, last));
         for (int k = first; k < last; ++k) {

@@ -193,7 +193,9 @@ void write_png_rgb8(const std::string& path, int width, int height,
 
 // The threads OpenEXR compresses and decompresses the blocks of a file on (its global
 // pool, Imf::setGlobalThreadCount): 0 means none, the calling thread does the work. The
-// file's bytes are the same for any count.
+// chunks octray compresses itself (uncompressed, ZIPS, ZIP) are compressed in parallel on
+// the caller's TBB arena when the count is 2 or more, on the calling thread alone else.
+// The file's bytes are the same for any count.
 void set_exr_thread_count(int threads);
 int exr_thread_count();
 
