@@ -59,8 +59,8 @@ void on_png_warning(png_structp, png_const_charp) {}
 // octray encodes the PNGs it writes itself: a PNG octray writes is wanted soon rather than
 // small. Every row is filtered with one filter (each byte minus its left neighbour's,
 // SUB) and the rows are compressed as one zlib stream by libdeflate at its fastest level,
-// which compresses the pixels about twice as fast as zlib's fastest level did through
-// libpng, to a file of about the same size (render/image/README.md, "Compression").
+// which compresses the pixels about 1.5 times as fast as zlib's fastest level did through
+// libpng, into a smaller file (render/image/README.md, "Compression").
 // libpng reads them back in the tests.
 
 constexpr int kPngLevel = 1;
