@@ -94,7 +94,8 @@ class StopOnSignal {
 void print_bench(const Scene& scene, const view::ViewSettings& settings,
                  const view::ViewBenchResult& r) {
     std::printf("octray view --bench: %s, %s path, %d threads (0 = all)\n",
-                scene.source.c_str(), render_path_name(settings.path), settings.threads);
+                scene.source.c_str(), render_path_name(settings.render.path),
+                settings.render.threads);
     std::printf("first picture: %dx%d at %d spp after %.3f s\n", r.first_width, r.first_height,
                 r.first_spp, r.first_picture_seconds);
     std::printf(
@@ -231,9 +232,7 @@ void run_view(const ViewArguments& args) {
     check_view_memory(scene, config, args);
 
     view::ViewSettings settings;
-    settings.path = config.path;
-    settings.isa = config.isa;
-    settings.threads = config.threads;
+    settings.render = config;
     settings.preview_divisor = args.preview_divisor;
     settings.frameless_block = args.frameless_block;
     settings.order = view::parse_pixel_order(args.order).value_or(view::PixelOrder::tiled);
