@@ -3,8 +3,10 @@
 //
 // A thin facade over the renderer's internal libraries: build a scene in code or load one
 // (a JSON file or a built-in such as "whitted"), render it with either path, get the
-// linear RGB image and the ray counts, write it as OpenEXR, compare two images. Nothing
-// here exposes an internal header, so the API stays the same when the internals change.
+// linear RGB image (or a crop of it), its AOVs and the ray counts, write it as OpenEXR,
+// render an animation's frames to files as `octray render` does, compare two images.
+// Nothing here exposes an internal header, so the API stays the same when the internals
+// change.
 //
 //   #include <octray/octray.h>
 //   octray::api::Scene scene = octray::api::Scene::load("whitted");
@@ -202,7 +204,7 @@ struct RenderOptions {
     int width = 0;             // image size; 0 keeps the scene's
     int height = 0;
     int frame = 0;  // frame number (>= 0) of an animated scene: its pose and jitter
-    // Threads, tile size and ISA never change the image: only its speed.
+    // Threads, tile size (sides 1 .. 4096) and ISA never change the image: only its speed.
     int tile_width = 16;
     int tile_height = 16;
     // Called on the thread that called render(): once before the render starts, then about
