@@ -1,7 +1,7 @@
-// The API against the batch library `octray render` runs: an animation's frames written
-// by api::render_frames hold, channel for channel and bit for bit, what the CLI's frame
-// loop writes for the same scene and settings (color, AOVs, a crop's data window), and
-// api::render's AOVs are the AOV channels of those files.
+// The API against `octray render` and the batch library it runs: an animation's frames
+// written by api::render_frames hold, channel for channel and bit for bit, what the
+// command and its frame loop write for the same scene and settings (color, AOVs, a crop's
+// data window), and api::render's AOVs are the AOV channels of those files.
 
 #include <gtest/gtest.h>
 
@@ -19,6 +19,7 @@
 #include "render/batch/spec.h"
 #include "render/image/image_read.h"
 #include "render/render_config.h"
+#include "tests/tools/run_octray.h"
 
 namespace api = octray::api;
 namespace batch = octray::batch;
@@ -135,19 +136,58 @@ TEST(ApiParity, FramesWrittenByTheApiEqualTheClisFiles) {
     }
 }
 
-// The one description of a render: the API's options and the command line's names give
-// the same RenderConfig, so both render alike.
-TEST(ApiParity, TheApisSettingsAreTheConfigsOwn) {
-    octray::RenderConfig config;
-    EXPECT_THROW(config.set_aovs("depth,mist"), octray::ConfigError);
-    try {
-        (void)api::parse_aovs("depth,mist");
-        ADD_FAILURE() << "mist parsed";
-    } catch (const api::Error& e) {
+// The one description of a render: the API's names are parsed by RenderConfig, with its
+// messages, so `--aov`, `--isa` and the API take and refuse the same names.
+TEST(ApiParity, TheApisNamesAreTheConfigsOwn) {
+    for (const char* list : {"depth,mist", "", "id,id", "normal,"}) {
+        octray::RenderConfig config;
+        std::string config_error;
         try {
-            config.set_aovs("depth,mist");
-        } catch (const octray::ConfigError& c) {
-            EXPECT_STREQ(e.what(), c.what());
+            config.set_aovs(list);
+        } catch (const octray::ConfigError& e) {
+            config_error = e.what();
         }
+        ASSERT_FALSE(config_error.empty()) << list;
+        try {
+            (void)api::parse_aovs(list);
+            ADD_FAILURE() << "\"" << list << "\" parsed";
+        } catch (const api::Error& e) {
+            EXPECT_EQ(e.what(), config_error);
+        }
+    }
+    octray::RenderConfig config;
+    config.set_aovs("albedo,id");
+    const api::AovSelection s = api::parse_aovs("albedo,id");
+    EXPECT_EQ(s.depth, config.aovs.depth);
+    EXPECT_EQ(s.normal, config.aovs.normal);
+    EXPECT_EQ(s.albedo, config.aovs.albedo);
+    EXPECT_EQ(s.id, config.aovs.id);
+    config.set_isa("sse4.1");
+    EXPECT_EQ(config.isa, octray::Isa::sse4_1);
+    EXPECT_EQ(api::parse_isa("sse4.1"), api::Isa::sse4_1);
+}
+
+// The files of the octray executable itself, as a user runs it.
+TEST(ApiParity, FramesWrittenByTheApiEqualTheCommandsFiles) {
+    const std::string dir = std::string(OCTRAY_TEST_TMPDIR) + "/api_parity_exe";
+    fs::remove_all(dir);
+    const std::string scene_file = write_scene(dir);
+    const octray::testing::RunResult run = octray::testing::run_octray(
+        {"render", scene_file, "--aov", "depth,normal,albedo,id", "--float", "--crop",
+         "4,3,30,20", "--threads", "2", "--progress", "none", "-q", "-o",
+         dir + "/cli/anim.####.exr"},
+        dir);
+    ASSERT_EQ(run.status, 0) << run.output;
+
+    api::RenderOptions options{.threads = 2};
+    options.aovs = api::parse_aovs("depth,normal,albedo,id");
+    options.crop = api::Crop{4, 3, 30, 20};
+    api::FrameFilesOptions files;
+    files.output = dir + "/api/anim.####.exr";
+    files.exr.float32 = true;
+    ASSERT_EQ(api::render_frames(api::Scene::load(scene_file), options, files).rendered, 3);
+    for (int f = 0; f < 3; ++f) {
+        const std::string name = "/anim.000" + std::to_string(f) + ".exr";
+        expect_same_pixels(dir + "/cli" + name, dir + "/api" + name);
     }
 }
