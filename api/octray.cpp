@@ -30,6 +30,7 @@
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
+#include "render/memory_estimate.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "render/render_config.h"
@@ -732,7 +733,16 @@ FrameFilesResult render_frames(const Scene& scene, const RenderOptions& options,
         } catch (const batch::SpecError& e) {
             throw std::invalid_argument(e.what());
         }
-        settings.write_behind = jobs.size() > 1;
+        // A frame is written while the next renders, as `octray render` does, when the
+        // memory estimate of two frames in flight fits this machine's memory.
+        RenderMemoryParams memory = config.memory_params();
+        memory.float32_output = files.exr.float32;
+        memory.png_preview = !files.png.empty();
+        memory.write_behind = true;
+        const std::uint64_t machine = machine_memory_bytes();
+        settings.write_behind =
+            jobs.size() > 1 &&
+            (machine == 0 || estimate_render_memory(scenes[0].scene, memory).total <= machine);
         batch::prepare_output_directories(jobs);
 
         FrameFilesObserver observer(scenes, jobs);
