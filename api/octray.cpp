@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <exception>
+#include <filesystem>
 #include <mutex>
 #include <new>
 #include <stdexcept>
@@ -19,12 +21,19 @@
 
 #include "core/version.h"
 #include "kernels/dispatch.h"
+#include "render/batch/digest.h"
+#include "render/batch/frame_loop.h"
+#include "render/batch/output_paths.h"
+#include "render/batch/plan.h"
+#include "render/batch/spec.h"
 #include "render/frame_renderer.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
+#include "render/memory_estimate.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
+#include "render/render_config.h"
 #include "scene/animation.h"
 #include "scene/load.h"
 #include "scene/scene.h"
@@ -163,15 +172,17 @@ struct CallbackFailure {
     std::exception_ptr error;
 };
 
-// Runs `run` (a render with options `o`) on a thread of its own while this thread calls
-// options.progress with the pixels done, and stops it when the callback says so.
-template <typename Run>
-octray::RenderResult render_reporting(const Run& run, octray::RenderOptions& o,
-                                      const octray::Scene& scene,
-                                      const RenderOptions& options) {
+// Runs `run` on a thread of its own while this thread calls options.progress with
+// done() of pixels_total pixels, and sets `cancel` (which `run` polls) when the callback
+// says stop. A run stopped that way throws RenderCancelled, which becomes
+// Error(cancelled); with `cancel_throws` false a stop before the run starts does not throw
+// either (the run sees `cancel` set and returns what it has).
+template <typename Run, typename Done>
+auto run_reporting(const Run& run, const Done& done, std::atomic<bool>& cancel,
+                   std::uint64_t pixels_total, const RenderOptions& options,
+                   bool cancel_throws = true) -> decltype(run()) {
     Progress progress;
-    progress.pixels_total = static_cast<std::uint64_t>(scene.image.width) *
-                            static_cast<std::uint64_t>(scene.image.height);
+    progress.pixels_total = pixels_total;
     const auto ask = [&] {
         try {
             return options.progress(progress);
@@ -179,16 +190,16 @@ octray::RenderResult render_reporting(const Run& run, octray::RenderOptions& o,
             throw CallbackFailure{std::current_exception()};
         }
     };
-    if (!ask()) throw Error(ErrorKind::cancelled, "render cancelled by the progress callback");
-    std::atomic<bool> cancel{false};
-    std::atomic<std::uint64_t> pixels{0};
-    o.cancel = &cancel;
-    o.pixels_done = &pixels;
+    if (!ask()) {
+        if (cancel_throws)
+            throw Error(ErrorKind::cancelled, "render cancelled by the progress callback");
+        cancel = true;
+    }
 
     std::mutex mutex;
     std::condition_variable finished_cv;
     bool finished = false;
-    octray::RenderResult result;
+    decltype(run()) result{};
     std::exception_ptr failure;
     std::thread worker([&] {
         try {
@@ -206,7 +217,7 @@ octray::RenderResult render_reporting(const Run& run, octray::RenderOptions& o,
         std::unique_lock lock(mutex);
         while (!finished_cv.wait_for(lock, interval, [&] { return finished; })) {
             if (cancel.load() || callback_failure) continue;  // waiting for the stop
-            progress.pixels_done = std::min(pixels.load(), progress.pixels_total);
+            progress.pixels_done = std::min(done(), progress.pixels_total);
             lock.unlock();
             try {
                 if (!options.progress(progress)) cancel = true;
@@ -226,9 +237,57 @@ octray::RenderResult render_reporting(const Run& run, octray::RenderOptions& o,
             throw Error(ErrorKind::cancelled, "render cancelled by the progress callback");
         }
     }
-    progress.pixels_done = progress.pixels_total;
-    static_cast<void>(ask());  // done: its answer changes nothing
+    if (!cancel.load()) {
+        progress.pixels_done = progress.pixels_total;
+        static_cast<void>(ask());  // done: its answer changes nothing
+    }
     return result;
+}
+
+// The one description of a render (render/render_config.h) that the API's options give,
+// checked.
+octray::RenderConfig to_config(const RenderOptions& options) {
+    if (options.width < 0 || options.height < 0 || options.spp < 0)
+        throw std::invalid_argument(
+            "render: width, height and spp must be >= 0 (0 keeps the scene's)");
+    octray::RenderConfig config;
+    config.path = options.path == Path::scalar ? RenderPath::scalar : RenderPath::simd;
+    config.isa = to_internal(options.isa);
+    config.threads = options.threads;
+    config.tile = {options.tile_width, options.tile_height};
+    if (options.width > 0) config.overrides.width = options.width;
+    if (options.height > 0) config.overrides.height = options.height;
+    if (options.spp > 0) config.overrides.spp = options.spp;
+    if (options.crop) {
+        const Crop& c = *options.crop;
+        config.crop = PixelRect{c.x0, c.y0, c.x1, c.y1};
+    }
+    config.aovs = {options.aovs.depth, options.aovs.normal, options.aovs.albedo,
+                   options.aovs.id};
+    config.check();
+    return config;
+}
+
+// The scene with the options' overrides applied, validated, and the crop checked against
+// it; the ISA resolved.
+octray::Scene configured_scene(const Scene& scene, octray::RenderConfig& config) {
+    octray::Scene source = SceneAccess::get(scene);
+    apply_overrides(source, config.overrides);
+    validate_scene(source);
+    config.check_crop(source.image.width, source.image.height);
+    config.resolve_isa();
+    return source;
+}
+
+Aovs from_internal(const AovImages& a) {
+    Aovs out;
+    out.depth = a.depth;
+    out.normal.reserve(3 * a.normal.size());
+    for (const octray::Vec3& n : a.normal) out.normal.insert(out.normal.end(), {n.x, n.y, n.z});
+    out.albedo.reserve(3 * a.albedo.size());
+    for (const octray::Rgb& c : a.albedo) out.albedo.insert(out.albedo.end(), {c.r, c.g, c.b});
+    out.id = a.id;
+    return out;
 }
 
 }  // namespace
@@ -394,6 +453,23 @@ std::string Scene::to_json() const {
 
 const char* isa_name(Isa isa) { return octray::isa_name(to_internal(isa)); }
 
+Isa parse_isa(const std::string& name) {
+    return translate_errors([&] {
+        octray::RenderConfig config;
+        config.set_isa(name);
+        return from_internal(config.isa);
+    });
+}
+
+AovSelection parse_aovs(const std::string& list) {
+    return translate_errors([&] {
+        octray::RenderConfig config;
+        config.set_aovs(list);
+        return AovSelection{config.aovs.depth, config.aovs.normal, config.aovs.albedo,
+                            config.aovs.id};
+    });
+}
+
 std::vector<Isa> supported_isas() {
     std::vector<Isa> out;
     for (octray::Isa isa : octray::supported_isas()) out.push_back(from_internal(isa));
@@ -403,55 +479,59 @@ std::vector<Isa> supported_isas() {
 // The render options checked, and the scene they apply to, once per Renderer.
 struct Renderer::Impl {
     RenderOptions options;
-    octray::Scene source;  // the overrides applied, validated
-    octray::RenderOptions internal;
-    octray::Isa isa = octray::Isa::automatic;  // resolved (simd path)
+    octray::RenderConfig config;  // checked, the ISA resolved
+    octray::Scene source;         // the overrides applied, validated
     // The frames of `source`, posed and prepared once (render/frame_renderer.h).
     std::unique_ptr<octray::FrameRenderer> renderer;
 
-    Impl(const Scene& scene, const RenderOptions& o) : options(o) {
-        // The command line's limits (render --help): a thread count beyond them would ask
-        // the OS for that many threads (INT_MAX crashed TBB), a negative size or spp was
-        // silently ignored.
-        if (options.threads < 0 || options.threads > kMaxRenderThreads)
-            throw std::invalid_argument("render: threads must be from 0 to " +
-                                        std::to_string(kMaxRenderThreads) + ", not " +
-                                        std::to_string(options.threads));
-        if (options.width < 0 || options.height < 0 || options.spp < 0)
-            throw std::invalid_argument(
-                "render: width, height and spp must be >= 0 (0 keeps the scene's)");
-        if (options.tile_width < 1 || options.tile_height < 1)
-            throw std::invalid_argument("render: tiles must be at least 1x1");
-        source = SceneAccess::get(scene);
-        if (options.width > 0) source.image.width = options.width;
-        if (options.height > 0) source.image.height = options.height;
-        if (options.spp > 0) source.image.spp = options.spp;
-        validate_scene(source);
-        internal.threads = options.threads;
-        internal.tile_width = options.tile_width;
-        internal.tile_height = options.tile_height;
-        if (options.path != Path::scalar) isa = resolve_isa(to_internal(options.isa));
-        renderer = std::make_unique<octray::FrameRenderer>(
-            source, options.path == Path::scalar ? RenderPath::scalar : RenderPath::simd, isa,
-            octray::Accel::automatic, options.threads);
+    Impl(const Scene& scene, const RenderOptions& o)
+        : options(o), config(to_config(o)), source(configured_scene(scene, config)) {
+        renderer = std::make_unique<octray::FrameRenderer>(source, config.path, config.isa,
+                                                           config.accel, config.threads);
     }
 
     RenderResult render(int frame) {
         if (frame < 0) throw std::invalid_argument("render: frame must be >= 0");
-        const octray::Scene& scene = renderer->prepare(frame);
-        octray::RenderOptions o = internal;
+        octray::RenderOptions o = config.render_options();
         o.frame = static_cast<std::uint32_t>(frame);
-        // With a progress callback, on a thread of its own (render_reporting).
-        const auto run = [&] { return renderer->render(o); };
-        const octray::RenderResult r =
-            options.progress ? render_reporting(run, o, scene, options) : run();
+        struct Rendered {
+            octray::RenderResult result;
+            AovImages aovs;
+        };
+        // Preparing the frame (compiling the scene and building its BVH for the first
+        // frame) is part of the run the progress callback reports.
+        const auto run = [&] {
+            Rendered r;
+            renderer->prepare(frame);
+            r.result = renderer->render(o);
+            if (config.aovs.any()) r.aovs = renderer->aovs(o, config.aovs);
+            return r;
+        };
+        Rendered r;
+        if (options.progress) {
+            std::atomic<bool> cancel{false};
+            std::atomic<std::uint64_t> pixels{0};
+            o.cancel = &cancel;
+            o.pixels_done = &pixels;
+            const std::uint64_t total =
+                config.crop ? config.crop->pixel_count()
+                            : static_cast<std::uint64_t>(source.image.width) *
+                                  static_cast<std::uint64_t>(source.image.height);
+            r = run_reporting(
+                run, [&] { return pixels.load(); }, cancel, total, options);
+        } else {
+            r = run();
+        }
         RenderResult out;
-        out.path = options.path == Path::scalar
-                       ? std::string("scalar")
-                       : std::string("simd (") + octray::isa_name(isa) + ")";
-        out.image = from_internal(r.image);
-        out.rays = {r.rays.primary, r.rays.shadow, r.rays.reflected, r.rays.refracted};
-        out.seconds = r.seconds;
+        out.path = config.path_label();
+        out.image = from_internal(r.result.image);
+        out.rays = {r.result.rays.primary, r.result.rays.shadow, r.result.rays.reflected,
+                    r.result.rays.refracted};
+        out.seconds = r.result.seconds;
+        if (config.aovs.any()) out.aovs = from_internal(r.aovs);
+        out.window = {r.result.rect.x0, r.result.rect.y0, r.result.rect.x1, r.result.rect.y1};
+        out.full_width = r.result.full_width;
+        out.full_height = r.result.full_height;
         return out;
     }
 };
@@ -526,6 +606,167 @@ CompareResult compare_files(const std::string& a, const std::string& b,
     return translate_errors([&] {
         return compare_channels(octray::read_image(a), octray::read_image(b), options);
     });
+}
+
+// ---- Frames to files ---------------------------------------------------------------------
+
+namespace {
+
+// The frame loop's reports as FrameFiles, and its pixels done over the whole run: the
+// frames started before (each whole, however it ended) plus the one rendering.
+class FrameFilesObserver : public batch::BatchObserver {
+  public:
+    explicit FrameFilesObserver(const std::vector<batch::BatchScene>& scenes,
+                                const std::vector<batch::BatchJob>& jobs)
+        : scenes_(scenes), jobs_(jobs) {}
+
+    std::atomic<std::uint64_t>* pixel_counter() override { return &pixels_; }
+    void frame_started(std::size_t index, const std::string&, int, std::uint64_t,
+                       int) override {
+        done_ += current_;
+        current_ = frame_pixels(index);
+        started_.push_back(index);
+        pixels_ = 0;
+    }
+    void frame_finished(const batch::FrameReport& report, std::uint64_t) override {
+        if (std::find(started_.begin(), started_.end(), report.index) == started_.end())
+            done_ += frame_pixels(report.index);  // skipped, or failed before rendering
+        FrameFile f;
+        f.frame = report.frame;
+        f.output = report.output;
+        f.png = report.preview;
+        f.status = report.outcome == batch::FrameOutcome::rendered ? FrameStatus::rendered
+                   : report.outcome == batch::FrameOutcome::failed ? FrameStatus::failed
+                                                                   : FrameStatus::skipped;
+        f.message = report.message;
+        f.rays = report.rays;
+        f.seconds = report.seconds;
+        const std::lock_guard lock(mutex_);
+        files_.push_back(std::move(f));
+    }
+
+    std::uint64_t frame_pixels(std::size_t index) const {
+        const batch::BatchScene& scene = scenes_[jobs_[index - 1].scene];
+        return scene.crop ? scene.crop->pixel_count()
+                          : static_cast<std::uint64_t>(scene.scene.image.width) *
+                                static_cast<std::uint64_t>(scene.scene.image.height);
+    }
+    std::uint64_t total_pixels() const {
+        std::uint64_t total = 0;
+        for (std::size_t i = 1; i <= jobs_.size(); ++i) total += frame_pixels(i);
+        return total;
+    }
+    std::uint64_t done() const { return done_.load() + pixels_.load(); }
+    std::vector<FrameFile> take_files() {
+        const std::lock_guard lock(mutex_);
+        std::sort(files_.begin(), files_.end(), [&](const FrameFile& a, const FrameFile& b) {
+            return index_of(a) < index_of(b);
+        });
+        return std::move(files_);
+    }
+
+  private:
+    std::size_t index_of(const FrameFile& f) const {
+        for (std::size_t i = 0; i < jobs_.size(); ++i)
+            if (jobs_[i].output == f.output) return i;
+        return jobs_.size();
+    }
+
+    const std::vector<batch::BatchScene>& scenes_;
+    const std::vector<batch::BatchJob>& jobs_;
+    std::atomic<std::uint64_t> pixels_{0};
+    std::atomic<std::uint64_t> done_{0};
+    std::uint64_t current_ = 0;
+    std::vector<std::size_t> started_;
+    std::mutex mutex_;
+    std::vector<FrameFile> files_;
+};
+
+// Whether an output name chooses PNG (else OpenEXR); any other extension is refused.
+bool png_output(const std::string& what, const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".png") return true;
+    if (ext == ".exr") return false;
+    throw std::invalid_argument(what + " \"" + path +
+                                "\": the extension chooses the format: .exr or .png");
+}
+
+}  // namespace
+
+FrameFilesResult render_frames(const Scene& scene, const RenderOptions& options,
+                               const FrameFilesOptions& files) try {
+    return translate_errors([&] {
+        const auto started = std::chrono::steady_clock::now();
+        octray::RenderConfig config = to_config(options);
+        batch::BatchScene loaded;
+        loaded.scene = configured_scene(scene, config);
+        loaded.spec = loaded.scene.source;
+        loaded.name = loaded.spec == "<api>" ? std::string("scene")
+                                             : batch::scene_display_name(loaded.spec);
+        loaded.sha256 = batch::sha256_hex(scene_to_json(loaded.scene));
+        loaded.crop = config.crop;
+        const std::vector<batch::BatchScene> scenes{std::move(loaded)};
+
+        batch::BatchRequest request;
+        request.threads = config.threads;
+        request.frames = files.frames;
+        request.output = files.output;
+        request.png = files.png;
+        batch::BatchSettings settings;
+        settings.render = config;
+        settings.exr.float32 = files.exr.float32;
+        settings.png_output = !files.output.empty() && png_output("output", files.output);
+        if (!files.png.empty() && png_output("png", files.png) == false)
+            throw std::invalid_argument("png \"" + files.png + "\": a preview is a .png");
+        if (settings.png_output &&
+            (config.aovs.any() || files.exr.float32 || !files.png.empty()))
+            throw std::invalid_argument("output \"" + files.output +
+                                        "\" is an 8-bit PNG, which holds R, G, B only: AOVs, "
+                                        "float32 and a png preview need an .exr output");
+        settings.skip_existing = files.skip_existing;
+        std::vector<batch::BatchJob> jobs;
+        try {
+            jobs = batch::plan_jobs(scenes, request);
+        } catch (const batch::RequestError& e) {
+            throw std::invalid_argument(e.what());
+        } catch (const batch::SpecError& e) {
+            throw std::invalid_argument(e.what());
+        }
+        // A frame is written while the next renders, as `octray render` does, when the
+        // memory estimate of two frames in flight fits this machine's memory.
+        RenderMemoryParams memory = config.memory_params();
+        memory.float32_output = files.exr.float32;
+        memory.png_preview = !files.png.empty();
+        memory.write_behind = true;
+        const std::uint64_t machine = machine_memory_bytes();
+        settings.write_behind =
+            jobs.size() > 1 &&
+            (machine == 0 || estimate_render_memory(scenes[0].scene, memory).total <= machine);
+        batch::prepare_output_directories(jobs);
+
+        FrameFilesObserver observer(scenes, jobs);
+        std::atomic<bool> cancel{false};
+        const auto run = [&] {
+            return batch::run_batch(scenes, jobs, settings, observer, &cancel);
+        };
+        const batch::BatchSummary summary =
+            options.progress ? run_reporting(
+                                   run, [&] { return observer.done(); }, cancel,
+                                   observer.total_pixels(), options, /*cancel_throws=*/false)
+                             : run();
+        FrameFilesResult out;
+        out.frames = observer.take_files();
+        out.rendered = static_cast<int>(summary.rendered);
+        out.skipped = static_cast<int>(summary.skipped);
+        out.failed = static_cast<int>(summary.failed);
+        out.cancelled = summary.interrupted;
+        out.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        return out;
+    });
+} catch (const CallbackFailure& failure) {
+    std::rethrow_exception(failure.error);
 }
 
 }  // namespace octray::api

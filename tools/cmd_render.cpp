@@ -95,34 +95,43 @@ auto usage_errors(F&& f) -> decltype(f()) {
     }
 }
 
-// What the options ask of octray::batch, as its plain request: the overrides only where
-// the user gave the option, so the scene's own value stays otherwise.
-batch::BatchRequest batch_request(const RenderArguments& args) {
+// What the options ask of octray::batch, as its plain request, with the scene overrides
+// of the render's description.
+batch::BatchRequest batch_request(const RenderArguments& args, const RenderConfig& config) {
     batch::BatchRequest request;
-    if (args.width_option->count()) request.overrides.width = args.width;
-    if (args.height_option->count()) request.overrides.height = args.height;
-    if (args.spp_option->count()) request.overrides.spp = args.spp;
-    if (args.max_depth_option->count()) request.overrides.max_depth = args.max_depth;
-    if (args.seed_option->count()) request.overrides.seed = args.seed;
-    request.threads = args.threads;
+    request.overrides = config.overrides;
+    request.threads = config.threads;
     request.frames = args.frames;
     request.output = args.output;
     request.png = args.png;
     return request;
 }
 
-// --aov and --accel values, as UsageErrors when bad.
-AovSet parse_aov_option(const std::string& text) {
-    std::string error;
-    const auto set = parse_aov_list(text, &error);
-    if (!set) throw UsageError("--aov: " + error);
-    return *set;
-}
-
-Accel parse_accel_option(const std::string& text) {
-    const auto accel = parse_accel(text);
-    if (!accel) throw UsageError("--accel: expected auto, bvh or none, not " + text);
-    return *accel;
+// The description of the render (render/render_config.h) that the options give, its
+// settings parsed and checked there; a bad one is a usage error naming its option.
+RenderConfig render_config(const RenderArguments& args) {
+    RenderConfig config;
+    try {
+        config.set_path(args.path);
+        config.set_isa(args.isa);
+        config.set_accel(args.accel);
+        config.set_tile(args.tile);
+        if (!args.aov.empty()) config.set_aovs(args.aov);
+        config.threads = args.threads;
+        // The overrides only where the user gave the option, so the scene's own value
+        // stays otherwise.
+        if (args.width_option->count()) config.overrides.width = args.width;
+        if (args.height_option->count()) config.overrides.height = args.height;
+        if (args.spp_option->count()) config.overrides.spp = args.spp;
+        if (args.max_depth_option->count()) config.overrides.max_depth = args.max_depth;
+        if (args.seed_option->count()) config.overrides.seed = args.seed;
+        config.check();
+        config.resolve_isa();
+    } catch (const ConfigError& e) {
+        const std::string option = e.setting() == "aovs" ? "aov" : e.setting();
+        throw UsageError("--" + option + ": " + e.detail());
+    }
+    return config;
 }
 
 // The exit status of a finished run (commands.h, plus 128 + the signal when interrupted).
@@ -181,19 +190,7 @@ batch::Shard resolve_shard(const RenderArguments& args) {
 void run_render(const RenderArguments& args) {
     // Everything about the command line first: no render time is spent on a bad one.
     batch::BatchSettings settings;
-    settings.path = *parse_render_path(args.path);  // CLI11 allowed only these two
-    if (settings.path == RenderPath::simd) {
-        try {
-            settings.isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
-        } catch (const std::runtime_error& e) {
-            throw UsageError(std::string("--isa: ") + e.what());
-        }
-    }
-    const auto tile = parse_tile_size(args.tile);
-    if (!tile) throw UsageError("--tile: expected WxH, e.g. 16x16");
-    settings.options.tile_width = tile->width;
-    settings.options.tile_height = tile->height;
-    settings.options.threads = args.threads;
+    settings.render = render_config(args);
     const auto compression = parse_exr_compression(args.compression);
     if (!compression) throw UsageError("--compression: unknown codec " + args.compression);
     settings.exr = {args.float32, *compression};
@@ -203,8 +200,6 @@ void run_render(const RenderArguments& args) {
     settings.placeholders = args.placeholders;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
     if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
-    if (!args.aov.empty()) settings.aovs = parse_aov_option(args.aov);
-    settings.options.accel = parse_accel_option(args.accel);
     std::uint64_t memory_limit = machine_memory_bytes();  // 0 if unknown: no limit
     if (!args.max_memory.empty()) {
         const auto limit = parse_memory_size(args.max_memory);
@@ -248,27 +243,18 @@ void run_render(const RenderArguments& args) {
     // Before oneTBB starts a worker (loading a scene file may): it would abort where they
     // cannot all start (ulimit -v); this says so instead, exit 1.
     check_threads_can_start(args.threads);
-    const batch::BatchRequest request = batch_request(args);
+    const batch::BatchRequest request = batch_request(args, settings.render);
     std::vector<batch::BatchScene> scenes;
     for (const std::string& spec : args.scenes) {
         scenes.push_back(usage_errors([&] { return batch::load_batch_scene(spec, request); }));
         print_scene_warnings(scenes.back().scene, args.quiet);
     }
 
-    RenderMemoryParams memory;
-    memory.threads = args.threads;
-    memory.tile_width = tile->width;
-    memory.tile_height = tile->height;
-    memory.packet_path = settings.path == RenderPath::simd;
-    memory.accel = settings.options.accel;
+    RenderMemoryParams memory = settings.render.memory_params();
     memory.float32_output = args.float32;
     memory.exr_lines_per_chunk = exr_lines_per_chunk(*compression);
     memory.png_preview = !args.png.empty();
     memory.progressive = args.progressive;
-    memory.aov_depth = settings.aovs.depth;
-    memory.aov_normal = settings.aovs.normal;
-    memory.aov_albedo = settings.aovs.albedo;
-    memory.aov_id = settings.aovs.id;
     // A frame is written while the next one renders (--progressive writes its passes as
     // they finish).
     bool write_behind = !args.progressive;

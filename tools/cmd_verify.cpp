@@ -22,6 +22,7 @@
 #include "render/memory_estimate.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
+#include "render/render_config.h"
 #include "scene/animation.h"
 #include "scene/load.h"
 #include "tools/cli_checks.h"
@@ -70,10 +71,10 @@ ChannelImage to_channels(const Image& image) {
 
 // Renders one frame with both paths and reports; true when they agree. `diff` and
 // `heatmap` name the pictures of this frame, or are empty.
-bool verify_frame(const VerifyArguments& args, const Scene& scene, Isa isa,
+bool verify_frame(const VerifyArguments& args, const Scene& scene, const RenderConfig& config,
                   const std::string& diff, const std::string& heatmap) {
-    RenderOptions options;
-    options.threads = args.threads;
+    const Isa isa = config.isa;
+    const RenderOptions options = config.render_options();
     const RenderResult ref = render_reference(scene, options);
     const RenderResult simd = render_packet(scene, options, isa);
     std::printf("scalar   %.3f s, %llu rays\n", ref.seconds,
@@ -126,11 +127,18 @@ bool verify_frame(const VerifyArguments& args, const Scene& scene, Isa isa,
 
 void run_verify(const VerifyArguments& args) {
     check_threads_can_start(args.threads);  // before oneTBB starts a worker (ulimit -v)
-    Isa isa = Isa::automatic;
+    // The description of the simd side's render (render/render_config.h).
+    RenderConfig config;
     try {
-        isa = resolve_isa(parse_isa(args.isa).value_or(Isa::automatic));
-    } catch (const std::runtime_error& e) {
-        throw UsageError(std::string("--isa: ") + e.what());
+        config.set_isa(args.isa);
+        config.threads = args.threads;
+        if (args.width > 0) config.overrides.width = args.width;
+        if (args.height > 0) config.overrides.height = args.height;
+        if (args.spp > 0) config.overrides.spp = args.spp;
+        config.check();
+        config.resolve_isa();
+    } catch (const ConfigError& e) {
+        throw UsageError("--" + e.setting() + ": " + e.detail());
     }
     std::vector<int> frames{0};
     if (!args.frames.empty()) {
@@ -150,9 +158,7 @@ void run_verify(const VerifyArguments& args) {
                          args.heatmap);
     Scene scene = load_scene(args.scene);
     print_scene_warnings(scene, args.quiet);
-    if (args.width > 0) scene.image.width = args.width;
-    if (args.height > 0) scene.image.height = args.height;
-    if (args.spp > 0) scene.image.spp = args.spp;
+    apply_overrides(scene, config.overrides);
     validate_scene(scene);
     // Both renders' framebuffers must fit in this machine's memory; the estimate counts one
     // render (render/memory_estimate.h). A scene's validity does not depend on the machine.
@@ -175,7 +181,7 @@ void run_verify(const VerifyArguments& args) {
         const std::string heatmap =
             args.heatmap.empty() ? "" : frame_file(args.heatmap, frame, several);
         failed += verify_frame(args, args.frames.empty() ? scene : scene_at_frame(scene, frame),
-                               isa, diff, heatmap)
+                               config, diff, heatmap)
                       ? 0
                       : 1;
     }

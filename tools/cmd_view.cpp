@@ -25,6 +25,7 @@
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
 #include "render/memory_estimate.h"
+#include "render/render_config.h"
 #include "render/view/compare_view.h"
 #include "render/view/jpeg.h"
 #include "render/view/view_bench.h"
@@ -93,7 +94,8 @@ class StopOnSignal {
 void print_bench(const Scene& scene, const view::ViewSettings& settings,
                  const view::ViewBenchResult& r) {
     std::printf("octray view --bench: %s, %s path, %d threads (0 = all)\n",
-                scene.source.c_str(), render_path_name(settings.path), settings.threads);
+                scene.source.c_str(), render_path_name(settings.render.path),
+                settings.render.threads);
     std::printf("first picture: %dx%d at %d spp after %.3f s\n", r.first_width, r.first_height,
                 r.first_spp, r.first_picture_seconds);
     std::printf(
@@ -163,11 +165,33 @@ void run_compare_view(const ViewArguments& args) {
     std::cout << "octray view: stopped\n" << std::flush;
 }
 
+// How the viewer renders at first (render/render_config.h): the path, ISA, threads and
+// the scene's overrides its options give; the page's switches change them later.
+RenderConfig view_config(const ViewArguments& args) {
+    RenderConfig config;
+    try {
+        config.set_path(args.path);
+        config.set_isa(args.isa);
+        config.threads = args.threads;
+        if (args.width > 0) config.overrides.width = args.width;
+        if (args.height > 0) config.overrides.height = args.height;
+        if (args.spp > 0) config.overrides.spp = args.spp;
+        if (args.max_depth > 0) config.overrides.max_depth = args.max_depth;
+        config.check();
+        RenderConfig resolved = config;  // each render resolves "auto" again
+        resolved.resolve_isa();
+    } catch (const ConfigError& e) {
+        throw UsageError("--" + e.setting() + ": " + e.detail());
+    }
+    return config;
+}
+
 // The viewer holds what a progressive `render --png` holds (the picture, the sums of its
 // passes, a PNG of it) and more threads' scratch: refused by the same estimate as `render`
 // when it exceeds the limit (--max-memory, else this machine's memory), rather than
 // starting and failing on its first picture with std::bad_alloc.
-void check_view_memory(const Scene& scene, const ViewArguments& args) {
+void check_view_memory(const Scene& scene, const RenderConfig& config,
+                       const ViewArguments& args) {
     std::uint64_t limit = machine_memory_bytes();  // 0 if unknown: no limit
     if (!args.max_memory.empty()) {
         const auto parsed = parse_memory_size(args.max_memory);
@@ -177,9 +201,7 @@ void check_view_memory(const Scene& scene, const ViewArguments& args) {
         limit = *parsed;
     }
     if (limit == 0) return;
-    RenderMemoryParams memory;
-    memory.threads = args.threads;
-    memory.packet_path = args.path == "simd";
+    RenderMemoryParams memory = config.memory_params();
     memory.progressive = true;
     memory.png_preview = true;
     try {
@@ -203,23 +225,14 @@ void run_view(const ViewArguments& args) {
     const std::string spec = args.inputs.empty() ? std::string("whitted") : args.inputs[0];
     // The digest names the scene in the header of a saved picture, as in `octray render`'s.
     // An animation is shown at frame 0; the page's slider poses the others.
+    const RenderConfig config = view_config(args);
     auto [scene, sha256] = batch::load_scene_and_digest(spec, args.threads);
-    if (args.width > 0) scene.image.width = args.width;
-    if (args.height > 0) scene.image.height = args.height;
-    if (args.spp > 0) scene.image.spp = args.spp;
-    if (args.max_depth > 0) scene.render.max_depth = args.max_depth;
+    apply_overrides(scene, config.overrides);
     validate_scene(scene);
-    check_view_memory(scene, args);
+    check_view_memory(scene, config, args);
 
     view::ViewSettings settings;
-    settings.path = *parse_render_path(args.path);
-    settings.isa = parse_isa(args.isa).value_or(Isa::automatic);
-    try {
-        resolve_isa(settings.isa);  // each render resolves "auto" again
-    } catch (const std::runtime_error& e) {
-        throw UsageError(std::string("--isa: ") + e.what());
-    }
-    settings.threads = args.threads;
+    settings.render = config;
     settings.preview_divisor = args.preview_divisor;
     settings.frameless_block = args.frameless_block;
     settings.order = view::parse_pixel_order(args.order).value_or(view::PixelOrder::tiled);

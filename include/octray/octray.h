@@ -3,8 +3,10 @@
 //
 // A thin facade over the renderer's internal libraries: build a scene in code or load one
 // (a JSON file or a built-in such as "whitted"), render it with either path, get the
-// linear RGB image and the ray counts, write it as OpenEXR, compare two images. Nothing
-// here exposes an internal header, so the API stays the same when the internals change.
+// linear RGB image (or a crop of it), its AOVs and the ray counts, write it as OpenEXR,
+// render an animation's frames to files as `octray render` does, compare two images.
+// Nothing here exposes an internal header, so the API stays the same when the internals
+// change.
 //
 //   #include <octray/octray.h>
 //   octray::api::Scene scene = octray::api::Scene::load("whitted");
@@ -19,6 +21,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -156,6 +159,8 @@ enum class Isa {
 
 // "auto", "sse2", "sse4.1", "avx2", "avx512".
 const char* isa_name(Isa isa);
+// The ISA of a name isa_name() gives; Error(invalid_argument) for any other.
+Isa parse_isa(const std::string& name);
 // The ISAs this CPU can run, best last (never Isa::automatic).
 std::vector<Isa> supported_isas();
 
@@ -168,6 +173,29 @@ struct Progress {
     }
 };
 
+// Arbitrary output variables rendered alongside the image (`octray render --aov`): each
+// pixel's first surface along its sample-0 camera ray, the same values on either path and
+// bit for bit what `octray render --aov` writes into its EXR.
+struct AovSelection {
+    bool depth = false;   // distance along the unit camera ray to the first hit
+    bool normal = false;  // the hit's world-space unit normal, facing the ray
+    bool albedo = false;  // the diffuse color Cd at the hit (checker included)
+    bool id = false;      // the hit object's index + 1 (spheres and planes in the order added)
+    bool any() const { return depth || normal || albedo || id; }
+};
+
+// "depth,normal,albedo,id" (any of them, each once, comma-separated) as a selection;
+// Error(invalid_argument) naming an unknown, empty or repeated item.
+AovSelection parse_aovs(const std::string& list);
+
+// A rectangle of pixels of the full image: columns x0 .. x1-1, rows y0 .. y1-1, row 0 on
+// top (`octray render --crop x0,y0,x1,y1`).
+struct Crop {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+};
+
 struct RenderOptions {
     Path path = Path::simd;
     Isa isa = Isa::automatic;  // simd path only; a forced ISA the CPU lacks is an Error
@@ -176,7 +204,7 @@ struct RenderOptions {
     int width = 0;             // image size; 0 keeps the scene's
     int height = 0;
     int frame = 0;  // frame number (>= 0) of an animated scene: its pose and jitter
-    // Threads, tile size and ISA never change the image: only its speed.
+    // Threads, tile size (sides 1 .. 4096) and ISA never change the image: only its speed.
     int tile_width = 16;
     int tile_height = 16;
     // Called on the thread that called render(): once before the render starts, then about
@@ -184,8 +212,17 @@ struct RenderOptions {
     // answer then changes nothing). Returning false stops the render at its next tile (it
     // waits for the tiles in flight, milliseconds): render() then throws
     // Error(ErrorKind::cancelled) and returns no image. Empty: no calls.
+    // Preparing a frame (on the simd path, a scene's first frame compiles it and builds
+    // its BVH) is part of the render: the first call comes before it, and the calls go on
+    // while it runs (pixels_done 0) and can stop the render after it.
     std::function<bool(const Progress&)> progress = nullptr;
     int progress_interval_ms = 100;
+    // Only this window of the image (width x height after the overrides): RenderResult's
+    // image (and AOVs) are crop-sized, each pixel bit for bit the same pixel of the whole
+    // image. Empty or outside the image: Error(invalid_argument). Unset: the whole image.
+    std::optional<Crop> crop = std::nullopt;
+    // The AOVs to render alongside the image (RenderResult::aovs); none by default.
+    AovSelection aovs{};
 };
 
 // Linear RGB floats, row 0 on top: pixel (x, y) is rgb[3 * (y * width + x) + {0, 1, 2}].
@@ -203,11 +240,28 @@ struct RayCounts {
     std::uint64_t total() const { return primary + shadow + reflected + refracted; }
 };
 
+// The AOVs of RenderOptions::aovs, pixel (x, y) of the image at index y * width + x (three
+// floats per pixel for normal and albedo, as Image::rgb); a vector is empty unless its AOV
+// was asked for. Background pixels (no hit) hold +inf depth, a zero normal and albedo,
+// id 0.
+struct Aovs {
+    std::vector<float> depth{};
+    std::vector<float> normal{};  // x, y, z
+    std::vector<float> albedo{};  // r, g, b (linear)
+    std::vector<std::uint32_t> id{};
+};
+
 struct RenderResult {
     Image image;
     RayCounts rays;
     double seconds = 0.0;  // wall-clock time of the render
     std::string path;      // "scalar", or "simd (avx2)" with the ISA used
+    Aovs aovs{};           // the AOVs asked for, the size of `image`
+    // Which pixels of the full_width x full_height image `image` holds: the crop, or the
+    // whole image.
+    Crop window{};
+    int full_width = 0;
+    int full_height = 0;
 };
 
 // Renders the scene (or its animation frame options.frame) with the options' overrides
@@ -283,5 +337,55 @@ CompareResult compare(const Image& a, const Image& b, const CompareOptions& opti
 // The same for two files (every channel, as `octray compare`).
 CompareResult compare_files(const std::string& a, const std::string& b,
                             const CompareOptions& options = {});
+
+// ---- Frames to files ----------------------------------------------------------------
+// An animation's frames (or a still) rendered to files by the frame loop of `octray render`
+// (the same library): each frame's EXR (with AOV channels, a crop's data window and the
+// header attributes of `octray render --help`) and optional PNG preview written
+// atomically, complete or absent; a frame that fails is reported and the others go on.
+
+struct FrameFilesOptions {
+    // The files: `#` runs or {frame:04d} become the frame number, {scene} the scene's name
+    // (a loaded scene's file stem or built-in name, "scene" for one built in code); .exr,
+    // or .png for the 8-bit sRGB preview alone. Empty: {scene}.exr for one frame, else
+    // {scene}.####.exr. Missing directories are created.
+    std::string output{};
+    // The frames: "5", "1-100", "1-100:2", "1-10,20,30-40:5" (`octray render --frames`).
+    // Empty: the animation's frames 0 .. frame_count()-1, or frame 0 of a still.
+    std::string frames{};
+    std::string png{};  // also an 8-bit sRGB PNG preview per frame, a pattern as `output`
+    ExrOptions exr{};
+    bool skip_existing = false;  // leave frames whose files all exist (resume)
+};
+
+enum class FrameStatus { rendered, skipped, failed };
+
+struct FrameFile {
+    int frame = 0;
+    std::string output;
+    std::string png;  // empty: no preview
+    FrameStatus status = FrameStatus::rendered;
+    std::string message;     // failed: why
+    std::uint64_t rays = 0;  // rays traced (a rendered frame)
+    double seconds = 0.0;    // the frame's time: prepare, render and write
+};
+
+struct FrameFilesResult {
+    std::vector<FrameFile> frames;  // in frame-list order; the interrupted one is absent
+    int rendered = 0, skipped = 0, failed = 0;
+    bool cancelled = false;  // the progress callback stopped the run
+    double seconds = 0.0;
+};
+
+// Renders the frames of `scene` with `options` (path, ISA, threads, tiles, size, spp,
+// crop, AOVs; its frame is not used) to files. options.progress is called with the
+// pixels of the whole run (every frame) done, on the calling thread; returning false
+// abandons the frame in progress at its next tile, deletes nothing finished, starts no
+// other frame and returns with `cancelled` set (no Error). Throws Error(invalid_argument)
+// for bad options (a frame spec or pattern, two frames writing one file, a crop outside
+// the image), Error(io) when an output directory cannot be made; a frame that fails to
+// render or write is in the result, `failed`.
+FrameFilesResult render_frames(const Scene& scene, const RenderOptions& options,
+                               const FrameFilesOptions& files);
 
 }  // namespace octray::api

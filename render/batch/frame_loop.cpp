@@ -380,9 +380,9 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         // one prepared scene).
         if (!renderer_ || renderer_index_ != job.scene) {
             renderer_.reset();
-            renderer_ = std::make_unique<FrameRenderer>(scene.scene, settings_.path,
-                                                        settings_.isa, settings_.options.accel,
-                                                        settings_.options.threads);
+            const RenderConfig& c = settings_.render;
+            renderer_ =
+                std::make_unique<FrameRenderer>(scene.scene, c.path, c.isa, c.accel, c.threads);
             renderer_index_ = job.scene;
         }
         FrameRenderer::Timing prepared;
@@ -390,7 +390,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         out.report.compile_seconds = prepared.compile_seconds;
         out.report.bvh_seconds = prepared.bvh_seconds;  // or the spheres' update and refit
         out.report.prepare_seconds = prepared.seconds();
-        RenderOptions options = settings_.options;
+        RenderOptions options = settings_.render.render_options();
         options.frame = static_cast<std::uint32_t>(job.frame);
         options.cancel = cancel_;
         options.pixels_done = observer_.pixel_counter();
@@ -411,7 +411,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         const auto trace_started = Clock::now();
 
         const auto render_pass = [&](const RenderOptions& o) { return renderer_->render(o); };
-        const AovImages aovs = renderer_->aovs(options, settings_.aovs);
+        const AovImages aovs = renderer_->aovs(options, settings_.render.aovs);
         double write_seconds = 0.0;
         const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
             const auto write_started = Clock::now();
@@ -477,10 +477,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
 }  // namespace
 
 std::string render_path_label(const BatchSettings& settings) {
-    std::string path(render_path_name(settings.path));
-    if (settings.path == RenderPath::simd)
-        path.append(" (").append(isa_name(settings.isa)).append(")");
-    return path;
+    return settings.render.path_label();
 }
 
 BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
@@ -488,9 +485,9 @@ BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<
                        const std::atomic<bool>* cancel) {
     // Limit TBB for the whole run; 0 keeps its default (every core it may use).
     std::optional<tbb::global_control> thread_limit;
-    if (settings.options.threads > 0)
+    if (settings.render.threads > 0)
         thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
-                             static_cast<std::size_t>(settings.options.threads));
+                             static_cast<std::size_t>(settings.render.threads));
     // OpenEXR compresses the blocks of scan lines of a frame on a pool of its own: as many
     // threads as the render's (none for one thread: the caller compresses). The file's
     // bytes are the same for any count, and the write is faster with more threads
@@ -503,8 +500,7 @@ BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<
     std::uint64_t total_work = 0;
     for (const BatchJob& job : jobs) total_work += frame_work(scenes[job.scene]);
     observer.run_started({scenes, jobs, render_path_label(settings), threads,
-                          settings.options.tile_width, settings.options.tile_height,
-                          total_work});
+                          settings.render.tile.width, settings.render.tile.height, total_work});
 
     const auto cancelled = [cancel] { return cancel != nullptr && cancel->load(); };
     BatchSummary summary;

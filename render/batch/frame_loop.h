@@ -13,16 +13,18 @@
 #include "render/batch/observer.h"
 #include "render/batch/plan.h"
 #include "render/image/image_io.h"
+#include "render/render_config.h"
 #include "render/types.h"
 
 namespace octray::batch {
 
 struct BatchSettings {
-    RenderPath path = RenderPath::simd;
-    Isa isa = Isa::automatic;  // resolved (simd path)
-    RenderOptions options;     // threads, tiles, accel; frame/crop/cancel set per frame
+    // How each frame renders (render/render_config.h): path, ISA (resolved:
+    // RenderConfig::resolve_isa), acceleration, threads, tiles and AOVs. Its crop and
+    // overrides are not read here: each scene carries its own (BatchScene::crop, and the
+    // overrides applied when it was loaded: BatchRequest).
+    RenderConfig render;
     ExrWriteOptions exr;
-    AovSet aovs;
     bool progressive = false;
     // The outputs are PNG files: each job's output is the 8-bit sRGB preview, its png empty.
     bool png_output = false;
@@ -36,7 +38,8 @@ struct BatchSettings {
     bool write_behind = false;
 };
 
-// The render path as the EXR attribute octray.path names it: "scalar", "simd (avx2)".
+// The render path as the EXR attribute octray.path names it: "scalar", "simd (avx2)"
+// (settings.render.path_label()).
 std::string render_path_label(const BatchSettings& settings);
 
 // The header attributes `octray render` writes with frame `frame` of `scene` (posed as
@@ -48,7 +51,7 @@ ExrAttributes render_exr_attributes(const BatchScene& scene, const Scene& posed,
                                     const RenderResult& result, const std::string& path_label,
                                     int samples_so_far, const std::string& owner);
 
-// Renders every job in order on at most settings.options.threads threads (0: every core)
+// Renders every job in order on at most settings.render.threads threads (0: every core)
 // and returns the summary. Each frame is reported to the observer once, in job order; with
 // settings.write_behind a frame is reported by the thread that wrote it, as soon as its
 // files are on disk, which may be while the next frame renders (after its frame_started;

@@ -92,13 +92,8 @@ BatchScene load_batch_scene(const std::string& spec, const BatchRequest& request
         std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     Scene& scene = loaded.scene;
     const SceneOverrides& o = request.overrides;
-    const bool overridden = o.width || o.height || o.spp || o.max_depth || o.seed;
-    if (o.width) scene.image.width = *o.width;
-    if (o.height) scene.image.height = *o.height;
-    if (o.spp) scene.image.spp = *o.spp;
-    if (o.max_depth) scene.render.max_depth = *o.max_depth;
-    if (o.seed) scene.render.seed = *o.seed;
-    if (overridden) {
+    apply_overrides(scene, o);
+    if (o.any()) {
         // The scene itself was valid when loaded, so a failure now is the overrides' fault.
         try {
             validate_scene(scene);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/pixel_rect.h"
+#include "render/render_config.h"
 #include "scene/scene.h"
 
 namespace octray::batch {
@@ -26,11 +27,9 @@ class RequestError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// A scene's settings that the request replaces; unset: the scene's own.
-struct SceneOverrides {
-    std::optional<int> width, height, spp, max_depth;
-    std::optional<std::uint64_t> seed;
-};
+// A scene's settings that the request replaces; unset: the scene's own (one struct for
+// every caller: render/render_config.h).
+using octray::SceneOverrides;
 
 struct BatchRequest {
     SceneOverrides overrides;

@@ -84,14 +84,15 @@ Scene ViewSession::scene() const {
 
 RenderSwitches ViewSession::switches() const {
     std::lock_guard lock(mutex_);
-    return RenderSwitches{settings_.threads, scene_.image.spp, scene_.render.max_depth,
-                          settings_.order,   settings_.path,   settings_.isa,
+    return RenderSwitches{settings_.render.threads, scene_.image.spp,
+                          scene_.render.max_depth,  settings_.order,
+                          settings_.render.path,    settings_.render.isa,
                           settings_.frame};
 }
 
 RenderOptions ViewSession::render_options(int width) const {
     RenderOptions options;
-    options.threads = settings_.threads;
+    options.threads = settings_.render.threads;
     options.cancel = &cancel_;
     options.frame = static_cast<std::uint32_t>(settings_.frame);
     if (settings_.order == PixelOrder::rows) {
@@ -109,8 +110,8 @@ ViewFrame ViewSession::frame_of(std::uint64_t version, const Camera& camera) con
     frame.target_spp = scene_.image.spp;
     frame.max_depth = scene_.render.max_depth;
     frame.animation_frame = settings_.frame;
-    frame.path = settings_.path;
-    frame.isa = settings_.isa;
+    frame.path = settings_.render.path;
+    frame.isa = settings_.render.isa;
     return frame;
 }
 
@@ -142,10 +143,10 @@ std::uint64_t ViewSession::reconfigure(const RenderSwitches& switches) {
         std::lock_guard lock(mutex_);
         if (frame_camera) camera_ = next.camera;
         scene_ = std::move(next);
-        settings_.threads = switches.threads;
+        settings_.render.threads = switches.threads;
         settings_.order = switches.order;
-        settings_.path = switches.path;
-        settings_.isa = switches.isa;
+        settings_.render.path = switches.path;
+        settings_.render.isa = switches.isa;
         settings_.frame = switches.frame;
         restart_ = false;
         cancel_ = false;
@@ -296,10 +297,10 @@ void ViewSession::run_frameless() {
     std::size_t fresh = blocks.size();  // blocks rendered with the current camera
     std::uint64_t version = 0;
     std::optional<Scene> scalar;  // the scalar path's scene, with the current camera
-    if (settings_.path == RenderPath::scalar) scalar = scene_;
+    if (settings_.render.path == RenderPath::scalar) scalar = scene_;
     std::optional<PreparedScene> prepared;
     RenderOptions options;
-    options.threads = settings_.threads;
+    options.threads = settings_.render.threads;
     options.frame = static_cast<std::uint32_t>(settings_.frame);
     Clock::time_point camera_start;
 
@@ -316,7 +317,7 @@ void ViewSession::run_frameless() {
         lock.unlock();
         try {
             if (new_camera) {
-                if (settings_.path == RenderPath::simd) {
+                if (settings_.render.path == RenderPath::simd) {
                     this->prepared(prepared).set_camera(camera);
                 } else {
                     scalar->camera = camera;
@@ -330,7 +331,7 @@ void ViewSession::run_frameless() {
                 batch.push_back(blocks[(cursor + i) % blocks.size()]);
             const RenderResult result =
                 prepared ? render_packet_blocks(*prepared, batch, framebuffer, options,
-                                                settings_.isa)
+                                                settings_.render.isa)
                          : render_reference_blocks(*scalar, batch, framebuffer, options);
             cursor = (cursor + count) % blocks.size();
             fresh += count;
@@ -356,7 +357,7 @@ void ViewSession::run_frameless() {
 // The SIMD path's scene, compiled and its BVH built for the first picture of these
 // switches; each picture after only re-aims it (and sizes it, for a preview).
 PreparedScene& ViewSession::prepared(std::optional<PreparedScene>& prepared) const {
-    if (!prepared) prepared.emplace(scene_, Accel::automatic, settings_.threads);
+    if (!prepared) prepared.emplace(scene_, Accel::automatic, settings_.render.threads);
     return *prepared;
 }
 
@@ -368,10 +369,10 @@ void ViewSession::render_preview(const Camera& camera, std::uint64_t version,
     const RenderOptions options = render_options(width);
     const auto start = Clock::now();
     RenderResult result;
-    if (settings_.path == RenderPath::simd) {
+    if (settings_.render.path == RenderPath::simd) {
         PreparedScene& scene = prepared(prepared_scene);
         scene.set_view(camera, width, height, 1);
-        result = render_packet(scene, options, settings_.isa);
+        result = render_packet(scene, options, settings_.render.isa);
     } else {
         Scene scene = scene_;
         scene.camera = camera;
@@ -396,7 +397,7 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version,
     const auto start = Clock::now();
     std::optional<Scene> scalar;  // the scalar path's scene with this camera
     PreparedScene* simd = nullptr;
-    if (settings_.path == RenderPath::simd) {
+    if (settings_.render.path == RenderPath::simd) {
         simd = &prepared(prepared_scene);
         simd->set_view(camera, scene_.image.width, scene_.image.height, scene_.image.spp);
     } else {
@@ -404,7 +405,7 @@ bool ViewSession::render_passes(const Camera& camera, std::uint64_t version,
         scalar->camera = camera;
     }
     const batch::PassRenderer render_pass = [&](const RenderOptions& pass_options) {
-        return simd ? render_packet(*simd, pass_options, settings_.isa)
+        return simd ? render_packet(*simd, pass_options, settings_.render.isa)
                     : render_reference(*scalar, pass_options);
     };
     RayCounts rays;

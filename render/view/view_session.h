@@ -17,6 +17,7 @@
 #include "core/image.h"
 #include "kernels/isa.h"
 #include "render/packet_renderer.h"
+#include "render/render_config.h"
 #include "render/types.h"
 #include "scene/scene.h"
 
@@ -32,11 +33,12 @@ enum class PixelOrder {
 struct ViewSettings {
     PixelOrder order = PixelOrder::tiled;
     int frameless_block = 8;  // frameless: block side in pixels
-    RenderPath path = RenderPath::simd;
-    Isa isa = Isa::automatic;  // as asked: automatic is resolved by each render
-    int threads = 0;           // 0: every core TBB sees
-    int frame = 0;             // an animated scene's frame shown first
-    int preview_divisor = 4;   // a moving camera renders (width / d) x (height / d) at 1 spp
+    // How it renders (render/render_config.h): the path, the ISA (as asked: automatic is
+    // resolved by each render) and the threads (0: every core TBB sees) are read from it;
+    // the viewer cuts its own tiles and rows, and the scene carries its overrides.
+    RenderConfig render;
+    int frame = 0;            // an animated scene's frame shown first
+    int preview_divisor = 4;  // a moving camera renders (width / d) x (height / d) at 1 spp
     // After a preview, the passes at full resolution start once the camera has not moved
     // for this long (a page that sends no final "stopped" still gets a sharp picture).
     std::chrono::milliseconds settle{300};

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "kernels/dispatch.h"
-#include "render/batch/frame_loop.h"
+#include "render/render_config.h"
 #include "render/types.h"
 #include "render/view/http_error.h"
 #include "render/view/request_json.h"
@@ -99,10 +99,11 @@ RenderSwitches parse_switches(const std::string& body, RenderSwitches switches,
 }
 
 std::string path_label(RenderPath path, Isa isa) {
-    batch::BatchSettings settings;
-    settings.path = path;
-    settings.isa = path == RenderPath::simd ? resolve_isa(isa) : isa;
-    return batch::render_path_label(settings);
+    RenderConfig config;
+    config.path = path;
+    config.isa = isa;
+    config.resolve_isa();
+    return config.path_label();
 }
 
 json switches_json(const RenderSwitches& switches) {

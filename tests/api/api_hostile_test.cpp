@@ -238,6 +238,47 @@ TEST(ApiHostile, RenderOptionsAtTheirEdges) {
     EXPECT_FALSE(api::supported_isas().empty());
 }
 
+// Crops at the edges of int, AOV names, and frames to files with odd frame lists,
+// patterns and crops: each an api::Error or a render, never a crash.
+TEST(ApiHostile, CropsAovsAndFramesToFiles) {
+    const api::Scene scene = small_scene();
+    const std::vector<int> edges = {INT_MIN, -1, 0, 1, 5, 6, 8, 9, INT_MAX};
+    int rendered = 0;
+    for (int a : edges)
+        for (int b : edges) {
+            api::RenderOptions options{.threads = 1};
+            options.crop = api::Crop{a, a, b, b};
+            options.aovs.id = true;
+            const std::string at = " crop " + std::to_string(a) + "," + std::to_string(b);
+            if (returns_or_api_error(at, [&] { api::render(scene, options); })) ++rendered;
+            returns_or_api_error("Renderer" + at,
+                                 [&] { api::Renderer(scene, options).render(0); });
+        }
+    EXPECT_GT(rendered, 0);
+    for (const char* list : {"", ",", "depth,,id", "id,id", "\xff", "depth,normal,albedo,id,"})
+        returns_or_api_error(std::string("aovs ") + list, [&] { api::parse_aovs(list); });
+    for (const char* name : {"", "AVX2", "sse4_1", "auto ", "\n"})
+        returns_or_api_error(std::string("isa ") + name, [&] { api::parse_isa(name); });
+
+    const std::string dir = temp_path("frames");
+    std::filesystem::remove_all(dir);
+    for (const char* frames : {"-1", "0-", "99999999999", "5-1", "0-3:0", "a", "0,0", ""}) {
+        for (const char* output : {"/x.####.exr", "/x.exr", "/x.####.jpg", "/{bad}.####.exr",
+                                   "/x.####.png", "/", "/.exr"}) {
+            api::FrameFilesOptions files;
+            files.output = dir + output;
+            files.frames = frames;
+            returns_or_api_error(std::string("render_frames ") + frames + " " + output,
+                                 [&] { api::render_frames(scene, {.threads = 1}, files); });
+        }
+    }
+    api::FrameFilesOptions files;
+    files.output = dir + "/same.####.exr";
+    files.png = files.output;  // one file twice
+    returns_or_api_error("png = output",
+                         [&] { api::render_frames(scene, {.threads = 1}, files); });
+}
+
 // Images, files and comparisons: odd shapes and paths.
 TEST(ApiHostile, ImagesFilesAndComparisons) {
     const std::vector<api::Image> images = {

@@ -109,8 +109,8 @@ class FrameLoopTest : public ::testing::Test {
         request_.frames = "0-2";
         request_.output = (dir_ / "w.#.exr").string();
         scenes_.push_back(load_batch_scene("whitted", request_));
-        settings_.isa = resolve_isa(Isa::automatic);
-        settings_.options.threads = 2;
+        settings_.render.resolve_isa();
+        settings_.render.threads = 2;
     }
 
     std::vector<BatchJob> jobs() const { return plan_jobs(scenes_, request_); }

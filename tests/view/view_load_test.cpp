@@ -84,7 +84,7 @@ class ViewLoadTest : public ::testing::Test {
   protected:
     void start(ServerOptions options) {
         ViewSettings settings;
-        settings.threads = 2;
+        settings.render.threads = 2;
         session_ = std::make_unique<ViewSession>(scene_, settings);
         server_ = std::make_unique<ViewServer>(*session_, std::move(options));
         server_->start();

@@ -51,7 +51,7 @@ TEST(ViewSave, WritesWhatRenderWrites) {
     const fs::path dir = empty_directory("octray_view_save_");
     const Scene scene = small_whitted();
     ViewSettings settings;
-    settings.threads = 2;
+    settings.render.threads = 2;
     ViewSession session(scene, settings);
     ServerOptions options;
     octray::view::SaveSettings save;
@@ -172,7 +172,7 @@ TEST(ViewSave, NeverOverwritesTheViewedSceneAndNamesEveryExistingFile) {
         std::ofstream(dir / "other.json") << "y";
     }
     ViewSettings settings;
-    settings.threads = 2;
+    settings.render.threads = 2;
     ViewSession session(scene, settings);
     ServerOptions options;
     octray::view::SaveSettings save;

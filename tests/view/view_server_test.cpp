@@ -60,7 +60,7 @@ class ViewServerTest : public ::testing::Test {
     void SetUp() override {
         ViewSettings settings;
         settings.order = order();
-        settings.threads = 2;
+        settings.render.threads = 2;
         // Long enough that a test polling the status sees a preview before it is refined,
         // however loaded the machine.
         settings.settle = std::chrono::milliseconds(3000);
@@ -299,7 +299,7 @@ TEST(ViewSessionPreviews, MovesFasterThanAPreviewRendersStillPublishPreviews) {
     scene.image.width = 640;  // a preview of some milliseconds: longer than a move
     scene.image.height = 360;
     ViewSettings settings;
-    settings.threads = 1;
+    settings.render.threads = 1;
     settings.preview_divisor = 1;
     ViewSession session(scene, settings);
     ASSERT_TRUE(session.wait_newer(0, std::chrono::seconds(60)));
@@ -326,7 +326,7 @@ TEST(ViewSessionPreviews, MovesFasterThanAPreviewRendersStillPublishPreviews) {
 TEST(ViewSessionPreviews, APreviewAndTheRefinedPictureAreThoseOfAFreshRender) {
     Scene scene = octray::load_scene("random:64,width=64,height=36,spp=2");
     ViewSettings settings;
-    settings.threads = 2;
+    settings.render.threads = 2;
     settings.settle = std::chrono::milliseconds(300);
     ViewSession session(scene, settings);
     auto frame = session.wait_newer(0, std::chrono::seconds(60));
@@ -545,7 +545,7 @@ TEST(FramelessSinglePixels, ConvergeToTheTiledPictureBitForBit) {
     ViewSettings settings;
     settings.order = octray::view::PixelOrder::frameless;
     settings.frameless_block = 1;
-    settings.threads = 2;
+    settings.render.threads = 2;
     ViewSession session(scene, settings);
     std::shared_ptr<const octray::view::ViewFrame> frame;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);

@@ -150,7 +150,7 @@ class SwitchesTest : public ::testing::Test {
   protected:
     void start(const Scene& scene, octray::view::PixelOrder order, const std::string& dir) {
         octray::view::ViewSettings settings;
-        settings.threads = 2;
+        settings.render.threads = 2;
         settings.order = order;
         session_ = std::make_unique<octray::view::ViewSession>(scene, settings);
         octray::view::ServerOptions options;
