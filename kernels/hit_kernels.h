@@ -127,7 +127,7 @@ std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std:
                                rays.dx + base,     rays.dy + base,     rays.dz + base,
                                rays.t_max + base,  rays.term_r + base, rays.term_g + base,
                                rays.term_b + base, rays.parent + base};
-        std::uint32_t flags[kTraversalWidth] = {};
+        alignas(64) std::uint32_t flags[kTraversalWidth] = {};
         any_hit_all<Arch>(s, one, static_cast<std::uint32_t>(32 - __builtin_clz(live)), flags);
         std::uint32_t bits = 0;
         for (std::uint32_t i = 0; i < kTraversalWidth; ++i) bits |= (flags[i] & 1u) << i;
