@@ -380,11 +380,10 @@ void set_up_scene(BenchRun& run, BenchScene& bs) {
 
 // ---- Rows ----
 
-// The packets octray's kernels trace in: 8 rays, and through the BVH the ISA's traversal
-// packets (16 rays with AVX-512, kernels/bvh_packet.h).
-std::string octray_mode(Isa isa, bool bvh) {
-    return "packet" +
-           std::to_string(bvh ? kernel_table(isa).traversal_width : kernels::kPacketWidth);
+// The packets octray's kernels trace in: the ISA's traversal packets (16 rays with AVX-512,
+// kernels/bvh_packet.h), through the BVH and in brute force alike.
+std::string octray_mode(Isa isa, bool /*bvh*/) {
+    return "packet" + std::to_string(kernel_table(isa).traversal_width);
 }
 
 BenchRow base_row(const BenchRun& run, const std::string& spec, Workload w, const Variant& v) {

@@ -10,11 +10,36 @@
 
 #include <cstdint>
 
+#include "kernels/bvh_packet.h"
 #include "kernels/packet_math.h"
 #include "kernels/plane_test.h"
 #include "kernels/sphere_test.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
+
+// Brute force takes kTraversalWidth rays at a time, in registers of RayArch (bvh_packet.h):
+// 16 rays in one AVX-512 register in the avx512 translation unit, where a sphere's test
+// then costs one 16-lane operation per step instead of two 8-lane ones (the packet is two
+// of the stream's 8-ray packets, neighbouring pixels or neighbouring secondary rays), and
+// the stream's 8-ray packets elsewhere. A stream's last packet may hold 8 rays or fewer:
+// load_stream repeats its lower half above, and store_stream writes back the lower half
+// alone, never past the stream's whole 8-ray packets (kernel_types.h).
+template <class B, class T>
+[[gnu::always_inline]] inline void store_stream(const B& x, T* out, std::uint32_t at,
+                                                std::uint32_t left) {
+    if constexpr (B::size == 16) {
+        if (left <= at + kPacketWidth) {
+            if constexpr (std::is_same_v<T, float>)
+                _mm256_store_ps(out + at, _mm512_castps512_ps256(x));
+            else
+                _mm256_store_si256(reinterpret_cast<__m256i*>(out + at),
+                                   _mm512_castsi512_si256(x));
+            return;
+        }
+    }
+    (void)left;
+    x.store_aligned(out + at);
+}
 
 // Closest hit over all spheres and planes, brute force (reference:
 // ReferenceTracer::intersect); closest_hit() in kernels/hit_kernels.h calls it when the
@@ -25,18 +50,22 @@ namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 template <class Arch>
 void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t count,
                      float t_min, const HitStream& hits) {
-    using F = xsimd::batch<float, Arch>;
-    using M = xsimd::batch_bool<float, Arch>;
+    using F = xsimd::batch<float, RayArch<Arch>>;
+    using M = xsimd::batch_bool<float, RayArch<Arch>>;
     constexpr std::uint32_t W = F::size;
-    constexpr std::uint32_t K = kPacketWidth / W;
+    constexpr std::uint32_t K = kTraversalWidth / W;
     const F tmin(t_min);
-    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+    for (std::uint32_t base = 0; base < count; base += kTraversalWidth) {
+        const std::uint32_t left = count - base;
+        const auto load = [&](const float* v, std::uint32_t at) {
+            return load_stream<F>(v + base, at, left);
+        };
         V3<F> o[K], d[K];
         F a[K], best_t[K], best_id[K];
         for (std::uint32_t k = 0; k < K; ++k) {
-            const std::uint32_t at = base + k * W;
-            o[k] = load3<F>(rays.ox, rays.oy, rays.oz, at);
-            d[k] = load3<F>(rays.dx, rays.dy, rays.dz, at);
+            const std::uint32_t at = k * W;
+            o[k] = {load(rays.ox, at), load(rays.oy, at), load(rays.oz, at)};
+            d[k] = {load(rays.dx, at), load(rays.dy, at), load(rays.dz, at)};
             a[k] = dot(d[k], d[k]);
             best_t[k] = F(kInf);
             best_id[k] = F(-1.0f);
@@ -64,10 +93,9 @@ void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t co
         }
         for (std::uint32_t k = 0; k < K; ++k)
             closest_planes(s, o[k], d[k], tmin, best_t[k], best_id[k]);
-        for (std::uint32_t k = 0; k < K; ++k) {
-            const std::uint32_t at = base + k * W;
-            best_t[k].store_aligned(hits.t + at);
-            xsimd::to_int(best_id[k]).store_aligned(hits.object + at);  // exact: ids < 2^24
+        for (std::uint32_t k = 0; k < K; ++k) {  // ids < 2^24: exact
+            store_stream(best_t[k], hits.t + base, k * W, left);
+            store_stream(xsimd::to_int(best_id[k]), hits.object + base, k * W, left);
         }
     }
 }
@@ -79,22 +107,26 @@ void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t co
 template <class Arch>
 void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t count,
                  std::uint32_t* occluded) {
-    using F = xsimd::batch<float, Arch>;
-    using M = xsimd::batch_bool<float, Arch>;
+    using F = xsimd::batch<float, RayArch<Arch>>;
+    using M = xsimd::batch_bool<float, RayArch<Arch>>;
     constexpr std::uint32_t W = F::size;
-    constexpr std::uint32_t K = kPacketWidth / W;
+    constexpr std::uint32_t K = kTraversalWidth / W;
     const F zero(0.0f);
-    for (std::uint32_t base = 0; base < count; base += kPacketWidth) {
+    for (std::uint32_t base = 0; base < count; base += kTraversalWidth) {
+        const std::uint32_t left = count - base;
+        const auto load = [&](const float* v, std::uint32_t at) {
+            return load_stream<F>(v + base, at, left);
+        };
         V3<F> o[K], d[K];
         F a[K], t_max[K];
         M done[K];  // occluded, or a dead lane
         for (std::uint32_t k = 0; k < K; ++k) {
-            const std::uint32_t at = base + k * W;
-            o[k] = load3<F>(rays.ox, rays.oy, rays.oz, at);
-            d[k] = load3<F>(rays.dx, rays.dy, rays.dz, at);
-            t_max[k] = F::load_aligned(rays.t_max + at);
+            const std::uint32_t at = k * W;
+            o[k] = {load(rays.ox, at), load(rays.oy, at), load(rays.oz, at)};
+            d[k] = {load(rays.dx, at), load(rays.dy, at), load(rays.dz, at)};
+            t_max[k] = load(rays.t_max, at);
             a[k] = dot(d[k], d[k]);
-            done[k] = at < count ? !live_lanes<F>(at, count) : (zero == zero);
+            done[k] = at < left ? !live_lanes<F>(at, left) : (zero == zero);
         }
         const auto all_done = [&] {
             for (std::uint32_t k = 0; k < K; ++k)
@@ -122,8 +154,8 @@ void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t cou
                 done[k] = done[k] || any_plane(s, o[k], d[k], t_max[k]);
         // Dead lanes come out as 1; nobody reads them.
         for (std::uint32_t k = 0; k < K; ++k)
-            xsimd::to_int(xsimd::select(done[k], F(1.0f), zero))
-                .store_aligned(reinterpret_cast<std::int32_t*>(occluded + base + k * W));
+            store_stream(xsimd::to_int(xsimd::select(done[k], F(1.0f), zero)),
+                         reinterpret_cast<std::int32_t*>(occluded + base), k * W, left);
     }
 }
 

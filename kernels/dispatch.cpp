@@ -190,6 +190,7 @@ kernels::SceneView make_scene_view(const CompiledScene& scene, const SphereBvh& 
                                 : ray_by_ray ? kernels::kPacketWidth + 1
                                              : packet_min_lanes;
     v.bvh_shadow_sort_min_spheres = kBvhShadowSortMinSpheres;
+    v.bvh_brute_force_max_spheres = kBvhBruteForceMaxSpheres;
     return v;
 }
 

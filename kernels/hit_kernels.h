@@ -32,6 +32,18 @@ inline std::uint32_t traversal_min_lanes(std::uint32_t min_lanes) {
     return min_lanes > kPacketWidth ? kTraversalWidth + 1 : min_lanes;
 }
 
+// Rays [base, ...) of a stream, as a stream (base a multiple of kTraversalWidth, so that
+// its arrays stay 64-byte aligned).
+inline RayStream stream_from(const RayStream& r, std::uint32_t base) {
+    return {r.ox + base, r.oy + base, r.oz + base, r.dx + base, r.dy + base,
+            r.dz + base, r.wr + base, r.wg + base, r.wb + base, r.pixel + base};
+}
+inline ShadowStream stream_from(const ShadowStream& r, std::uint32_t base) {
+    return {r.ox + base,     r.oy + base,     r.oz + base,    r.dx + base,
+            r.dy + base,     r.dz + base,     r.t_max + base, r.term_r + base,
+            r.term_g + base, r.term_b + base, r.parent + base};
+}
+
 template <class Arch>
 void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t count,
                  float t_min, const HitStream& hits) {
@@ -52,6 +64,12 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
         // A group of rays from one origin is a beam (bvh_beam.h).
         const std::uint32_t n = count - group < kBeamRays ? count - group : kBeamRays;
         const bool in_beam = beam_for_group<FN>(s, rays, group, n, count, beam, st);
+        if (!in_beam && s.sphere_count <= s.bvh_brute_force_max_spheres) {
+            // A small BVH: rays that form no beam test every sphere (SceneView).
+            closest_hit_all<Arch>(s, stream_from(rays, group), n, t_min,
+                                  HitStream{hits.t + group, hits.object + group});
+            continue;
+        }
         for (std::uint32_t base = group; base < group + n; base += kTraversalWidth) {
             const std::uint32_t live = live_bits(base, count);
             // Lanes the BVH traverses: all of them, or those a beam leaves unfinished,
@@ -69,13 +87,10 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
             }
             if ((finite & live) != live) {
                 // Box tests would overflow: this packet against every sphere.
-                const RayStream one{rays.ox + base,   rays.oy + base, rays.oz + base,
-                                    rays.dx + base,   rays.dy + base, rays.dz + base,
-                                    rays.wr + base,   rays.wg + base, rays.wb + base,
-                                    rays.pixel + base};
                 closest_hit_all<Arch>(
-                    s, one, count - base < kTraversalWidth ? count - base : kTraversalWidth,
-                    t_min, HitStream{hits.t + base, hits.object + base});
+                    s, stream_from(rays, base),
+                    count - base < kTraversalWidth ? count - base : kTraversalWidth, t_min,
+                    HitStream{hits.t + base, hits.object + base});
                 continue;
             }
             if (traverse != 0) bvh_closest_packet<Arch>(s, p, traverse, t_min, st);
@@ -123,12 +138,9 @@ std::uint32_t occluded_packet(const SceneView& s, const ShadowStream& rays, std:
                             base, count, p) &
          live) != live) {
         // Box tests would overflow: this packet against every sphere.
-        const ShadowStream one{rays.ox + base,     rays.oy + base,     rays.oz + base,
-                               rays.dx + base,     rays.dy + base,     rays.dz + base,
-                               rays.t_max + base,  rays.term_r + base, rays.term_g + base,
-                               rays.term_b + base, rays.parent + base};
-        std::uint32_t flags[kTraversalWidth] = {};
-        any_hit_all<Arch>(s, one, static_cast<std::uint32_t>(32 - __builtin_clz(live)), flags);
+        alignas(64) std::uint32_t flags[kTraversalWidth] = {};
+        any_hit_all<Arch>(s, stream_from(rays, base),
+                          static_cast<std::uint32_t>(32 - __builtin_clz(live)), flags);
         std::uint32_t bits = 0;
         for (std::uint32_t i = 0; i < kTraversalWidth; ++i) bits |= (flags[i] & 1u) << i;
         return bits & live;
@@ -193,7 +205,9 @@ void shadow_keys(const SceneView& s, const ShadowStream& rays, std::uint32_t at,
 template <class Arch>
 void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t count,
              std::uint32_t* occluded) {
-    if (scene.bvh_nodes == nullptr) return any_hit_all<Arch>(scene, rays, count, occluded);
+    // Small BVHs too: brute force beats their shadow beams (SceneView).
+    if (scene.bvh_nodes == nullptr || scene.sphere_count <= scene.bvh_brute_force_max_spheres)
+        return any_hit_all<Arch>(scene, rays, count, occluded);
     SceneView s = scene;
     s.bvh_packet_min_lanes = traversal_min_lanes(s.bvh_packet_min_lanes);
     BvhPacket p;

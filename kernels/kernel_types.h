@@ -88,6 +88,9 @@ struct SceneView {
     // Shadow rays are regrouped by origin and direction before tracing (hit_kernels.h,
     // any_hit) in BVHs of at least this many spheres.
     std::uint32_t bvh_shadow_sort_min_spheres;
+    // In BVHs of at most this many spheres, shadow rays, and closest-hit rays that form no
+    // beam, test every sphere as without a BVH (hit_kernels.h; kernels/dispatch.h).
+    std::uint32_t bvh_brute_force_max_spheres;
 };
 
 // Film positions of camera samples, in [-1, 1]^2 with y up, plus the thin-lens aperture

@@ -18,7 +18,7 @@ enum class Accel { automatic, bvh, none };
 
 // The sphere count from which Accel::automatic builds a BVH: the crossover measured by
 // `octray bench` (docs/performance-log.md, the paragraph "The `auto` crossover").
-inline constexpr std::uint32_t kBvhAutoMinSpheres = 32;
+inline constexpr std::uint32_t kBvhAutoMinSpheres = 16;
 
 // "auto", "bvh", "none".
 const char* accel_name(Accel accel);

@@ -562,6 +562,8 @@ class BvhTraversalTest : public ::testing::Test {
         // Shadow rays regrouped whatever the scene's size (the default keeps the order
         // given below kBvhShadowSortMinSpheres; the loop after any_hit checks that path).
         view.bvh_shadow_sort_min_spheres = 0;
+        // The traversal even in small trees (one sphere), which otherwise test every sphere.
+        view.bvh_brute_force_max_spheres = 0;
         ASSERT_NE(view.bvh_nodes, nullptr);
         const kernels::KernelTable& k = kernel_table(Tag::isa);
         const ReferenceTracer ref(ns.scene);
@@ -698,7 +700,8 @@ class BeamTraversalTest : public BvhTraversalTest<Tag> {
         SCOPED_TRACE(ns.name);
         const CompiledScene c = compile_scene(ns.scene);
         const SphereBvh bvh = build_sphere_bvh(c.spheres);
-        const kernels::SceneView view = make_scene_view(c, bvh, 3);
+        kernels::SceneView view = make_scene_view(c, bvh, 3);
+        view.bvh_brute_force_max_spheres = 0;  // beams and the traversal in small trees too
         ASSERT_NE(view.bvh_nodes, nullptr);
         const kernels::KernelTable& k = kernel_table(Tag::isa);
         const ReferenceTracer ref(ns.scene);
@@ -737,6 +740,7 @@ class BeamTraversalTest : public BvhTraversalTest<Tag> {
         const SphereBvh bvh = build_sphere_bvh(c.spheres);
         kernels::SceneView view = make_scene_view(c, bvh, 3);
         view.bvh_shadow_sort_min_spheres = ~0u;  // in the order given: the beams' path
+        view.bvh_brute_force_max_spheres = 0;    // in small trees too
         const kernels::KernelTable& k = kernel_table(Tag::isa);
         const ReferenceTracer ref(ns.scene);
         std::mt19937 rng(4243);
