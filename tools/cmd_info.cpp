@@ -35,7 +35,8 @@ void run_info(const std::string& scene_spec, bool quiet) {
             " per 8-ray packet" +
             (k.traversal_width == kernels::kPacketWidth
                  ? std::string()
-                 : ", " + std::to_string(k.traversal_width) + "-ray BVH packets") +
+                 : ", " + std::to_string(k.traversal_width) +
+                       "-ray packets in BVH traversal and brute force") +
             ")";
     }
     for (Isa isa : supported_isas())

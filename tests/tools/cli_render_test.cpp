@@ -427,7 +427,7 @@ TEST_F(CliTest, SimdPathMatchesScalarAndVerifyPasses) {
     ASSERT_EQ(sse2.status, 0) << sse2.output;
     EXPECT_TRUE(
         same_bits(read_exr_pixels(path("scalar.exr")), read_exr_pixels(path("sse2.exr"))));
-    // AVX-512 where the CPU has it (16-ray BVH packets; this scene has no BVH, but its
+    // AVX-512 where the CPU has it (16-ray packets in BVH traversal and brute force; its
     // kernels are the AVX-512 build's), else a clear refusal.
     const RunResult avx512 =
         octray({"render", spec, "--isa", "avx512", "-o", "avx512.exr", "--float"});
