@@ -33,8 +33,8 @@ namespace {
 static_assert(kJsonPadding >= simdjson::SIMDJSON_PADDING,
               "read_scene_file must leave the padding simdjson reads past the end");
 
-using namespace fast_json;
-using json_rules::kMaxIntValue;
+using namespace scene_json::fast;
+using scene_json::kMaxIntValue;
 
 // ---------------------------------------------------------------------------------------
 // The sections. Keys arrive in file order; each reader collects them, then applies the
@@ -47,7 +47,7 @@ void read_image(od::value& v, ImageSettings& image) {
         od::field field = take(std::move(f));
         const std::size_t key = seen.see(key_of(field));
         const int n = static_cast<int>(
-            integer_of(field.value(), 1, key == 2 ? json_rules::kMaxSpp : kMaxIntValue));
+            integer_of(field.value(), 1, key == 2 ? scene_json::kMaxSpp : kMaxIntValue));
         switch (key) {
             case 0:
                 image.width = n;
@@ -114,7 +114,7 @@ void read_camera(od::value& v, Camera& camera) {
         if (!seen.has(kAperture)) throw Decline{};
         if (!seen.has(kFocus)) {
             camera.focus_distance =
-                json_rules::default_focus_distance(camera.eye, camera.lookat);
+                scene_json::default_focus_distance(camera.eye, camera.lookat);
         }
     }
 }
@@ -154,7 +154,7 @@ void read_render(od::value& v, RenderSettings& render) {
         switch (which) {
             case 0:
                 render.max_depth =
-                    static_cast<int>(integer_of(value, 0, json_rules::kMaxDepthLimit));
+                    static_cast<int>(integer_of(value, 0, scene_json::kMaxDepthLimit));
                 break;
             case 1:
                 render.seed = unsigned64_of(value);
@@ -320,7 +320,7 @@ void read_objects(od::value& v, Scene& scene, Materials& materials,
                 seen.has(kRadius)) {
                 throw Decline{};
             }
-            const std::optional<Vec3> unit = json_rules::unit_plane_normal(obj.normal);
+            const std::optional<Vec3> unit = scene_json::unit_plane_normal(obj.normal);
             if (!unit) throw Decline{};
             obj.normal = *unit;
         }
