@@ -34,7 +34,7 @@ inline std::optional<RenderPath> parse_render_path(std::string_view name) {
 // render --spp/--threads`, `octray view`'s switches (tools/cli_checks.h builds the options'
 // checks and help from these). The spp limit is the scene format's (a scene file's
 // image.spp, a built-in's spp=, the API's RenderOptions::spp): one limit wherever it is set.
-inline constexpr int kMaxSamplesPerPixel = json_rules::kMaxSpp;
+inline constexpr int kMaxSamplesPerPixel = scene_json::kMaxSpp;
 inline constexpr int kMaxRenderThreads = 4096;
 
 struct RayCounts {

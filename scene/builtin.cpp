@@ -116,7 +116,7 @@ BuiltinSpec parse_spec(const std::string& spec) {
         } else if (key == "height") {
             out.overrides.height = int_option(1, kIntMax);
         } else if (key == "spp") {
-            out.overrides.spp = int_option(1, json_rules::kMaxSpp);
+            out.overrides.spp = int_option(1, scene_json::kMaxSpp);
         } else if (key == "max_depth") {
             out.overrides.max_depth = int_option(0, kMaxDepthLimit);
         } else if (key == "seed") {

@@ -10,7 +10,7 @@
 
 #include "scene/json_rules.h"
 
-namespace octray::fast_json {
+namespace octray::scene_json::fast {
 
 // ---------------------------------------------------------------------------------------
 // Strings. simdjson's stage 1 has validated the whole text as UTF-8 without unescaped
@@ -130,7 +130,7 @@ double number_of(od::value& v) {
 
 float float_of(od::value& v) {
     const double d = number_of(v);
-    if (!json_rules::fits_float(d)) throw Decline{};
+    if (!scene_json::fits_float(d)) throw Decline{};
     return static_cast<float>(d);
 }
 
@@ -190,4 +190,4 @@ Rgb color_of(od::value& v) {
     return {c.x, c.y, c.z};
 }
 
-}  // namespace octray::fast_json
+}  // namespace octray::scene_json::fast

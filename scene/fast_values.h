@@ -14,7 +14,7 @@
 #include "core/color.h"
 #include "core/vec3.h"
 
-namespace octray::fast_json {
+namespace octray::scene_json::fast {
 
 namespace od = simdjson::ondemand;
 
@@ -33,7 +33,7 @@ std::string_view key_of(od::field& field);
 std::string_view string_of(od::value& v);
 // A number as nlohmann reads it (strtod's result where simdjson would not read it).
 double number_of(od::value& v);
-// A number that fits a float (json_rules::fits_float).
+// A number that fits a float (scene_json::fits_float, json_rules.h).
 float float_of(od::value& v);
 // An integer in [lo, hi]; an integral double such as 640.0 counts.
 std::int64_t integer_of(od::value& v, std::int64_t lo, std::int64_t hi);
@@ -88,4 +88,4 @@ void read_fields(Object& v, KeySet<N>& seen, Read&& read) {
     }
 }
 
-}  // namespace octray::fast_json
+}  // namespace octray::scene_json::fast

@@ -78,7 +78,7 @@ class Reader {
     float number(const Json& v, const std::string& path) const {
         if (!v.is_number()) fail(path, "expected a number, found " + describe(v));
         const double d = v.get<double>();
-        if (!json_rules::fits_float(d)) {
+        if (!fits_float(d)) {
             fail(path,
                  "expected a finite number within float range (magnitude at most "
                  "3.4028235e38), found " +

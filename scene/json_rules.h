@@ -9,7 +9,7 @@
 
 #include "core/vec3.h"
 
-namespace octray::json_rules {
+namespace octray::scene_json {
 
 // Integers the scene stores in an int (image size, spp, key frame numbers).
 inline constexpr int kMaxIntValue = std::numeric_limits<int>::max();
@@ -52,4 +52,4 @@ inline float default_focus_distance(Vec3 eye, Vec3 lookat) {
                                         static_cast<double>(d.z) * d.z));
 }
 
-}  // namespace octray::json_rules
+}  // namespace octray::scene_json

@@ -25,8 +25,6 @@
 namespace octray::scene_json {
 namespace {
 
-using json_rules::kMaxIntValue;
-
 // The animation block: JSON types, key names and object names here; the rules on values
 // (frame order, ranges, keys that do not fit the object or camera) in Validator::animation,
 // so that a hand-built Animation is checked the same way.

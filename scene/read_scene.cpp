@@ -32,8 +32,8 @@ namespace octray {
 namespace {
 
 using namespace scene_json;
-using json_rules::kMaxDepthLimit;
-using json_rules::kMaxIntValue;
+using scene_json::kMaxDepthLimit;
+using scene_json::kMaxIntValue;
 
 constexpr std::array<std::string_view, 9> kTopKeys = {"image",   "camera", "background",
                                                       "ambient", "render", "materials",
@@ -49,7 +49,7 @@ void read_image(const Reader& r, const Json& j, ImageSettings& image) {
         image.height =
             static_cast<int>(r.integer(j["height"], "image.height", 1, kMaxIntValue));
     if (j.contains("spp"))
-        image.spp = static_cast<int>(r.integer(j["spp"], "image.spp", 1, json_rules::kMaxSpp));
+        image.spp = static_cast<int>(r.integer(j["spp"], "image.spp", 1, scene_json::kMaxSpp));
 }
 
 void read_camera(const Reader& r, const Json& j, Camera& camera) {
@@ -103,7 +103,7 @@ void read_camera(const Reader& r, const Json& j, Camera& camera) {
             camera.focus_distance = r.number(j["focus_distance"], "camera.focus_distance");
         } else {
             camera.focus_distance =
-                json_rules::default_focus_distance(camera.eye, camera.lookat);
+                scene_json::default_focus_distance(camera.eye, camera.lookat);
         }
     }
 }
@@ -178,9 +178,9 @@ Material read_material(const Reader& r, const Json& j, const std::string& path) 
     return m;
 }
 
-// A plane normal made unit length (json_rules::unit_plane_normal), or the error for zero.
+// A plane normal made unit length (scene_json::unit_plane_normal), or the error for zero.
 Vec3 normalized_normal(const Reader& r, Vec3 n, const std::string& path) {
-    const std::optional<Vec3> unit = json_rules::unit_plane_normal(n);
+    const std::optional<Vec3> unit = scene_json::unit_plane_normal(n);
     if (!unit) r.fail(path, "expected a non-zero normal vector, found " + format_vec(n));
     return *unit;
 }

@@ -29,12 +29,12 @@ namespace octray {
 namespace {
 
 using namespace scene_json;
-using json_rules::kMaxDepthLimit;
-using json_rules::kMaxIntValue;
+using scene_json::kMaxDepthLimit;
+using scene_json::kMaxIntValue;
 
 // Pixel indices must fit in an int (the renderers and image writers index with int).
 constexpr std::int64_t kMaxPixels = std::numeric_limits<int>::max();
-// validate_scene is looser than json_rules::kUnitTolerance: it only has to catch normals
+// validate_scene is looser than scene_json::kUnitTolerance: it only has to catch normals
 // that were never normalised.
 constexpr double kValidateUnitTolerance = 1e-5;
 // Refraction scales directions by the index ratio (or its inverse); far beyond real
@@ -104,7 +104,7 @@ class Validator {
         const ImageSettings& im = scene_.image;
         int_range(im.width, "image.width", 1, kMaxIntValue);
         int_range(im.height, "image.height", 1, kMaxIntValue);
-        int_range(im.spp, "image.spp", 1, json_rules::kMaxSpp);
+        int_range(im.spp, "image.spp", 1, scene_json::kMaxSpp);
         // Both factors are below 2^31, so neither product overflows 64 bits (nor does the
         // sample count width * height * spp, which stays below 2^51).
         const std::int64_t pixels = static_cast<std::int64_t>(im.width) * im.height;

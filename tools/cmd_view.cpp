@@ -1,4 +1,4 @@
-// `octray view`: a scene rendering live in the browser (render/view/README.md). A thin
+// `octray view`: a scene rendering live in the browser (view/README.md). A thin
 // command over octray::view: load the scene, apply the overrides, serve until Ctrl-C.
 
 #include <pthread.h>
@@ -26,15 +26,15 @@
 #include "render/image/image_io.h"
 #include "render/memory_estimate.h"
 #include "render/render_config.h"
-#include "render/view/compare_view.h"
-#include "render/view/jpeg.h"
-#include "render/view/view_bench.h"
-#include "render/view/view_server.h"
-#include "render/view/view_session.h"
 #include "scene/load.h"
 #include "scene/max_depth.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
+#include "view/compare_view.h"
+#include "view/jpeg.h"
+#include "view/view_bench.h"
+#include "view/view_server.h"
+#include "view/view_session.h"
 
 namespace octray::tools {
 namespace {
@@ -369,7 +369,7 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         "defaults, same figures) and the page flips between A, B, |A - B| and the error\n"
         "heatmap; an image that cannot be read exits 4, two that cannot be compared exit 3.\n"
         "The HTTP API (status, events, the picture stream, PNG and float32 pictures,\n"
-        "camera) is described in render/view/README.md. Ctrl-C (or SIGTERM) stops the\n"
+        "camera) is described in view/README.md. Ctrl-C (or SIGTERM) stops the\n"
         "server.\n\n"
         "Examples:\n"
         "  octray view                                  # the built-in whitted scene\n"

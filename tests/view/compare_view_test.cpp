@@ -3,7 +3,7 @@
 // heatmap is compare's, the value under the cursor is validated, and unreadable or
 // mismatched images fail as compare fails.
 
-#include "render/view/compare_view.h"
+#include "view/compare_view.h"
 
 #include <gtest/gtest.h>
 #include <httplib.h>
@@ -20,7 +20,7 @@
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
-#include "render/view/view_server.h"
+#include "view/view_server.h"
 
 namespace {
 

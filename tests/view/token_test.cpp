@@ -1,6 +1,6 @@
-// The access token of `octray view` (render/view/token.h).
+// The access token of `octray view` (view/token.h).
 
-#include "render/view/token.h"
+#include "view/token.h"
 
 #include <gtest/gtest.h>
 

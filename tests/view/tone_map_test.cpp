@@ -1,6 +1,6 @@
-// What the page is sent of a linear picture (render/view/tone_map.h).
+// What the page is sent of a linear picture (view/tone_map.h).
 
-#include "render/view/tone_map.h"
+#include "view/tone_map.h"
 
 #include <gtest/gtest.h>
 #include <png.h>

@@ -32,7 +32,7 @@ TEST(ViewCli, HelpExplainsTheTokenTheApiAndCtrlC) {
     const RunResult r = run_octray({"view", "--help"}, kCwd);
     EXPECT_EQ(r.status, 0) << r.output;
     for (const char* part : {"--bind", "--port", "--preview-divisor", "token", "403", "Ctrl-C",
-                             "render/view/README.md", "Exit codes:"})
+                             "view/README.md", "Exit codes:"})
         EXPECT_TRUE(contains(r.output, part)) << part << "\n" << r.output;
 }
 

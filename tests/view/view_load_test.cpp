@@ -1,7 +1,7 @@
 // Issue 38: `octray view` stays responsive under load. Before, the server ran every
 // connection on a fixed pool of 16 workers: 16 open event streams, or 16 clients trickling
 // a request a byte at a time without the token, left no worker for the page and the API.
-// Now each connection has a thread of its own (render/view/guarded_server.h), connections
+// Now each connection has a thread of its own (view/guarded_server.h), connections
 // that do not present the token within a deadline are closed, and past a cap on
 // connections the answer is a 503 saying so. The clients here are raw sockets, so that
 // hundreds of them cost the test one thread.
@@ -21,8 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include "render/view/view_server.h"
-#include "render/view/view_session.h"
+#include "view/view_server.h"
+#include "view/view_session.h"
 #include "view_fixtures.h"
 
 namespace {

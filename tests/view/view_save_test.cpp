@@ -1,4 +1,4 @@
-// POST /api/save of `octray view` (render/view/view_save.h) through a real client: what it
+// POST /api/save of `octray view` (view/view_save.h) through a real client: what it
 // writes equals what `octray render` writes of the same scene and spp.
 
 #include <gtest/gtest.h>
@@ -18,10 +18,10 @@
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
-#include "render/view/view_server.h"
-#include "render/view/view_session.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
+#include "view/view_server.h"
+#include "view/view_session.h"
 #include "view_fixtures.h"
 
 namespace {

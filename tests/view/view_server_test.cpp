@@ -2,7 +2,7 @@
 // in this process on a free port: the token, refused requests, the first picture equal to
 // a plain render bit for bit, the camera endpoint, previews, event streams, reconnects.
 
-#include "render/view/view_server.h"
+#include "view/view_server.h"
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
@@ -26,10 +26,10 @@
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
-#include "render/view/frameless.h"
-#include "render/view/view_session.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
+#include "view/frameless.h"
+#include "view/view_session.h"
 #include "view_fixtures.h"
 
 namespace {

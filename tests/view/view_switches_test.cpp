@@ -1,10 +1,10 @@
-// The page's path, ISA and frame switches (render/view/view_switches.h): the parsing and
+// The page's path, ISA and frame switches (view/view_switches.h): the parsing and
 // its refusals on their own (an ISA the CPU lacks, with a CPU that lacks one made up), then
 // through a real client against a session: the scalar path and a forced ISA render the
 // picture `octray render --path/--isa` makes, and an animated scene's frame is rendered,
 // shown (tiled and frameless) and saved as `octray render --frames N` renders it.
 
-#include "render/view/view_switches.h"
+#include "view/view_switches.h"
 
 #include <gtest/gtest.h>
 #include <httplib.h>
@@ -24,11 +24,11 @@
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
-#include "render/view/http_error.h"
-#include "render/view/view_server.h"
-#include "render/view/view_session.h"
 #include "scene/animation.h"
 #include "scene/load.h"
+#include "view/http_error.h"
+#include "view/view_server.h"
+#include "view/view_session.h"
 #include "view_fixtures.h"
 
 namespace {

@@ -1,6 +1,6 @@
 #pragma once
 // The HTTP side of `octray view`: the page, the pictures of a ViewSession and the camera
-// endpoint, behind an access token (render/view/README.md lists the protocol).
+// endpoint, behind an access token (view/README.md lists the protocol).
 
 #include <chrono>
 #include <cstddef>
@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
-#include "render/view/compare_view.h"
-#include "render/view/view_session.h"
+#include "view/compare_view.h"
+#include "view/view_session.h"
 
 namespace octray::view {
 

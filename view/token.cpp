@@ -1,4 +1,4 @@
-#include "render/view/token.h"
+#include "view/token.h"
 
 #include <array>
 #include <cstdint>

@@ -2,7 +2,7 @@
 // The renderer behind `octray view`: one scene, a camera the page moves, and a thread that
 // renders it — a reduced-resolution preview while the camera moves, then progressive
 // passes of 1, 2, 4, ... samples per pixel up to the scene's spp once it stops — and
-// publishes each finished picture for the HTTP server (render/view/view_server.h).
+// publishes each finished picture for the HTTP server (view/view_server.h).
 
 #include <atomic>
 #include <chrono>

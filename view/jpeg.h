@@ -1,5 +1,5 @@
 #pragma once
-// JPEG in memory for the picture stream (render/view/README.md, "Transport"): a moving
+// JPEG in memory for the picture stream (view/README.md, "Transport"): a moving
 // camera's previews and the passes before the last are sent as JPEG, which costs a few
 // milliseconds to encode and to decode at 1280x720 where PNG costs tens (measured there);
 // the refined picture stays PNG, lossless. libjpeg-turbo (Debian's libjpeg62-turbo-dev).

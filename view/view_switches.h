@@ -1,5 +1,5 @@
 #pragma once
-// POST /api/settings of `octray view` (render/view/README.md): the page's switches —
+// POST /api/settings of `octray view` (view/README.md): the page's switches —
 // threads, spp, max depth, pixel order, render path, ISA and the animation's frame — read
 // from the request's JSON and checked, and the JSON in which /api/status reports them.
 
@@ -9,7 +9,7 @@
 
 #include "kernels/isa.h"
 #include "render/types.h"
-#include "render/view/view_session.h"
+#include "view/view_session.h"
 
 namespace octray::view {
 
@@ -29,7 +29,7 @@ std::vector<std::string> isa_choices(const SwitchLimits& limits);
 // 1..2^20, "max_depth": 1..64, "order": "tiled" | "rows" | "frameless", "path": "simd" |
 // "scalar", "isa": "auto" | one of limits.isas, "frame": 0..frames-1}, every key
 // optional. Anything else — not JSON, an unknown key, a wrong type, a value out of range,
-// an ISA this CPU lacks — throws BadRequest (render/view/http_error.h) with status 400 and
+// an ISA this CPU lacks — throws BadRequest (view/http_error.h) with status 400 and
 // a message naming the key and what it takes.
 RenderSwitches parse_switches(const std::string& body, RenderSwitches current,
                               const SwitchLimits& limits);

@@ -1,4 +1,4 @@
-#include "render/view/guarded_server.h"
+#include "view/guarded_server.h"
 
 #include <netdb.h>
 #include <poll.h>

@@ -1,4 +1,4 @@
-#include "render/view/view_session.h"
+#include "view/view_session.h"
 
 #include <algorithm>
 #include <atomic>
@@ -13,10 +13,10 @@
 #include "render/batch/progressive.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
-#include "render/view/frameless.h"
 #include "scene/animation.h"
 #include "scene/load.h"
 #include "scene/scene_error.h"
+#include "view/frameless.h"
 
 namespace octray::view {
 namespace {

@@ -1,8 +1,8 @@
-#include "render/view/request_json.h"
+#include "view/request_json.h"
 
-#include "render/view/http_error.h"
 #include "scene/json_dom.h"
 #include "scene/scene_error.h"
+#include "view/http_error.h"
 
 namespace octray::view {
 

@@ -1,4 +1,4 @@
-#include "render/view/view_server.h"
+#include "view/view_server.h"
 
 #include <httplib.h>
 
@@ -23,17 +23,17 @@
 
 #include "core/decimal.h"
 #include "render/image/image_io.h"
-#include "render/view/guarded_server.h"
-#include "render/view/http_error.h"
-#include "render/view/jpeg.h"
-#include "render/view/page.h"
-#include "render/view/request_json.h"
-#include "render/view/token.h"
-#include "render/view/tone_map.h"
-#include "render/view/view_save.h"
-#include "render/view/view_switches.h"
 #include "scene/load.h"
 #include "scene/scene_error.h"
+#include "view/guarded_server.h"
+#include "view/http_error.h"
+#include "view/jpeg.h"
+#include "view/page.h"
+#include "view/request_json.h"
+#include "view/token.h"
+#include "view/tone_map.h"
+#include "view/view_save.h"
+#include "view/view_switches.h"
 
 namespace octray::view {
 namespace {

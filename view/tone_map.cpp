@@ -1,9 +1,9 @@
-#include "render/view/tone_map.h"
+#include "view/tone_map.h"
 
 #include <cmath>
 
 #include "render/image/image_io.h"
-#include "render/view/jpeg.h"
+#include "view/jpeg.h"
 
 namespace octray::view {
 

@@ -1,4 +1,4 @@
-#include "render/view/jpeg.h"
+#include "view/jpeg.h"
 
 // clang-format off
 #include <cstdio>  // jpeglib.h needs FILE and size_t first

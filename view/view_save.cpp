@@ -1,4 +1,4 @@
-#include "render/view/view_save.h"
+#include "view/view_save.h"
 
 #include <cctype>
 #include <filesystem>
@@ -12,11 +12,11 @@
 #include "render/batch/frame_loop.h"
 #include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
-#include "render/view/http_error.h"
-#include "render/view/request_json.h"
-#include "render/view/view_switches.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
+#include "view/http_error.h"
+#include "view/request_json.h"
+#include "view/view_switches.h"
 
 namespace octray::view {
 namespace {
@@ -70,7 +70,7 @@ bool same_camera(const Camera& a, const Camera& b) {
 
 }  // namespace
 
-// POST /api/save: the refined picture as `octray render` writes it (render/view/README.md).
+// POST /api/save: the refined picture as `octray render` writes it (view/README.md).
 nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
                          const std::string& body) {
     const json request = parse_request_json(body, "save");

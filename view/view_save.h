@@ -1,12 +1,12 @@
 #pragma once
-// POST /api/save of `octray view` (render/view/README.md): the refined picture written as
+// POST /api/save of `octray view` (view/README.md): the refined picture written as
 // `octray render` writes it, with the command line that renders it again.
 
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "render/view/view_server.h"
-#include "render/view/view_session.h"
+#include "view/view_server.h"
+#include "view/view_session.h"
 
 namespace octray::view {
 

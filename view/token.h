@@ -1,6 +1,6 @@
 #pragma once
 // The access token of `octray view`, as Jupyter's: a random secret in the URL the command
-// prints, which every request must carry (render/view/README.md, "Token").
+// prints, which every request must carry (view/README.md, "Token").
 
 #include <string>
 #include <string_view>

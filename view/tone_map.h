@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/image.h"
-#include "render/view/view_session.h"
+#include "view/view_session.h"
 
 namespace octray::view {
 

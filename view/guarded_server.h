@@ -4,7 +4,7 @@
 // the page and the API need), the number of connections is capped (past it a client gets
 // a 503 saying so, then the connection closes), and a connection that has not presented
 // the token within a deadline of its opening is shut down, however slowly it trickles its
-// bytes (render/view/README.md, "Safety").
+// bytes (view/README.md, "Safety").
 //
 // It replaces httplib's private virtual `process_and_close_socket` (legal C++: a derived
 // class may override a private virtual) with its own keep-alive loop around the protected

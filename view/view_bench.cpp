@@ -1,4 +1,4 @@
-#include "render/view/view_bench.h"
+#include "view/view_bench.h"
 
 #include <chrono>
 #include <cmath>
@@ -8,8 +8,8 @@
 
 #include "core/vec3.h"
 #include "render/image/image_io.h"
-#include "render/view/jpeg.h"
-#include "render/view/tone_map.h"
+#include "view/jpeg.h"
+#include "view/tone_map.h"
 
 namespace octray::view {
 namespace {

@@ -4,7 +4,7 @@
 // (each rendered as a moving camera is, then tone-mapped and encoded as the picture stream
 // sends it to the page: a preview as JPEG).
 
-#include "render/view/view_session.h"
+#include "view/view_session.h"
 
 namespace octray::view {
 

@@ -1,13 +1,13 @@
-#include "render/view/view_switches.h"
+#include "view/view_switches.h"
 
 #include <algorithm>
 
 #include "kernels/dispatch.h"
 #include "render/render_config.h"
 #include "render/types.h"
-#include "render/view/http_error.h"
-#include "render/view/request_json.h"
 #include "scene/max_depth.h"
+#include "view/http_error.h"
+#include "view/request_json.h"
 
 namespace octray::view {
 namespace {

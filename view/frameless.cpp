@@ -1,4 +1,4 @@
-#include "render/view/frameless.h"
+#include "view/frameless.h"
 
 #include <algorithm>
 #include <random>

@@ -1,4 +1,4 @@
-#include "render/view/compare_view.h"
+#include "view/compare_view.h"
 
 #include <array>
 #include <set>
