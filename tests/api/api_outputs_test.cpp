@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "error_kind.h"
+#include "floor_and_ball.h"
 #include "octray/octray.h"
 
 namespace api = octray::api;
@@ -20,18 +21,10 @@ using octray::api::testing::kind_of;
 
 namespace {
 
-// A checkered floor, a ball (object 2) and a background: every AOV has hits and misses.
+// The floor and the ball against a sky: every AOV has hits and misses.
 api::Scene small_scene() {
-    api::Scene scene;
-    scene.set_image(40, 30, 2)
-        .set_camera({.eye = {0.0f, 1.5f, 6.0f}, .lookat = {0.0f, 0.8f, 0.0f}, .fov = 45.0f})
-        .set_background({1.0f, 1.0f, 1.0f}, {0.4f, 0.6f, 1.0f});
-    const auto floor = scene.add_material(
-        {.color = {0.9f, 0.9f, 0.9f}, .checker = true, .checker_color = {0.1f, 0.1f, 0.1f}});
-    const auto ball = scene.add_material({.color = {0.8f, 0.2f, 0.1f}, .ks = 0.4f});
-    scene.add_plane({0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, floor);
-    scene.add_sphere({0.0f, 1.0f, 0.0f}, 1.0f, ball, "ball");
-    scene.add_point_light({5.0f, 8.0f, 5.0f}, {1.0f, 1.0f, 1.0f});
+    api::Scene scene = octray::api::testing::floor_and_ball(40, 30, 2);
+    scene.set_background({1.0f, 1.0f, 1.0f}, {0.4f, 0.6f, 1.0f});
     return scene;
 }
 

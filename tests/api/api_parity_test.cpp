@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "floor_and_ball.h"
 #include "octray/octray.h"
 #include "render/batch/frame_loop.h"
 #include "render/batch/observer.h"
@@ -29,16 +30,7 @@ namespace {
 
 // A floor, a moving ball, 3 frames, as a scene file both sides load.
 std::string write_scene(const std::string& dir) {
-    api::Scene scene;
-    scene.set_image(36, 24, 2).set_camera(
-        {.eye = {0.0f, 1.5f, 6.0f}, .lookat = {0.0f, 0.8f, 0.0f}, .fov = 45.0f});
-    const auto floor = scene.add_material(
-        {.color = {0.9f, 0.9f, 0.9f}, .checker = true, .checker_color = {0.1f, 0.1f, 0.1f}});
-    const auto ball = scene.add_material({.color = {0.8f, 0.2f, 0.1f}, .ks = 0.4f});
-    scene.add_plane({0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, floor);
-    scene.add_sphere({0.0f, 1.0f, 0.0f}, 1.0f, ball, "ball");
-    scene.add_point_light({5.0f, 8.0f, 5.0f}, {1.0f, 1.0f, 1.0f});
-    std::string json = scene.to_json();
+    std::string json = octray::api::testing::floor_and_ball(36, 24, 2).to_json();
     json.insert(json.rfind('}'), R"(, "animation": {"frames": 3, "objects": {"ball": [
         {"frame": 0, "center": [0, 1, 0]}, {"frame": 2, "center": [1, 1.5, -1]}]}})");
     fs::create_directories(dir);
