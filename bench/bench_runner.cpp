@@ -381,7 +381,7 @@ void set_up_scene(BenchRun& run, BenchScene& bs) {
 // ---- Rows ----
 
 // The packets octray's kernels trace in: the ISA's traversal packets (16 rays with AVX-512,
-// kernels/bvh_packet.h), through the BVH and in brute force alike.
+// kernels/bvh/bvh_packet.h), through the BVH and in brute force alike.
 std::string octray_mode(Isa isa, bool /*bvh*/) {
     return "packet" + std::to_string(kernel_table(isa).traversal_width);
 }

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "kernels/bvh_node.h"
+#include "kernels/bvh/bvh_node.h"
 
 namespace octray::bvh_sah {
 

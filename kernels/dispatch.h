@@ -60,7 +60,7 @@ inline constexpr std::uint32_t kBvhPacketMinLanes = 2;
 inline constexpr std::uint32_t kBvhShadowSortMinSpheres = 32768;
 
 // In BVHs of at most this many spheres, shadow rays, and closest-hit rays that form no beam
-// (kernels/bvh_beam.h: primary rays from one origin do), test every sphere as without a
+// (kernels/bvh/bvh_beam.h: primary rays from one origin do), test every sphere as without a
 // BVH: 16 spheres against a 16-ray register cost less than the packet traversal's and the
 // shadow beams' bookkeeping, while primary rays' beams beat brute force from about 16
 // spheres on (measured: docs/performance-log.md, "Small scenes: brute force 16 rays

@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-#include "kernels/bvh_node.h"
+#include "kernels/bvh/bvh_node.h"
 
 namespace octray::kernels {
 
@@ -85,11 +85,11 @@ struct SceneView {
     // pixels' secondary rays leave different tiny spheres in unrelated directions and share
     // too few nodes for a packet to pay (kernels/dispatch.h).
     std::uint32_t bvh_secondary_min_lanes;
-    // Shadow rays are regrouped by origin and direction before tracing (hit_kernels.h,
+    // Shadow rays are regrouped by origin and direction before tracing (stream/hit_kernels.h,
     // any_hit) in BVHs of at least this many spheres.
     std::uint32_t bvh_shadow_sort_min_spheres;
     // In BVHs of at most this many spheres, shadow rays, and closest-hit rays that form no
-    // beam, test every sphere as without a BVH (hit_kernels.h; kernels/dispatch.h).
+    // beam, test every sphere as without a BVH (stream/hit_kernels.h; kernels/dispatch.h).
     std::uint32_t bvh_brute_force_max_spheres;
 };
 

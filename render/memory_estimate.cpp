@@ -13,7 +13,7 @@
 #include <system_error>
 #include <thread>
 
-#include "kernels/bvh_node.h"
+#include "kernels/bvh/bvh_node.h"
 #include "render/tile_layout.h"
 #include "scene/scene_error.h"
 

@@ -1,4 +1,4 @@
-// The sphere BVH (kernels/bvh_build.h) and its traversal (kernels/hit_kernels.h and the bvh_*.h
+// The sphere BVH (kernels/bvh_build.h) and its traversal (kernels/stream/hit_kernels.h and the bvh_*.h
 // headers it includes).
 // Builder: every sphere in exactly one leaf, leaves of 1-8 spheres, every child box holds
 // its spheres (the exact spheres, in double precision) and its children's boxes, empty
@@ -631,7 +631,7 @@ class BvhTraversalTest : public ::testing::Test {
 TYPED_TEST_SUITE(BvhTraversalTest, Isas);
 
 // Streams whose groups of 256 rays share their origin: the beams of closest_hit
-// (kernels/bvh_beam.h). Each group is a grid of 16 x 16 directions about a random axis,
+// (kernels/bvh/bvh_beam.h). Each group is a grid of 16 x 16 directions about a random axis,
 // from 1e-4 to 1 radian wide, from an origin in or around the scene; in every other group
 // the grid's first row grazes a sphere's silhouette (to within a few ulps, from 10 to 10^6
 // radii away), so that the sphere lies on the edge of the beam's pyramid and of its first

@@ -6,7 +6,7 @@
 // (packet_math.h; kernels/README.md, "the ODR rule").
 //
 // The tree is kernels/bvh_build.h's: 8-wide nodes with their children's boxes in SoA
-// (kernels/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
+// (kernels/bvh/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
 // - packet traversal (Wald et al. 2001, "Interactive rendering with coherent ray
 //   tracing", widened to 8-wide nodes): the packet as a whole (a frustum, where its
 //   directions' signs agree) is tested against all 8 children at once; the 8-ray packet is

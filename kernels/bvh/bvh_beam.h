@@ -32,7 +32,7 @@
 // and its tie rule (the lower file index wins) decide the hits, in any order. So a sphere
 // may be dropped only where no ray of the pyramid could report it. A lane reports a
 // sphere only when its ray passes within r + 10u|O'| of the center (u = 2^-24; the bound
-// of kernels/bvh_packet.h), at a point in front of O, or when O lies within that distance
+// of kernels/bvh/bvh_packet.h), at a point in front of O, or when O lies within that distance
 // of the center (a root in front of an origin behind the sphere's center). Both put the
 // sphere's center within that distance of the pyramid, so within it of each of the
 // pyramid's planes: the sphere is kept while every plane's signed distance to the center
@@ -58,9 +58,9 @@
 #include <cmath>
 #include <cstdint>
 
-#include "kernels/bvh_frustum.h"
-#include "kernels/bvh_packet.h"
-#include "kernels/bvh_packet_traversal.h"
+#include "kernels/bvh/bvh_frustum.h"
+#include "kernels/bvh/bvh_packet.h"
+#include "kernels/bvh/bvh_packet_traversal.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 

@@ -12,7 +12,7 @@
 
 #include <cstdint>
 
-#include "kernels/compaction.h"
+#include "kernels/stream/compaction.h"
 #include "kernels/packet_math.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
