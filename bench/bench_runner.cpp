@@ -24,9 +24,10 @@
 #include "bench/bench_detail.h"
 #include "bench/embree_baseline.h"
 #include "bench/embree_frames.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/packet_renderer.h"
+#include "render/prepare/bvh_build.h"
+#include "render/prepare/scene_view.h"
 #include "render/reference.h"
 #include "scene/compile.h"
 

@@ -10,9 +10,9 @@
 
 #define OCTRAY_KERNEL_NAMESPACE avx512
 #define OCTRAY_TRAVERSAL_ARCH xsimd::avx512f
+#include "kernels/kernel_table.h"
 #include "kernels/stream/camera_rays.h"
 #include "kernels/stream/hit_kernels.h"
-#include "kernels/kernel_table.h"
 #include "kernels/stream/shading.h"
 
 namespace octray::kernels {

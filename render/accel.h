@@ -11,9 +11,9 @@
 
 namespace octray {
 
-// automatic: the BVH (kernels/bvh_build.h) from kBvhAutoMinSpheres spheres on, brute force
-// below; bvh: always the BVH; none: brute force (every ray against every sphere). The image
-// is the same whichever is used (kernels/README.md, section "The BVH").
+// automatic: the BVH (render/prepare/bvh_build.h) from kBvhAutoMinSpheres spheres on, brute
+// force below; bvh: always the BVH; none: brute force (every ray against every sphere). The
+// image is the same whichever is used (kernels/README.md, section "The BVH").
 enum class Accel { automatic, bvh, none };
 
 // The sphere count from which Accel::automatic builds a BVH: the crossover measured by

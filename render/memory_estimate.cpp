@@ -56,9 +56,9 @@ constexpr std::uint64_t kCompiledMaterialBytes = 16 * 4;  // CompiledMaterials' 
 constexpr std::uint64_t kCompiledLightBytes = 11 * 4;     // CompiledLights' 11 columns
 constexpr std::uint64_t kPadding = 8;
 
-// kernels/bvh_build.cpp build_sphere_bvh, per sphere: one PrimRef array (32 bytes; the
+// render/prepare/bvh_build.cpp build_sphere_bvh, per sphere: one PrimRef array (32 bytes; the
 // partitions work in place) and n - 1 BinaryNodes (28 bytes; inner nodes only) while
-// building (kernels/bvh_sah.h), the 8-wide nodes (224 bytes each; one per 26 spheres
+// building (render/prepare/bvh_sah.h), the 8-wide nodes (224 bytes each; one per 26 spheres
 // measured on random:1000000, counted as one per 4) and the BVH's copy of the spheres
 // (5 columns). Its arrays sit on 2 MiB huge pages: a
 // page of rounding for each of its 8 arrays.

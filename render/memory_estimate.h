@@ -4,7 +4,7 @@
 // --max-memory`), and the parser for sizes such as "512M" or "4G".
 //
 // The estimate counts what the process really allocates, from the layouts in
-// core/image.h, scene/compile.h, kernels/bvh_build.cpp, render/packet_renderer.cpp (its
+// core/image.h, scene/compile.h, render/prepare/bvh_build.cpp, render/packet_renderer.cpp (its
 // tile scratch: render/tile_layout.h), render/batch/progressive.cpp, render/aov.h,
 // render/batch/result_exr.cpp, render/image/png.cpp and render/batch/frame_loop.cpp,
 // plus the process's own fixed footprint and the parse of a scene file; it is meant to be

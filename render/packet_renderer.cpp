@@ -22,10 +22,11 @@
 
 #include "core/aligned.h"
 #include "core/random.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/crop.h"
 #include "render/parallel.h"
+#include "render/prepare/bvh_build.h"
+#include "render/prepare/scene_view.h"
 #include "render/stream_row.h"
 #include "render/tile_layout.h"
 #include "scene/camera.h"

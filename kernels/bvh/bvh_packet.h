@@ -5,7 +5,7 @@
 // Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
 // (packet_math.h; kernels/README.md, "the ODR rule").
 //
-// The tree is kernels/bvh_build.h's: 8-wide nodes with their children's boxes in SoA
+// The tree is render/prepare/bvh_build.h's: 8-wide nodes with their children's boxes in SoA
 // (kernels/bvh/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
 // - packet traversal (Wald et al. 2001, "Interactive rendering with coherent ray
 //   tracing", widened to 8-wide nodes): the packet as a whole (a frustum, where its
@@ -69,7 +69,7 @@ static_assert(kTraversalWidth % kPacketWidth == 0 && kTraversalWidth <= 16);
 
 // Entries of a traversal stack: a node pushes at most 8 children (the single-ray
 // traversal writes all 8 slots above the top at once), and the builder keeps the tree
-// below 48 + 28 levels (kernels/bvh_sah.cpp, kMaxSahDepth).
+// below 48 + 28 levels (render/prepare/bvh_sah.cpp, kMaxSahDepth).
 constexpr std::uint32_t kBvhStackSize = 1024;
 // 32u and 64u of the margin above.
 constexpr float kBvhFuzz = 0x1.0p-19f;

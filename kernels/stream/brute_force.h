@@ -11,9 +11,9 @@
 #include <cstdint>
 
 #include "kernels/bvh/bvh_packet.h"
-#include "kernels/packet_math.h"
 #include "kernels/geometry/plane_test.h"
 #include "kernels/geometry/sphere_test.h"
+#include "kernels/packet_math.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 

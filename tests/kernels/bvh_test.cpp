@@ -1,14 +1,13 @@
-// The sphere BVH (kernels/bvh_build.h) and its traversal (kernels/stream/hit_kernels.h and the bvh_*.h
-// headers it includes).
-// Builder: every sphere in exactly one leaf, leaves of 1-8 spheres, every child box holds
-// its spheres (the exact spheres, in double precision) and its children's boxes, empty
-// slots last and never entered, the same bytes for any thread count, leaves that are small
-// parts of the root on spread-out spheres.
-// Traversal, under every ISA the CPU runs and with packets, single rays and the switch
-// between them: closest hits equal the scalar reference's (brute force) bit for bit and
-// hit for hit on random rays over random and degenerate scenes (one sphere, all spheres at
-// one point, radii from 1e-6 to 1e3, spheres far apart along one axis, duplicates that tie,
-// planes); any-hit equals the reference's occlusion and agrees with closest hit.
+// The sphere BVH (render/prepare/bvh_build.h) and its traversal (kernels/stream/hit_kernels.h
+// and the bvh_*.h headers it includes). Builder: every sphere in exactly one leaf, leaves of
+// 1-8 spheres, every child box holds its spheres (the exact spheres, in double precision) and
+// its children's boxes, empty slots last and never entered, the same bytes for any thread
+// count, leaves that are small parts of the root on spread-out spheres. Traversal, under every
+// ISA the CPU runs and with packets, single rays and the switch between them: closest hits
+// equal the scalar reference's (brute force) bit for bit and hit for hit on random rays over
+// random and degenerate scenes (one sphere, all spheres at one point, radii from 1e-6 to 1e3,
+// spheres far apart along one axis, duplicates that tie, planes); any-hit equals the
+// reference's occlusion and agrees with closest hit.
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -21,8 +20,9 @@
 #include <vector>
 
 #include "core/aligned.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
+#include "render/prepare/bvh_build.h"
+#include "render/prepare/scene_view.h"
 #include "render/reference.h"
 #include "scene/compile.h"
 
@@ -268,8 +268,8 @@ void check_invariants(const NamedScene& ns) {
     EXPECT_GT(bvh.memory_bytes(), 0u);
 }
 
-// Large enough that the builder's tasks collapse subtrees of their own (kernels/bvh_build.cpp:
-// 1024 spheres or more), whose nodes are appended and relocated.
+// Large enough that the builder's tasks collapse subtrees of their own
+// (render/prepare/bvh_build.cpp: 1024 spheres or more), whose nodes are appended and relocated.
 NamedScene large_scene() {
     std::mt19937 rng(2026);
     return {"20000 spheres", scene_of(random_spheres(rng, 20000, 3.0f, 0.005f, 0.03f))};

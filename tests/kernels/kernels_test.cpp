@@ -14,8 +14,9 @@
 
 #include "core/aligned.h"
 #include "core/random.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
+#include "render/prepare/bvh_build.h"
+#include "render/prepare/scene_view.h"
 #include "render/reference.h"
 #include "scene/compile.h"
 #include "scene/load.h"
