@@ -36,7 +36,7 @@ namespace {
 
 using kernels::kPacketWidth;
 
-// The stream layout render/tile_layout.h states (and render/memory_estimate.cpp counts).
+// The stream layout render/tile_layout.h states (and render/batch/memory_estimate.cpp counts).
 static_assert(kTileStreamPacket == kPacketWidth);
 
 // Rounds a stream length up to whole packets, with one spare packet.
@@ -53,7 +53,7 @@ void grow(std::size_t n, Columns&... columns) {
                   "render/tile_layout.h: column element size");
     const std::size_t capacity = stream_capacity(n);
     // reserve first: resize alone may allocate up to twice the size (libstdc++ grows
-    // geometrically), and render/memory_estimate.cpp counts exactly `capacity` elements.
+    // geometrically), and render/batch/memory_estimate.cpp counts exactly `capacity` elements.
     ((columns.size() < capacity ? (columns.reserve(capacity), columns.resize(capacity))
                                 : void()),
      ...);

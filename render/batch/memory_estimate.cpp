@@ -1,7 +1,7 @@
-// The memory estimate of render/memory_estimate.h. Every size below names the layout it comes
-// from; when those layouts change, change the constants with them.
+// The memory estimate of render/batch/memory_estimate.h. Every size below names the layout it
+// comes from; when those layouts change, change the constants with them.
 
-#include "render/memory_estimate.h"
+#include "render/batch/memory_estimate.h"
 
 #include <unistd.h>
 
@@ -17,7 +17,7 @@
 #include "render/tile_layout.h"
 #include "scene/scene_error.h"
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
@@ -316,4 +316,18 @@ std::optional<std::uint64_t> parse_memory_size(std::string_view text) {
     return value << shift;
 }
 
-}  // namespace octray
+RenderMemoryParams memory_params(const RenderConfig& config) {
+    RenderMemoryParams p;
+    p.threads = config.threads;
+    p.tile_width = config.tile.width;
+    p.tile_height = config.tile.height;
+    p.packet_path = config.path == RenderPath::simd;
+    p.accel = config.accel;
+    p.aov_depth = config.aovs.depth;
+    p.aov_normal = config.aovs.normal;
+    p.aov_albedo = config.aovs.albedo;
+    p.aov_id = config.aovs.id;
+    return p;
+}
+
+}  // namespace octray::batch
