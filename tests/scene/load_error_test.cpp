@@ -22,7 +22,7 @@
 namespace octray {
 namespace {
 
-using namespace load_test;
+using namespace testing;
 
 // ---------------------------------------------------------------------------------------
 // Errors
