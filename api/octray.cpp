@@ -105,21 +105,21 @@ Isa from_internal(octray::Isa isa) {
     return Isa::automatic;
 }
 
-octray::Image to_internal(const Image& image) {
+octray::RgbImage to_internal(const Image& image) {
     if (image.width < 0 || image.height < 0 ||
         image.rgb.size() != 3 * static_cast<std::size_t>(image.width) *
                                 static_cast<std::size_t>(image.height)) {
         throw Error(ErrorKind::invalid_argument,
                     "image: rgb must hold 3 floats for each of width x height pixels");
     }
-    octray::Image out(image.width, image.height);
+    octray::RgbImage out(image.width, image.height);
     for (std::size_t k = 0; k < out.pixel_count(); ++k) {
         out.data()[k] = {image.rgb[3 * k], image.rgb[3 * k + 1], image.rgb[3 * k + 2]};
     }
     return out;
 }
 
-Image from_internal(const octray::Image& image) {
+Image from_internal(const octray::RgbImage& image) {
     Image out;
     out.width = image.width();
     out.height = image.height();
@@ -132,20 +132,19 @@ Image from_internal(const octray::Image& image) {
     return out;
 }
 
-ChannelImage to_channels(const Image& image) {
-    const octray::Image rgb = to_internal(image);
-    ChannelImage out(image.width, image.height, {"R", "G", "B"});
-    for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) {
-            out.at(0, x, y) = rgb.at(x, y).r;
-            out.at(1, x, y) = rgb.at(x, y).g;
-            out.at(2, x, y) = rgb.at(x, y).b;
-        }
-    }
+// The API's plain RGB image as octray's image: float32 channels R, G, B.
+octray::Image to_channels(const Image& image) {
+    const octray::RgbImage rgb = to_internal(image);
+    octray::Image out(image.width, image.height, {"R", "G", "B"});
+    const float* values = reinterpret_cast<const float*>(rgb.data());
+    for (int c = 0; c < 3; ++c)
+        out.channels[static_cast<std::size_t>(c)] = octray::make_channel(
+            out.channels[static_cast<std::size_t>(c)].name, octray::PixelFormat::float32,
+            values + c, rgb.pixel_count(), 3);
     return out;
 }
 
-CompareResult compare_channels(const ChannelImage& a, const ChannelImage& b,
+CompareResult compare_channels(const octray::Image& a, const octray::Image& b,
                                const CompareOptions& options) {
     octray::CompareOptions o;
     o.fail_threshold = options.fail_threshold;
@@ -279,14 +278,29 @@ octray::Scene configured_scene(const Scene& scene, octray::RenderConfig& config)
     return source;
 }
 
-Aovs from_internal(const AovImages& a) {
+// The AOV image's channels (render/aov.h) as the API's vectors: Z, N.* and albedo.*
+// interleaved three to a pixel, id.
+Aovs from_internal(const octray::Image& a) {
     Aovs out;
-    out.depth = a.depth;
-    out.normal.reserve(3 * a.normal.size());
-    for (const octray::Vec3& n : a.normal) out.normal.insert(out.normal.end(), {n.x, n.y, n.z});
-    out.albedo.reserve(3 * a.albedo.size());
-    for (const octray::Rgb& c : a.albedo) out.albedo.insert(out.albedo.end(), {c.r, c.g, c.b});
-    out.id = a.id;
+    const auto floats = [&](const char* name) {
+        const octray::ImageChannel* c = a.find_channel(name);
+        return c == nullptr ? nullptr : c->floats();
+    };
+    const auto interleave = [&](std::vector<float>& v, const char* x, const char* y,
+                                const char* z) {
+        const float* p[3] = {floats(x), floats(y), floats(z)};
+        if (p[0] == nullptr) return;
+        v.resize(3 * a.pixel_count());
+        for (std::size_t k = 0; k < a.pixel_count(); ++k)
+            for (std::size_t c = 0; c < 3; ++c) v[3 * k + c] = p[c][k];
+    };
+    if (const float* z = floats("Z")) out.depth.assign(z, z + a.pixel_count());
+    interleave(out.normal, "N.X", "N.Y", "N.Z");
+    interleave(out.albedo, "albedo.R", "albedo.G", "albedo.B");
+    if (const octray::ImageChannel* id = a.find_channel("id")) {
+        out.id.resize(a.pixel_count());
+        for (std::size_t k = 0; k < a.pixel_count(); ++k) out.id[k] = id->uint_value(k);
+    }
     return out;
 }
 
@@ -496,7 +510,7 @@ struct Renderer::Impl {
         o.frame = static_cast<std::uint32_t>(frame);
         struct Rendered {
             octray::RenderResult result;
-            AovImages aovs;
+            octray::Image aovs;
         };
         // Preparing the frame (compiling the scene and building its BVH for the first
         // frame) is part of the run the progress callback reports.
@@ -575,18 +589,18 @@ void write_exr(const std::string& path, const Image& image, const ExrOptions& op
 
 Image read_image(const std::string& path) {
     return translate_errors([&] {
-        const ChannelImage c = octray::read_image(path);
-        const int r = c.find_channel("R"), g = c.find_channel("G"), b = c.find_channel("B");
+        const octray::Image c = octray::read_image(path);
+        const int r = c.channel_index("R"), g = c.channel_index("G"), b = c.channel_index("B");
         if (r < 0 || g < 0 || b < 0) {
             throw IoError(path + ": no R, G and B channels");
         }
         Image out;
-        out.width = c.width;
-        out.height = c.height;
+        out.width = c.width();
+        out.height = c.height();
         out.rgb.resize(3 * c.pixel_count());
-        for (int y = 0; y < c.height; ++y) {
-            for (int x = 0; x < c.width; ++x) {
-                const std::size_t k = static_cast<std::size_t>(y) * c.width + x;
+        for (int y = 0; y < c.height(); ++y) {
+            for (int x = 0; x < c.width(); ++x) {
+                const std::size_t k = static_cast<std::size_t>(y) * c.width() + x;
                 out.rgb[3 * k] = c.at(r, x, y);
                 out.rgb[3 * k + 1] = c.at(g, x, y);
                 out.rgb[3 * k + 2] = c.at(b, x, y);

@@ -1,6 +1,8 @@
 #pragma once
-// An RGB float image. Row 0 is the TOP row, as OpenEXR stores it and as a raster image
-// is read; the cameras flip the row index when turning a pixel into a ray.
+// The renderers' framebuffer: RGB floats, interleaved. Row 0 is the TOP row, as OpenEXR
+// stores it and as a raster image is read; the cameras flip the row index when turning a
+// pixel into a ray. Past the renderer an image is render/image/image.h's Image (named
+// channels, formats, windows, metadata): make_image() makes one from an RgbImage.
 
 #include <cstddef>
 #include <utility>
@@ -11,20 +13,20 @@
 
 namespace octray {
 
-class Image {
+class RgbImage {
   public:
     // A renderer about to write every pixel (in parallel) asks for unwritten storage: the
     // pages are then first touched by the threads that fill them, not zeroed serially.
     struct Uninitialized {};
 
-    Image() = default;
+    RgbImage() = default;
     // Every pixel black.
-    Image(int width, int height)
+    RgbImage(int width, int height)
         : width_(width),
           height_(height),
           pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Rgb()) {}
     // Pixel values undefined until written: the caller writes every one.
-    Image(int width, int height, Uninitialized)
+    RgbImage(int width, int height, Uninitialized)
         : width_(width),
           height_(height),
           pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {}
@@ -33,15 +35,15 @@ class Image {
     // holds exactly that many pixels: a frame loop hands back the frame it has written,
     // and the next frame then touches no freshly mapped pages. Fresh storage otherwise,
     // after `spare`'s is freed (never two frames at once). `spare` is left empty.
-    static Image reuse(Image&& spare, int width, int height) {
-        Image image;
+    static RgbImage reuse(RgbImage&& spare, int width, int height) {
+        RgbImage image;
         if (!spare.fits(width, height)) {
-            spare = Image();
-            return Image(width, height, Uninitialized{});
+            spare = RgbImage();
+            return RgbImage(width, height, Uninitialized{});
         }
         image.width_ = width, image.height_ = height;
         image.pixels_ = std::move(spare.pixels_);
-        spare = Image();
+        spare = RgbImage();
         return image;
     }
 
@@ -63,7 +65,7 @@ class Image {
     const Rgb* data() const { return pixels_.data(); }
     const std::vector<Rgb, UninitializedAllocator<Rgb>>& pixels() const { return pixels_; }
 
-    friend bool operator==(const Image& a, const Image& b) {
+    friend bool operator==(const RgbImage& a, const RgbImage& b) {
         return a.width_ == b.width_ && a.height_ == b.height_ && a.pixels_ == b.pixels_;
     }
 

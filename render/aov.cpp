@@ -7,6 +7,7 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <limits>
 #include <stdexcept>
@@ -81,18 +82,28 @@ namespace {
 
 // The AOVs of the pixels of options.crop from each pixel's first hit: traced by the
 // reference here (`hits` null), or given (the packet path's, trace_first_hits).
-AovImages aovs_from(const Scene& scene, const RenderOptions& options, AovSet set,
-                    const FirstHits* hits) {
+Image aovs_from(const Scene& scene, const RenderOptions& options, AovSet set,
+                const FirstHits* hits) {
     const PixelRect rect = render_rect(options, scene.image.width, scene.image.height);
-    AovImages out;
-    out.set = set;
-    out.rect = rect;
     const std::size_t n = rect.pixel_count();
-    if (set.depth) out.depth.assign(n, std::numeric_limits<float>::infinity());
-    if (set.normal) out.normal.assign(n, Vec3{});
-    if (set.albedo) out.albedo.assign(n, Rgb{});
-    if (set.id) out.id.assign(n, 0u);
+    std::vector<std::string> names;
+    if (set.depth) names.push_back("Z");
+    if (set.normal) names.insert(names.end(), {"N.X", "N.Y", "N.Z"});
+    if (set.albedo) names.insert(names.end(), {"albedo.R", "albedo.G", "albedo.B"});
+    Image out(rect.width(), rect.height(), names);  // every float 0: a miss
+    out.data_window = out.display_window = rect;
+    if (set.id) out.channels.push_back(make_channel("id", std::vector<std::uint32_t>(n, 0u)));
     if (!set.any()) return out;
+    float* const depth = set.depth ? out.plane(out.channel_index("Z")) : nullptr;
+    if (depth != nullptr) std::fill(depth, depth + n, std::numeric_limits<float>::infinity());
+    float* const normal[3] = {set.normal ? out.plane(out.channel_index("N.X")) : nullptr,
+                              set.normal ? out.plane(out.channel_index("N.Y")) : nullptr,
+                              set.normal ? out.plane(out.channel_index("N.Z")) : nullptr};
+    float* const albedo[3] = {set.albedo ? out.plane(out.channel_index("albedo.R")) : nullptr,
+                              set.albedo ? out.plane(out.channel_index("albedo.G")) : nullptr,
+                              set.albedo ? out.plane(out.channel_index("albedo.B")) : nullptr};
+    std::uint32_t* const id =
+        set.id ? reinterpret_cast<std::uint32_t*>(out.channels.back().samples.data()) : nullptr;
     if (hits != nullptr &&
         (!(hits->rect == rect) || hits->t.size() != n || hits->object.size() != n))
         throw std::invalid_argument("compute_aovs: the first hits cover " +
@@ -119,12 +130,17 @@ AovImages aovs_from(const Scene& scene, const RenderOptions& options, AovSet set
                         hit = tracer.surface_hit(*ray, hits->t[k],
                                                  static_cast<std::uint32_t>(hits->object[k]));
                     if (!hit) continue;
-                    if (set.depth) out.depth[k] = hit->t;
-                    if (set.normal)  // the normal shading uses: facing the incoming ray
-                        out.normal[k] = dot(hit->normal, ray->direction) > 0.0f ? -hit->normal
-                                                                                : hit->normal;
-                    if (set.albedo) out.albedo[k] = tracer.surface_color(*hit);
-                    if (set.id) out.id[k] = hit->object + 1;
+                    if (set.depth) depth[k] = hit->t;
+                    if (set.normal) {  // the normal shading uses: facing the incoming ray
+                        const Vec3 v = dot(hit->normal, ray->direction) > 0.0f ? -hit->normal
+                                                                               : hit->normal;
+                        normal[0][k] = v.x, normal[1][k] = v.y, normal[2][k] = v.z;
+                    }
+                    if (set.albedo) {
+                        const Rgb c = tracer.surface_color(*hit);
+                        albedo[0][k] = c.r, albedo[1][k] = c.g, albedo[2][k] = c.b;
+                    }
+                    if (set.id) id[k] = hit->object + 1;
                 }
         });
     };
@@ -134,41 +150,30 @@ AovImages aovs_from(const Scene& scene, const RenderOptions& options, AovSet set
 
 }  // namespace
 
-AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set) {
+Image compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set) {
     return aovs_from(scene, options, set, nullptr);
 }
 
-AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
-                       const FirstHits& hits) {
+Image compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
+                   const FirstHits& hits) {
     return aovs_from(scene, options, set, &hits);
 }
 
-void append_aov_channels(ExrImage& exr, const AovImages& aovs, ExrPixelType color_type) {
-    if (!(exr.data_window == aovs.rect))
-        throw std::invalid_argument("append_aov_channels: the AOVs cover " +
-                                    to_string(aovs.rect) + ", the image's data window is " +
-                                    to_string(exr.data_window));
-    if (color_type == ExrPixelType::uint32)
+void append_aov_channels(Image& image, const Image& aovs, PixelFormat color_type) {
+    if (!(image.data_window == aovs.data_window))
+        throw std::invalid_argument(
+            "append_aov_channels: the AOVs cover " + to_string(aovs.data_window) +
+            ", the image's data window is " + to_string(image.data_window));
+    if (color_type != PixelFormat::half && color_type != PixelFormat::float32)
         throw std::invalid_argument("append_aov_channels: colors are half or float");
-    const std::size_t n = aovs.rect.pixel_count();
-    if (aovs.set.depth)
-        exr.channels.push_back(
-            make_exr_channel("Z", ExrPixelType::float32, aovs.depth.data(), n));
-    if (aovs.set.normal) {
-        const float* v = reinterpret_cast<const float*>(aovs.normal.data());
-        static_assert(sizeof(Vec3) == 3 * sizeof(float));
-        exr.channels.push_back(make_exr_channel("N.X", color_type, v + 0, n, 3));
-        exr.channels.push_back(make_exr_channel("N.Y", color_type, v + 1, n, 3));
-        exr.channels.push_back(make_exr_channel("N.Z", color_type, v + 2, n, 3));
+    for (const ImageChannel& c : aovs.channels) {
+        // Depth keeps float32 (its +inf misses and far hits); normals and albedo take the
+        // colour channels' type, ids stay uint32.
+        if (c.format != PixelFormat::float32 || c.name == "Z")
+            image.channels.push_back(c);
+        else
+            image.channels.push_back(make_channel(c.name, color_type, c.floats(), c.size()));
     }
-    if (aovs.set.albedo) {
-        const float* c = reinterpret_cast<const float*>(aovs.albedo.data());
-        static_assert(sizeof(Rgb) == 3 * sizeof(float));
-        exr.channels.push_back(make_exr_channel("albedo.R", color_type, c + 0, n, 3));
-        exr.channels.push_back(make_exr_channel("albedo.G", color_type, c + 1, n, 3));
-        exr.channels.push_back(make_exr_channel("albedo.B", color_type, c + 2, n, 3));
-    }
-    if (aovs.set.id) exr.channels.push_back(make_exr_channel("id", aovs.id));
 }
 
 }  // namespace octray

@@ -32,33 +32,30 @@ struct AovSet {
 // AOV 'foo' (known: depth, normal, albedo, id)").
 std::optional<AovSet> parse_aov_list(std::string_view list, std::string* error = nullptr);
 
-// The AOVs of the pixels of `rect`, row by row (top row first); a vector is empty unless
-// its AOV was asked for.
-struct AovImages {
-    AovSet set;
-    PixelRect rect;
-    std::vector<float> depth;       // t of the first hit along the unit primary ray; +inf: miss
-    std::vector<Vec3> normal;       // world-space unit normal facing the ray; 0: miss
-    std::vector<Rgb> albedo;        // Cd at the hit (checker included); 0: miss
-    std::vector<std::uint32_t> id;  // Scene::objects index + 1; 0: miss
-};
+// The AOVs are an Image (render/image/image.h) whose data window (and display window) is
+// the rendered rectangle, with a float32 channel for each value asked for, in this order:
+//   Z                              t of the first hit along the unit primary ray; +inf: miss
+//   N.X N.Y N.Z                    world-space unit normal facing the ray; 0: miss
+//   albedo.R albedo.G albedo.B     Cd at the hit (checker included); 0: miss
+//   id (uint32)                    Scene::objects index + 1; 0: miss
+// An empty set gives an image without channels.
 
 // Computes `set` for the pixels of options.crop (or the whole image) of frame
 // options.frame, from sample 0's primary ray of each pixel (the pixel center at 1 spp), in
 // parallel over options.threads threads. The scene must have passed validate_scene().
 // Throws std::invalid_argument for a bad crop, as the renderers do.
-AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set);
+Image compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set);
 
 // The same from first hits traced beforehand (the packet path's: trace_first_hits in
 // render/packet_renderer.h, over the same crop), with the same bits: the reference only
 // turns each hit's t and object into a point, a normal and a color, as its own search
 // would have. Throws std::invalid_argument when `hits` covers another rectangle.
-AovImages compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
-                       const FirstHits& hits);
+Image compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
+                   const FirstHits& hits);
 
-// Appends the AOV channels to `exr` (whose data window must be aovs.rect): Z float32; N.*
-// and albedo.* in `color_type` (the R, G, B type: half, or float32 with --float); id
+// Appends the AOV channels to `image` (whose data window must be the AOVs'): Z float32;
+// N.* and albedo.* in `color_type` (the R, G, B type: half, or float32 with --float); id
 // uint32. Throws std::invalid_argument if the windows disagree.
-void append_aov_channels(ExrImage& exr, const AovImages& aovs, ExrPixelType color_type);
+void append_aov_channels(Image& image, const Image& aovs, PixelFormat color_type);
 
 }  // namespace octray

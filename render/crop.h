@@ -43,7 +43,7 @@ inline PixelRect render_rect(const RenderOptions& options, int width, int height
 // (render_packet_blocks, render_reference_blocks): each block non-empty and inside it, and
 // neither a crop nor a sample range (a block render traces every sample of its pixels).
 // Throws std::invalid_argument.
-inline void check_block_render(std::span<const PixelRect> blocks, const Image& target,
+inline void check_block_render(std::span<const PixelRect> blocks, const RgbImage& target,
                                int width, int height, const RenderOptions& options) {
     if (target.width() != width || target.height() != height)
         throw std::invalid_argument("a block render writes into the whole " +

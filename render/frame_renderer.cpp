@@ -46,7 +46,7 @@ RenderResult FrameRenderer::render(const RenderOptions& options) const {
                                      : render_reference(*current_, options);
 }
 
-AovImages FrameRenderer::aovs(const RenderOptions& options, AovSet set) const {
+Image FrameRenderer::aovs(const RenderOptions& options, AovSet set) const {
     if (current_ == nullptr) throw std::logic_error("FrameRenderer::aovs before prepare");
     if (!set.any() || path_ != RenderPath::simd) return compute_aovs(*current_, options, set);
     return compute_aovs(*current_, options, set, trace_first_hits(*prepared_, options, isa_));

@@ -43,7 +43,7 @@ class FrameRenderer {
     RenderResult render(const RenderOptions& options) const;
     // The prepared frame's AOVs: each pixel's first hit traced by the kernels (simd) or by
     // the reference (scalar), the same values either way.
-    AovImages aovs(const RenderOptions& options, AovSet set) const;
+    Image aovs(const RenderOptions& options, AovSet set) const;
 
     RenderPath path() const { return path_; }
     Isa isa() const { return isa_; }

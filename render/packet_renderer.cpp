@@ -201,7 +201,7 @@ TileScratch& scratch_for_thread() {
 // took 7-10 ms this way against 10-14 ms of faults (docs/performance-log.md, "Division-free
 // rejection in the BVH leaves, render_tile's loops, the first frame"). Advice only: a kernel
 // before Linux 5.14 refuses it, and the tiles' first touch maps the pages as before.
-void populate_frame(Image& image) {
+void populate_frame(RgbImage& image) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     constexpr std::size_t kPage = 4096, kChunk = std::size_t{2} << 20;
     const auto at = reinterpret_cast<std::uintptr_t>(image.data());
@@ -319,11 +319,11 @@ struct TileGrid {
 // Where a render's tiles go: the crop-sized image (and, for a progressive pass, the sums),
 // and which samples of each pixel to trace (render/crop.h).
 struct RenderTarget {
-    Image& image;
-    PixelRect rect;                     // the pixels `image` holds; tiles lie inside it
-    SampleRange samples;                // [0, spp) for a plain render
-    const Image* start_sums = nullptr;  // sums of samples [0, samples.begin) or nullptr
-    Image* sums = nullptr;              // a progressive pass: where the new sums go
+    RgbImage& image;
+    PixelRect rect;                        // the pixels `image` holds; tiles lie inside it
+    SampleRange samples;                   // [0, spp) for a plain render
+    const RgbImage* start_sums = nullptr;  // sums of samples [0, samples.begin) or nullptr
+    RgbImage* sums = nullptr;              // a progressive pass: where the new sums go
 };
 
 // Pixel blocks of 4 x 2 inside a tile: eight neighbouring pixels fill one packet at one
@@ -643,11 +643,11 @@ RenderResult render_frame(const CompiledScene& scene, FrameTree tree,
                              !options.spare_image->fits(rect.width(), rect.height());
     result.image =
         options.spare_image != nullptr
-            ? Image::reuse(std::move(*options.spare_image), rect.width(), rect.height())
-            : Image(rect.width(), rect.height(), Image::Uninitialized{});
+            ? RgbImage::reuse(std::move(*options.spare_image), rect.width(), rect.height())
+            : RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
     RenderTarget target{result.image, rect, sample_range};
     if (options.samples) {
-        result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});
+        result.sample_sums = RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
         target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
         target.sums = &result.sample_sums;
     }
@@ -777,7 +777,7 @@ PreparedScene::Update PreparedScene::update(const Scene& posed) {
 }
 
 RenderResult render_packet_blocks(const PreparedScene& prepared,
-                                  std::span<const PixelRect> blocks, Image& target,
+                                  std::span<const PixelRect> blocks, RgbImage& target,
                                   const RenderOptions& options, Isa isa) {
     const auto start = std::chrono::steady_clock::now();
     const CompiledScene& scene = prepared.compiled();

@@ -354,10 +354,10 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
     // Every pixel of the rectangle is written by its tile.
     result.image =
         options.spare_image != nullptr
-            ? Image::reuse(std::move(*options.spare_image), rect.width(), rect.height())
-            : Image(rect.width(), rect.height(), Image::Uninitialized{});
+            ? RgbImage::reuse(std::move(*options.spare_image), rect.width(), rect.height())
+            : RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
     if (partial_samples)
-        result.sample_sums = Image(rect.width(), rect.height(), Image::Uninitialized{});
+        result.sample_sums = RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
     tbb::combinable<RayCounts> counts;
     TileControl control(options);
 
@@ -400,7 +400,7 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
 }
 
 RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRect> blocks,
-                                     Image& target, const RenderOptions& options) {
+                                     RgbImage& target, const RenderOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     check_block_render(blocks, target, scene.image.width, scene.image.height, options);
     const ReferenceTracer tracer(scene, reference_accel(options.accel), options.cancel);

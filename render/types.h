@@ -71,10 +71,10 @@ struct RenderOptions {
     // finished tile's pixel count to *pixels_done (progress).
     const std::atomic<bool>* cancel = nullptr;
     std::atomic<std::uint64_t>* pixels_done = nullptr;
-    // A spent image whose storage the render may take for its own (Image::reuse: when
+    // A spent image whose storage the render may take for its own (RgbImage::reuse: when
     // the pixel counts agree; it is left empty then). The frame loop hands back each frame
     // it has written, so a batch maps its frame's pages once, not once per frame.
-    Image* spare_image = nullptr;
+    RgbImage* spare_image = nullptr;
     // Render only these pixels of the full image (render/README.md, "Crops"): the result
     // image is crop-sized and each pixel equals the same pixel of the full render bit for
     // bit. Must be non-empty and inside the image (else std::invalid_argument).
@@ -84,7 +84,7 @@ struct RenderOptions {
     // [0, begin), crop-sized; nullptr when begin == 0). The result then also carries the
     // new sums; its image is sums / end. Unset: every sample, as a plain render.
     std::optional<SampleRange> samples;
-    const Image* sample_sums = nullptr;
+    const RgbImage* sample_sums = nullptr;
     // The SIMD path's acceleration structure for spheres (`--accel`, render/accel.h): auto
     // builds a BVH from kBvhAutoMinSpheres spheres on. The image is the same either way;
     // the scalar reference ignores it (brute force always).
@@ -113,16 +113,16 @@ struct FirstHits {
 };
 
 struct RenderResult {
-    Image image;  // the pixels of `rect` (crop-sized); (0, 0) is pixel (rect.x0, rect.y0)
+    RgbImage image;  // the pixels of `rect` (crop-sized); (0, 0) is pixel (rect.x0, rect.y0)
     // Which pixels of the full_width x full_height image `image` holds: the crop, or the
     // whole image. An EXR writer makes `rect` the data window and the full image the
-    // display window (render/image/image_io.h, make_exr_image).
+    // display window (render/image/image_io.h, make_image).
     PixelRect rect;
     int full_width = 0;
     int full_height = 0;
     // With RenderOptions::samples: the per-pixel sums of samples [0, samples->end), to pass
     // on as the next pass's sample_sums. Empty otherwise.
-    Image sample_sums;
+    RgbImage sample_sums;
     RayCounts rays;
     double seconds = 0.0;  // wall-clock time of the render itself
     // The parts of `seconds` spent compiling the scene and building its BVH (0 where the

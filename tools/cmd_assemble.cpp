@@ -25,18 +25,18 @@ struct AssembleArguments {
 // The assembled R, G, B as the 8-bit sRGB preview `render --png` writes.
 batch::AssembleSummary assemble_png(const std::vector<std::string>& part_paths,
                                     const std::string& output) {
-    std::vector<ExrImage> parts;
+    std::vector<Image> parts;
     parts.reserve(part_paths.size());
     for (const std::string& path : part_paths) parts.push_back(read_exr_image(path));
-    const ExrImage full = batch::assemble_parts(parts, part_paths);
-    const ExrChannel* rgb[3] = {full.find_channel("R"), full.find_channel("G"),
-                                full.find_channel("B")};
+    const Image full = batch::assemble_parts(parts, part_paths);
+    const ImageChannel* rgb[3] = {full.find_channel("R"), full.find_channel("G"),
+                                  full.find_channel("B")};
     if (!rgb[0] || !rgb[1] || !rgb[2])
         throw UsageError("-o " + output +
                          ": a PNG holds R, G, B, and the parts have no R, G and B channels; "
                          "write an OpenEXR (.exr) instead");
     const int width = full.data_window.width(), height = full.data_window.height();
-    Image image(width, height);
+    RgbImage image(width, height);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             const std::size_t k =

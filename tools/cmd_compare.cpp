@@ -72,7 +72,7 @@ void run_compare(const CompareArguments& args) {
         throw UsageError("--diff and --heatmap name the same file: " + args.diff + " and " +
                          args.heatmap);
 
-    ChannelImage a, b;
+    Image a, b;
     CompareResult result;
     try {
         // A device or FIFO as --diff or --heatmap is refused before any reading (exit 4).
@@ -95,7 +95,7 @@ void run_compare(const CompareArguments& args) {
     }
 
     // The outputs first: a file that cannot be written is exit 4, whatever the verdict.
-    if (!args.diff.empty()) write_channel_exr(args.diff, difference_image(a, b, result));
+    if (!args.diff.empty()) write_exr(args.diff, difference_image(a, b, result));
     ErrorHeatmap map;
     if (!args.heatmap.empty()) map = write_error_heatmap(args.heatmap, a, b, result, heatmap);
 

@@ -58,8 +58,8 @@ std::string frame_file(const std::string& path, int frame, bool several) {
     return path.substr(0, dot) + number + path.substr(dot);
 }
 
-ChannelImage to_channels(const Image& image) {
-    ChannelImage out(image.width(), image.height(), {"R", "G", "B"});
+Image to_channels(const RgbImage& image) {
+    Image out(image.width(), image.height(), {"R", "G", "B"});
     const std::size_t n = image.pixel_count();
     for (std::size_t k = 0; k < n; ++k) {
         out.plane(0)[k] = image.data()[k].r;
@@ -87,13 +87,13 @@ bool verify_frame(const VerifyArguments& args, const Scene& scene, const RenderC
     compare.fail_threshold = compare.warn_threshold = args.fail;
     compare.fail_percent = compare.warn_percent = args.fail_percent;
     compare.hard_fail = compare.hard_warn = args.hard_fail;
-    const ChannelImage scalar_channels = to_channels(ref.image);
-    const ChannelImage simd_channels = to_channels(simd.image);
+    const Image scalar_channels = to_channels(ref.image);
+    const Image simd_channels = to_channels(simd.image);
     const CompareResult r = compare_images(scalar_channels, simd_channels, compare);
     const ErrorStats& all = r.overall;
     // The pictures compare writes, A the scalar image and B the simd one.
     if (!diff.empty()) {
-        write_channel_exr(diff, difference_image(scalar_channels, simd_channels, r));
+        write_exr(diff, difference_image(scalar_channels, simd_channels, r));
         std::printf("wrote    %s (|scalar - simd|, float)\n", diff.c_str());
     }
     if (!heatmap.empty()) {
@@ -208,12 +208,12 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         ->capture_default_str();
     cmd->add_option(
            "--width", args->width,
-           "Image width, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
+           "RgbImage width, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
         ->type_name("W")
         ->transform(decimal_integer(1, kMaxImageSide));
-    cmd->add_option(
-           "--height", args->height,
-           "Image height, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
+    cmd->add_option("--height", args->height,
+                    "RgbImage height, " + integer_range_text(1, kMaxImageSide) +
+                        " (overrides the scene)")
         ->type_name("H")
         ->transform(decimal_integer(1, kMaxImageSide));
     cmd->add_option("--spp", args->spp,

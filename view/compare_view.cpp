@@ -10,11 +10,11 @@ namespace octray::view {
 namespace {
 
 // Channels `source` (red, green, blue) of `image` as a picture; black without channels.
-Image picture_of(const ChannelImage& image, const std::array<int, 3>& source) {
-    Image rgb(image.width, image.height);
+RgbImage picture_of(const Image& image, const std::array<int, 3>& source) {
+    RgbImage rgb(image.width(), image.height());
     if (source[0] < 0) return rgb;
-    for (int y = 0; y < image.height; ++y)
-        for (int x = 0; x < image.width; ++x)
+    for (int y = 0; y < image.height(); ++y)
+        for (int x = 0; x < image.width(); ++x)
             rgb.at(x, y) = Rgb{image.at(source[0], x, y), image.at(source[1], x, y),
                                image.at(source[2], x, y)};
     return rgb;
@@ -22,20 +22,20 @@ Image picture_of(const ChannelImage& image, const std::array<int, 3>& source) {
 
 }  // namespace
 
-Image display_rgb(const ChannelImage& image) {
-    std::array<int, 3> source{image.find_channel("R"), image.find_channel("G"),
-                              image.find_channel("B")};
+RgbImage display_rgb(const Image& image) {
+    std::array<int, 3> source{image.channel_index("R"), image.channel_index("G"),
+                              image.channel_index("B")};
     if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
-        int gray = image.find_channel("Y");
+        int gray = image.channel_index("Y");
         if (gray < 0) gray = image.channel_count() > 0 ? 0 : -1;
         source = {gray, gray, gray};
     }
     return picture_of(image, source);
 }
 
-std::vector<std::string> display_layers(const ChannelImage& image) {
+std::vector<std::string> display_layers(const Image& image) {
     std::set<std::string> named;
-    for (const std::string& name : image.channel_names) {
+    for (const std::string& name : image.channel_names()) {
         const std::size_t dot = name.rfind('.');
         if (dot != std::string::npos && dot > 0)
             named.insert(name.substr(0, dot));
@@ -47,19 +47,19 @@ std::vector<std::string> display_layers(const ChannelImage& image) {
     return layers;
 }
 
-Image display_rgb(const ChannelImage& image, const std::string& layer) {
+RgbImage display_rgb(const Image& image, const std::string& layer) {
     if (layer.empty()) return display_rgb(image);
     const auto find = [&](const char* suffix) {
-        return image.find_channel(layer + "." + suffix);
+        return image.channel_index(layer + "." + suffix);
     };
     std::array<int, 3> source{find("R"), find("G"), find("B")};
     if (source[0] < 0 || source[1] < 0 || source[2] < 0)
         source = {find("X"), find("Y"), find("Z")};
     if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
         // One channel as gray: the layer's first, or the unprefixed channel of that name.
-        int gray = image.find_channel(layer);
+        int gray = image.channel_index(layer);
         for (int c = 0; gray < 0 && c < image.channel_count(); ++c)
-            if (image.channel_names[static_cast<std::size_t>(c)].rfind(layer + ".", 0) == 0)
+            if (image.channels[static_cast<std::size_t>(c)].name.rfind(layer + ".", 0) == 0)
                 gray = c;
         if (gray < 0) throw std::invalid_argument("no layer \"" + layer + "\" in the image");
         source = {gray, gray, gray};

@@ -19,12 +19,12 @@ namespace octray::view {
 // colour, else its first channel as gray.
 struct CompareView {
     std::string path_a, path_b;
-    ChannelImage a, b;
-    ChannelImage diff;  // |A - B| of every channel (difference_image)
+    Image a, b;
+    Image diff;  // |A - B| of every channel (difference_image)
     CompareOptions options;
     CompareResult result;
     std::string figures_json;  // format_compare_json(): the figures of `octray compare --json`
-    Image rgb_a, rgb_b, rgb_diff;
+    RgbImage rgb_a, rgb_b, rgb_diff;
     ErrorHeatmap heatmap;  // render_error_heatmap() with compare's defaults (8-bit sRGB)
     // The layers the page can show (display_layers of A; B has the same channels): "" the
     // colour, then each AOV ("N", "albedo", "depth", "id", ...).
@@ -34,12 +34,12 @@ struct CompareView {
 // The layers of `image` the page can show: "" (R, G, B, or Y, or the first channel: what
 // display_rgb shows), then each name before a channel's last '.' ("N" of N.X, N.Y, N.Z)
 // and each other channel without one ("Z", "id"), sorted.
-std::vector<std::string> display_layers(const ChannelImage& image);
+std::vector<std::string> display_layers(const Image& image);
 
 // The displayed RGB of `layer` of a channel image: its channels R, G, B or X, Y, Z as
 // colour, else its first channel as gray (an unprefixed layer: that channel). Throws
 // std::invalid_argument for a layer the image does not have.
-Image display_rgb(const ChannelImage& image, const std::string& layer);
+RgbImage display_rgb(const Image& image, const std::string& layer);
 
 // Reads and compares the two files. Throws IoError (unreadable, not an image: `octray
 // compare`'s exit 4) or ImageMismatch (sizes or channels differ: its exit 3), as compare.
@@ -47,6 +47,6 @@ CompareView load_compare_view(const std::string& path_a, const std::string& path
                               const CompareOptions& options = {});
 
 // The displayed RGB of a channel image (see CompareView).
-Image display_rgb(const ChannelImage& image);
+RgbImage display_rgb(const Image& image);
 
 }  // namespace octray::view

@@ -10,7 +10,6 @@
 #include "kernels/dispatch.h"
 #include "render/batch/digest.h"
 #include "render/batch/frame_loop.h"
-#include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
@@ -165,7 +164,8 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
         identity, posed, animation_frame, result, path_label(frame->path, frame->isa),
         posed.image.spp, std::string());
     write_exr((directory / name).string(),
-              make_exr_image(result, ExrWriteOptions{}, attributes));
+              make_image(result.image, result.rect, result.full_width, result.full_height,
+                         ExrWriteOptions{}, attributes));
 
     std::string command = "octray render " + shell_word(identity.spec) + " --width " +
                           std::to_string(posed.image.width) + " --height " +

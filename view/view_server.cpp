@@ -156,7 +156,7 @@ float exposure_param(const httplib::Request& req) {
 
 // {"x": X, "y": Y, "width": W, "height": H, "rgb": [r, g, b]}: the linear value of pixel
 // (x, y) of `image` (non-finite values as the strings "nan", "inf", "-inf").
-json pixel_json(const httplib::Request& req, const Image& image) {
+json pixel_json(const httplib::Request& req, const RgbImage& image) {
     const int x = integer_param(req, "x", 0, image.width() - 1);
     const int y = integer_param(req, "y", 0, image.height() - 1);
     const Rgb& p = image.at(x, y);
@@ -172,7 +172,7 @@ json pixel_json(const httplib::Request& req, const Image& image) {
                 {"rgb", json::array({value(p.r), value(p.g), value(p.b)})}};
 }
 
-std::string float_bytes(const Image& image) {
+std::string float_bytes(const RgbImage& image) {
     static_assert(sizeof(Rgb) == 3 * sizeof(float));
     return std::string(reinterpret_cast<const char*>(image.data()),
                        image.pixel_count() * sizeof(Rgb));
@@ -221,7 +221,7 @@ struct ViewServer::Impl {
     // `octray view A B`: the pictures of layers other than the colour, by (picture, layer),
     // made when first asked for (std::map: references to them stay valid).
     std::mutex layer_mutex;
-    std::map<std::pair<std::string, std::string>, Image> layer_pictures;
+    std::map<std::pair<std::string, std::string>, RgbImage> layer_pictures;
     std::mutex stop_mutex;
 
     Impl(ViewSession* s, const CompareView* c, ServerOptions o)
@@ -472,8 +472,8 @@ void ViewServer::Impl::compare_routes() {
                           {"b", view.path_b},
                           {"full_width", view.result.width},
                           {"full_height", view.result.height},
-                          {"heatmap_width", view.heatmap.image.width},
-                          {"heatmap_height", view.heatmap.image.height},
+                          {"heatmap_width", view.heatmap.image.width()},
+                          {"heatmap_height", view.heatmap.image.height()},
                           {"heatmap_zoom", view.heatmap.zoom},
                           {"heatmap_legend", view.heatmap.legend},
                           {"heatmap_min", view.heatmap.scale_min},
@@ -488,7 +488,7 @@ void ViewServer::Impl::compare_routes() {
     });
     // picture=a (default), b or diff: the linear RGB picture; layer= one of the status's
     // layers (default "": the colour), each made once when first asked for.
-    const auto picture = [this, &view](const httplib::Request& req) -> const Image& {
+    const auto picture = [this, &view](const httplib::Request& req) -> const RgbImage& {
         const std::string name =
             req.has_param("picture") ? req.get_param_value("picture") : "a";
         const std::string layer = req.has_param("layer") ? req.get_param_value("layer") : "";
@@ -503,9 +503,7 @@ void ViewServer::Impl::compare_routes() {
             const std::lock_guard lock(layer_mutex);
             auto [it, fresh] = layer_pictures.try_emplace({name, layer});
             if (fresh) {
-                const ChannelImage& source = name == "a"   ? view.a
-                                             : name == "b" ? view.b
-                                                           : view.diff;
+                const Image& source = name == "a" ? view.a : name == "b" ? view.b : view.diff;
                 it->second = display_rgb(source, layer);
             }
             return it->second;
@@ -525,18 +523,17 @@ void ViewServer::Impl::compare_routes() {
                                                   httplib::Response& res) {
         const float exposure = exposure_param(req);
         if (req.has_param("picture") && req.get_param_value("picture") == "heatmap") {
-            const Rgb8Image& map = view.heatmap.image;
-            res.set_content(encode_png_rgb8(map.width, map.height, map.rgb), "image/png");
+            res.set_content(encode_png(view.heatmap.image), "image/png");
             return;
         }
-        const Image& image = picture(req);
+        const RgbImage& image = picture(req);
         res.set_content(
             encode_png_rgb8(image.width(), image.height(), tone_map_srgb8(image, exposure)),
             "image/png");
     });
     server.Get("/api/image.f32",
                [picture](const httplib::Request& req, httplib::Response& res) {
-                   const Image& image = picture(req);
+                   const RgbImage& image = picture(req);
                    res.set_header("X-Octray-Width", std::to_string(image.width()));
                    res.set_header("X-Octray-Height", std::to_string(image.height()));
                    res.set_content(float_bytes(image), "application/octet-stream");

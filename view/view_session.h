@@ -61,7 +61,7 @@ std::optional<PixelOrder> parse_pixel_order(const std::string& name);
 
 // One published picture and how it was made.
 struct ViewFrame {
-    Image image;                       // linear RGB, row 0 on top
+    RgbImage image;                    // linear RGB, row 0 on top
     std::uint64_t generation = 0;      // 1, 2, 3, ... in publishing order
     std::uint64_t camera_version = 0;  // which set_camera() call it shows (1: the scene's)
     Camera camera;

@@ -18,23 +18,23 @@ constexpr std::size_t kMaxSamples = std::size_t{1} << 30;
 
 std::string quoted(const std::string& name) { return "'" + name + "'"; }
 
-std::string channel_list(const ExrImage& image) {
+std::string channel_list(const Image& image) {
     std::string s;
-    for (const ExrChannel& c : image.channels) {
+    for (const ImageChannel& c : image.channels) {
         if (!s.empty()) s += ", ";
         s += c.name;
         s += " (";
-        s += to_string(c.type);
+        s += to_string(c.format);
         s += ")";
     }
     return s;
 }
 
-bool same_channels(const ExrImage& a, const ExrImage& b) {
+bool same_channels(const Image& a, const Image& b) {
     if (a.channels.size() != b.channels.size()) return false;
-    for (const ExrChannel& c : a.channels) {
-        const ExrChannel* other = b.find_channel(c.name);
-        if (other == nullptr || other->type != c.type) return false;
+    for (const ImageChannel& c : a.channels) {
+        const ImageChannel* other = b.find_channel(c.name);
+        if (other == nullptr || other->format != c.format) return false;
     }
     return true;
 }
@@ -68,16 +68,15 @@ PixelRect first_gap(const std::vector<unsigned char>& covered, const PixelRect& 
 
 }  // namespace
 
-ExrImage assemble_parts(const std::vector<ExrImage>& parts,
-                        const std::vector<std::string>& names) {
+Image assemble_parts(const std::vector<Image>& parts, const std::vector<std::string>& names) {
     if (parts.empty()) throw std::invalid_argument("assemble: no parts");
     if (names.size() != parts.size())
         throw std::invalid_argument("assemble: one name per part is needed");
-    const ExrImage& first = parts.front();
+    const Image& first = parts.front();
     const PixelRect display = first.display_window;
 
     for (std::size_t k = 0; k < parts.size(); ++k) {
-        const ExrImage& p = parts[k];
+        const Image& p = parts[k];
         if (!(p.display_window == display))
             throw AssembleError("part " + quoted(names[k]) + " has the display window " +
                                 to_string(p.display_window) + ", but " + quoted(names[0]) +
@@ -109,10 +108,10 @@ ExrImage assemble_parts(const std::vector<ExrImage>& parts,
     // Coverage: no overlaps (checked above), so the parts cover the display window iff
     // their pixel counts add up to it; find and name a gap otherwise.
     std::size_t covered_pixels = 0;
-    for (const ExrImage& p : parts) covered_pixels += p.data_window.pixel_count();
+    for (const Image& p : parts) covered_pixels += p.data_window.pixel_count();
     if (covered_pixels != pixels) {
         std::vector<unsigned char> covered(pixels, 0);
-        for (const ExrImage& p : parts)
+        for (const Image& p : parts)
             for (int y = p.data_window.y0; y < p.data_window.y1; ++y)
                 std::memset(covered.data() +
                                 static_cast<std::size_t>(y - display.y0) * display.width() +
@@ -127,20 +126,20 @@ ExrImage assemble_parts(const std::vector<ExrImage>& parts,
                             to_string(gap));
     }
 
-    ExrImage out;
+    Image out;
     out.display_window = display;
     out.data_window = display;
     out.compression = first.compression;
     out.attributes = first.attributes;
-    for (const ExrChannel& c : first.channels)
-        out.channels.push_back(ExrChannel{
-            c.name, c.type, std::vector<unsigned char>(pixels * sample_size(c.type))});
+    for (const ImageChannel& c : first.channels)
+        out.channels.push_back(ImageChannel{
+            c.name, c.format, std::vector<unsigned char>(pixels * sample_size(c.format))});
     const std::size_t width = static_cast<std::size_t>(display.width());
-    for (const ExrImage& p : parts) {
+    for (const Image& p : parts) {
         const PixelRect& r = p.data_window;
-        for (ExrChannel& c : out.channels) {
-            const ExrChannel& source = *p.find_channel(c.name);
-            const std::size_t size = sample_size(c.type);
+        for (ImageChannel& c : out.channels) {
+            const ImageChannel& source = *p.find_channel(c.name);
+            const std::size_t size = sample_size(c.format);
             const std::size_t row_bytes = static_cast<std::size_t>(r.width()) * size;
             for (int y = r.y0; y < r.y1; ++y) {
                 const std::size_t to = (static_cast<std::size_t>(y - display.y0) * width +
@@ -157,18 +156,18 @@ ExrImage assemble_parts(const std::vector<ExrImage>& parts,
 AssembleSummary assemble_files(const std::vector<std::string>& part_paths,
                                const std::string& output) {
     if (part_paths.empty()) throw std::invalid_argument("assemble: no parts");
-    std::vector<ExrImage> parts;
+    std::vector<Image> parts;
     parts.reserve(part_paths.size());
     for (const std::string& path : part_paths) parts.push_back(read_exr_image(path));
-    const ExrImage image = assemble_parts(parts, part_paths);
+    const Image image = assemble_parts(parts, part_paths);
     parts.clear();
     write_exr(output, image);
 
     AssembleSummary summary;
     summary.display_window = image.display_window;
     summary.parts = part_paths.size();
-    for (const ExrChannel& c : image.channels)
-        summary.channels.push_back(c.name + " (" + std::string(to_string(c.type)) + ")");
+    for (const ImageChannel& c : image.channels)
+        summary.channels.push_back(c.name + " (" + std::string(to_string(c.format)) + ")");
     return summary;
 }
 

@@ -25,8 +25,7 @@ class AssembleError : public std::runtime_error {
 // channels with the same pixel types; the data windows must lie inside the display
 // window, must not overlap and must together cover it. The result carries the first
 // part's compression and attributes. Throws AssembleError.
-ExrImage assemble_parts(const std::vector<ExrImage>& parts,
-                        const std::vector<std::string>& names);
+Image assemble_parts(const std::vector<Image>& parts, const std::vector<std::string>& names);
 
 struct AssembleSummary {
     PixelRect display_window;

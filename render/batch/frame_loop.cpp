@@ -23,9 +23,9 @@
 #include "render/batch/camera_matrices.h"
 #include "render/batch/claim_owner.h"
 #include "render/batch/progressive.h"
-#include "render/batch/result_exr.h"
 #include "render/batch/resume.h"
 #include "render/frame_renderer.h"
+#include "render/image/image_io.h"
 #include "scene/animation.h"
 #include "scene/scene_error.h"
 
@@ -87,11 +87,11 @@ void record_failure(FrameResult& out, const std::exception_ptr& error) {
 // the preview of its pixels goes.
 struct FrameFiles {
     std::string exr_path, png_path;  // either may be empty
-    ExrImage exr;
+    Image exr;
 
     // Both are written atomically, each on its own; the frame counts as finished only
     // when both are (resume.h).
-    void write(const Image& pixels) const {
+    void write(const RgbImage& pixels) const {
         if (exr_path.empty()) {
             write_png_preview(png_path, pixels);
         } else if (png_path.empty()) {
@@ -112,7 +112,7 @@ struct PendingWrite {
     std::string claimed;  // its placeholder, released if the write fails
     Clock::time_point started;
     FrameFiles files;
-    Image pixels;
+    RgbImage pixels;
     double seconds = 0.0;
     std::exception_ptr report_error;  // what reporting it threw, rethrown when joined
     std::thread writer;
@@ -149,7 +149,7 @@ class BatchRunner {
     ExrAttributes attributes(const BatchScene& scene, const Scene& posed, int frame,
                              const RenderResult& result, int samples_so_far) const;
     FrameFiles files(const BatchScene& scene, const BatchJob& job, const Scene& posed,
-                     const RenderResult& result, const AovImages& aovs, int samples_so_far);
+                     const RenderResult& result, const Image& aovs, int samples_so_far);
     void finish(const FrameResult& out, std::uint64_t work);
     void write_behind(PendingWrite& p);
 
@@ -161,10 +161,10 @@ class BatchRunner {
     std::string owner_;  // octray.owner of this run's unfinished passes
     // The last frame written: the next frame renders into its storage (RenderOptions::
     // spare_image), so only a run's first frame maps fresh pages for its pixels.
-    Image spare_frame_;
+    RgbImage spare_frame_;
     // The channels of the last EXR written, converted into again by the next (the same
-    // reason: make_exr_image's `spare`).
-    std::vector<ExrChannel> spare_channels_;
+    // reason: make_image's `spare`).
+    std::vector<ImageChannel> spare_channels_;
     // The frames of scene renderer_index_, posed and prepared once (FrameRenderer).
     // (A pointer: g++ 12 takes an optional holding an optional for maybe-uninitialized.)
     std::unique_ptr<FrameRenderer> renderer_;
@@ -226,7 +226,7 @@ ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& pose
 }
 
 FrameFiles BatchRunner::files(const BatchScene& scene, const BatchJob& job, const Scene& posed,
-                              const RenderResult& result, const AovImages& aovs,
+                              const RenderResult& result, const Image& aovs,
                               int samples_so_far) {
     FrameFiles f;
     if (settings_.png_output) {
@@ -235,12 +235,13 @@ FrameFiles BatchRunner::files(const BatchScene& scene, const BatchJob& job, cons
     }
     f.exr_path = job.output;
     f.png_path = job.png;
-    f.exr = make_exr_image(result, settings_.exr,
-                           attributes(scene, posed, job.frame, result, samples_so_far),
-                           std::move(spare_channels_));
-    if (aovs.set.any())
+    f.exr =
+        make_image(result.image, result.rect, result.full_width, result.full_height,
+                   settings_.exr, attributes(scene, posed, job.frame, result, samples_so_far),
+                   std::move(spare_channels_));
+    if (!aovs.channels.empty())
         append_aov_channels(f.exr, aovs,
-                            settings_.exr.float32 ? ExrPixelType::float32 : ExrPixelType::half);
+                            settings_.exr.float32 ? PixelFormat::float32 : PixelFormat::half);
     return f;
 }
 
@@ -402,7 +403,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
                                          : static_cast<std::uint64_t>(posed.image.width) *
                                                static_cast<std::uint64_t>(posed.image.height);
         if (spare_frame_.pixel_count() != pixels) {
-            spare_frame_ = Image();
+            spare_frame_ = RgbImage();
             spare_channels_.clear();
         }
         options.spare_image = &spare_frame_;
@@ -411,7 +412,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         const auto trace_started = Clock::now();
 
         const auto render_pass = [&](const RenderOptions& o) { return renderer_->render(o); };
-        const AovImages aovs = renderer_->aovs(options, settings_.render.aovs);
+        const Image aovs = renderer_->aovs(options, settings_.render.aovs);
         double write_seconds = 0.0;
         const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
             const auto write_started = Clock::now();

@@ -34,7 +34,7 @@ constexpr std::uint64_t kFramebufferBytesPerPixel = 12;
 // render/batch/progressive.cpp: while a pass renders, the last pass's image and sample sums are
 // kept, and the pass makes its own: four images.
 constexpr std::uint64_t kProgressiveImages = 4;
-// render/batch/result_exr.cpp make_exr_image and render/aov.cpp append_aov_channels: every
+// render/image/exr_write.cpp make_image and render/aov.cpp append_aov_channels: every
 // channel is copied into the EXR image, as half (2 bytes) or float (4); the id AOV is
 // UINT (4).
 constexpr std::uint64_t kColorChannels = 3;
@@ -44,7 +44,7 @@ constexpr std::uint64_t kDepthChannels = 1, kNormalChannels = 3, kAlbedoChannels
 constexpr std::uint64_t kExrLineBufferCopies = 3;
 // render/image/png.cpp write_png_file: 8-bit RGB rows and a row pointer per row.
 constexpr std::uint64_t kPngBytesPerPixel = 3, kPngBytesPerRow = 8;
-// render/aov.h AovImages: depth a float, normal a Vec3, albedo an Rgb, id a uint32.
+// render/aov.h Image: depth a float, normal a Vec3, albedo an Rgb, id a uint32.
 constexpr std::uint64_t kAovDepthBytes = 4, kAovNormalBytes = 12, kAovAlbedoBytes = 12,
                         kAovIdBytes = 4;
 

@@ -81,14 +81,21 @@ constexpr std::array<std::uint8_t, 3> text_color{235, 235, 235};
 
 class Canvas {
   public:
-    explicit Canvas(Rgb8Image& image) : image_(image) {}
+    // A width x height picture of uint8 channels R, G, B.
+    Canvas(Image& image, int width, int height)
+        : image_(image), width_(width), height_(height) {
+        image_.display_window = image_.data_window = PixelRect{0, 0, width, height};
+        image_.channels.clear();
+        for (const char* name : {"R", "G", "B"})
+            image_.channels.push_back(
+                make_channel(name, std::vector<std::uint8_t>(image_.pixel_count())));
+    }
 
     void set(int x, int y, std::array<std::uint8_t, 3> color) {
-        if (x < 0 || y < 0 || x >= image_.width || y >= image_.height) return;
-        const std::size_t i = 3 * (static_cast<std::size_t>(y) * image_.width + x);
-        image_.rgb[i] = color[0];
-        image_.rgb[i + 1] = color[1];
-        image_.rgb[i + 2] = color[2];
+        if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                              static_cast<std::size_t>(x);
+        for (std::size_t c = 0; c < 3; ++c) image_.channels[c].samples[i] = color[c];
     }
 
     void text(int x, int y, std::string_view s) {
@@ -108,7 +115,8 @@ class Canvas {
     }
 
   private:
-    Rgb8Image& image_;
+    Image& image_;
+    int width_, height_;
 };
 
 int text_width(std::string_view s) {
@@ -156,8 +164,18 @@ std::array<std::uint8_t, 3> magma_color(double t) {
     return color;
 }
 
-ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
-                                  const CompareResult& result, const HeatmapOptions& options) {
+std::array<std::uint8_t, 3> ErrorHeatmap::color(int x, int y) const {
+    const std::size_t i =
+        static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width()) +
+        static_cast<std::size_t>(x);
+    return {image.channels[0].samples[i], image.channels[1].samples[i],
+            image.channels[2].samples[i]};
+}
+
+ErrorHeatmap render_error_heatmap(const Image& a, const Image& b, const CompareResult& result,
+                                  const HeatmapOptions& options) {
+    if (!a.all_float32() || !b.all_float32())
+        return render_error_heatmap(to_float32(a), to_float32(b), result, options);
     ErrorHeatmap map;
     const int width = result.width, height = result.height;
     map.scale_max = options.factor > 0.0 ? 1.0 / options.factor : result.overall.max_abs_error;
@@ -170,14 +188,12 @@ ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
     map.zoom = std::max(1, std::min(map.zoom, 4096 / std::max(height, 1)));
     const int map_w = width * map.zoom, map_h = height * map.zoom;
 
-    Rgb8Image& image = map.image;
-    image.width = std::max(map_w, min_canvas_width);
+    const int canvas_w = std::max(map_w, min_canvas_width);
     const int legend_top = map_h + margin;
-    image.height = legend_top + bar_height + 2 * (4 + glyph_height) + margin;
-    image.rgb.resize(3 * static_cast<std::size_t>(image.width) * image.height);
-    Canvas canvas(image);
-    for (int y = 0; y < image.height; ++y)
-        for (int x = 0; x < image.width; ++x) canvas.set(x, y, background);
+    const int canvas_h = legend_top + bar_height + 2 * (4 + glyph_height) + margin;
+    Canvas canvas(map.image, canvas_w, canvas_h);
+    for (int y = 0; y < canvas_h; ++y)
+        for (int x = 0; x < canvas_w; ++x) canvas.set(x, y, background);
 
     // The map: the largest error over the compared channels, per pixel.
     const std::size_t pixels = static_cast<std::size_t>(width) * height;
@@ -206,7 +222,7 @@ ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
     // The legend: the ramp from its bottom to its top, with the bottom, the middle (the
     // geometric middle on the log scale) and the top printed, and the scale's name below.
     map.bar_x0 = margin;
-    map.bar_x1 = image.width - margin;
+    map.bar_x1 = canvas_w - margin;
     map.bar_y0 = legend_top;
     map.bar_y1 = legend_top + bar_height;
     const int bar_span = std::max(map.bar_x1 - map.bar_x0 - 1, 1);
@@ -229,11 +245,10 @@ ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
     return map;
 }
 
-ErrorHeatmap write_error_heatmap(const std::string& path, const ChannelImage& a,
-                                 const ChannelImage& b, const CompareResult& result,
-                                 const HeatmapOptions& options) {
+ErrorHeatmap write_error_heatmap(const std::string& path, const Image& a, const Image& b,
+                                 const CompareResult& result, const HeatmapOptions& options) {
     const ErrorHeatmap map = render_error_heatmap(a, b, result, options);
-    write_png_rgb8(path, map.image.width, map.image.height, map.image.rgb);
+    write_png(path, map.image);
     return map;
 }
 

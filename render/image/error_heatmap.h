@@ -35,26 +35,17 @@ std::optional<HeatmapScale> parse_heatmap_scale(std::string_view name);
 // Pixels holding NaN or Inf in either image: a green that magma never produces.
 inline constexpr std::array<std::uint8_t, 3> heatmap_nonfinite_color{0, 255, 0};
 
-// 8-bit sRGB, interleaved RGB, row 0 on top.
-struct Rgb8Image {
-    int width = 0;
-    int height = 0;
-    std::vector<std::uint8_t> rgb;
-
-    std::array<std::uint8_t, 3> at(int x, int y) const {
-        const std::size_t i = 3 * (static_cast<std::size_t>(y) * width + x);
-        return {rgb[i], rgb[i + 1], rgb[i + 2]};
-    }
-};
-
 struct ErrorHeatmap {
-    Rgb8Image image;
+    Image image;                 // uint8 channels R, G, B: sRGB values, row 0 on top
     int zoom = 1;                // each source pixel is a zoom x zoom block at the top left
     double scale_max = 0.0;      // the error that maps to the ramp's top
     double scale_min = 0.0;      // the error at the ramp's bottom (0, or the log scale's)
     std::string legend;          // what the legend says of the scale: "linear", "log x100"
     int bar_x0 = 0, bar_x1 = 0;  // the legend bar's columns [x0, x1) and rows [y0, y1)
     int bar_y0 = 0, bar_y1 = 0;
+
+    // The colour of pixel (x, y) of the picture.
+    std::array<std::uint8_t, 3> color(int x, int y) const;
 };
 
 // magma at t in [0, 1] (clamped; NaN reads as 0).
@@ -68,13 +59,12 @@ double heatmap_position(double error, double scale_min, double scale_max, Heatma
 // `options`. Small images are enlarged (nearest neighbour) so the picture is at least
 // about 256 pixels wide. The legend under the map is the ramp with its bottom, middle and
 // top errors printed, and a line naming the scale and factor ("linear", "log x100").
-ErrorHeatmap render_error_heatmap(const ChannelImage& a, const ChannelImage& b,
-                                  const CompareResult& result,
+ErrorHeatmap render_error_heatmap(const Image& a, const Image& b, const CompareResult& result,
                                   const HeatmapOptions& options = {});
 
 // render_error_heatmap() written as a PNG, and returned. Throws IoError.
-ErrorHeatmap write_error_heatmap(const std::string& path, const ChannelImage& a,
-                                 const ChannelImage& b, const CompareResult& result,
+ErrorHeatmap write_error_heatmap(const std::string& path, const Image& a, const Image& b,
+                                 const CompareResult& result,
                                  const HeatmapOptions& options = {});
 
 }  // namespace octray

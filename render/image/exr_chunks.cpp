@@ -202,7 +202,7 @@ struct DwaRule {
     std::string suffix;
     DwaScheme scheme = DwaScheme::unknown;
     bool case_insensitive = false;
-    ExrPixelType type = ExrPixelType::half;
+    PixelFormat type = PixelFormat::half;
 };
 
 std::uint64_t read_u64_le(const unsigned char* p) {
@@ -225,14 +225,14 @@ bool matches(const DwaRule& rule, const ExrChunkChannel& channel) {
 }
 
 // OpenEXR's pixel type numbers, as the rules store them.
-std::optional<ExrPixelType> pixel_type(unsigned value) {
+std::optional<PixelFormat> pixel_type(unsigned value) {
     switch (value) {
         case 0:
-            return ExrPixelType::uint32;
+            return PixelFormat::uint32;
         case 1:
-            return ExrPixelType::half;
+            return PixelFormat::half;
         case 2:
-            return ExrPixelType::float32;
+            return PixelFormat::float32;
         default:
             return std::nullopt;
     }
@@ -335,7 +335,7 @@ std::string b44_problem(const ExrChunkShape& shape, const unsigned char* data,
                         std::size_t size) {
     std::size_t at = 0;
     for (const ExrChunkChannel& channel : shape.channels) {
-        if (channel.type != ExrPixelType::half) {
+        if (channel.type != PixelFormat::half) {
             const std::uint64_t raw = static_cast<std::uint64_t>(pixels(shape)) * 4;
             if (raw > size - at) return "holds B44 data that ends inside its channels";
             at += static_cast<std::size_t>(raw);
@@ -407,7 +407,7 @@ std::string exr_chunk_problem(const ExrChunkShape& shape, const unsigned char* d
             // PXR24 keeps 24 bits of a FLOAT, all of a HALF or UINT, then deflates.
             std::uint64_t packed = 0;
             for (const ExrChunkChannel& channel : shape.channels)
-                packed += channel.type == ExrPixelType::float32 ? 3 : sample_size(channel.type);
+                packed += channel.type == PixelFormat::float32 ? 3 : sample_size(channel.type);
             packed *= static_cast<std::uint64_t>(pixels(shape));
             const auto n = inflated_size(data, size, packed);
             if (!n) return "holds damaged or cut-off PXR24 (zlib) data";

@@ -20,7 +20,7 @@ namespace octray {
 
 struct ExrChunkChannel {
     std::string name;
-    ExrPixelType type = ExrPixelType::half;
+    PixelFormat type = PixelFormat::half;
 };
 
 // One chunk as the header describes it: the codec, the channels in the file's order

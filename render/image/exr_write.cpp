@@ -1,4 +1,4 @@
-// The one OpenEXR writer, write_exr(path, ExrImage), and the types of an OpenEXR image
+// The one OpenEXR writer, write_exr(path, Image), and the types of an OpenEXR image
 // (render/image/image_io.h). Every EXR octray writes goes through write_exr_file() below.
 
 #include <ImfChannelList.h>
@@ -95,16 +95,18 @@ Imath::Box2i to_box(const PixelRect& r) {
     return Imath::Box2i({r.x0, r.y0}, {r.x1 - 1, r.y1 - 1});
 }
 
-Imf::PixelType to_imf(ExrPixelType type) {
+Imf::PixelType to_imf(PixelFormat type) {
     switch (type) {
-        case ExrPixelType::uint32:
+        case PixelFormat::uint32:
             return Imf::UINT;
-        case ExrPixelType::half:
+        case PixelFormat::half:
             return Imf::HALF;
-        case ExrPixelType::float32:
+        case PixelFormat::float32:
             return Imf::FLOAT;
+        case PixelFormat::uint8:
+            break;
     }
-    throw std::invalid_argument("unknown EXR pixel type");
+    throw std::invalid_argument("OpenEXR has no 8-bit samples");
 }
 
 // Attributes the writer derives from the image itself; a caller may not set them.
@@ -158,7 +160,7 @@ void insert_attributes(Imf::Header& header, const ExrAttributes& attributes) {
     }
 }
 
-void check_exr_image(const ExrImage& image) {
+void check_exr_image(const Image& image) {
     if (image.display_window.empty())
         throw std::invalid_argument("the display window " + window_text(image.display_window) +
                                     " is empty");
@@ -167,11 +169,14 @@ void check_exr_image(const ExrImage& image) {
                                     " is empty");
     if (image.channels.empty()) throw std::invalid_argument("the image has no channels");
     std::set<std::string> names;
-    for (const ExrChannel& c : image.channels) {
+    for (const ImageChannel& c : image.channels) {
         if (c.name.empty()) throw std::invalid_argument("a channel has an empty name");
         if (!names.insert(c.name).second)
             throw std::invalid_argument("channel '" + c.name + "' is given twice");
-        const std::size_t expected = image.data_window.pixel_count() * sample_size(c.type);
+        if (c.format == PixelFormat::uint8)
+            throw std::invalid_argument("channel '" + c.name +
+                                        "' holds 8-bit samples, which OpenEXR cannot store");
+        const std::size_t expected = image.data_window.pixel_count() * sample_size(c.format);
         if (c.samples.size() != expected)
             throw std::invalid_argument(
                 "channel '" + c.name + "' holds " + std::to_string(c.samples.size()) +
@@ -180,28 +185,28 @@ void check_exr_image(const ExrImage& image) {
     }
 }
 
-Imf::Header make_header(const ExrImage& image) {
+Imf::Header make_header(const Image& image) {
     // Line order INCREASING_Y: the file's first scan line is the top row.
     Imf::Header header(to_box(image.display_window), to_box(image.data_window));
     header.compression() = to_imf(image.compression);
     insert_attributes(header, image.attributes);
-    for (const ExrChannel& c : image.channels)
-        header.channels().insert(c.name, Imf::Channel(to_imf(c.type)));
+    for (const ImageChannel& c : image.channels)
+        header.channels().insert(c.name, Imf::Channel(to_imf(c.format)));
     return header;
 }
 
 // The other compressions: OpenEXR packs and compresses the chunks.
-void write_exr_with_openexr(const std::string& path, const ExrImage& image,
+void write_exr_with_openexr(const std::string& path, const Image& image,
                             const Imf::Header& header) {
     const Imath::Box2i window = to_box(image.data_window);
     const std::size_t width = static_cast<std::size_t>(image.data_window.width());
     Imf::FrameBuffer frame_buffer;
-    for (const ExrChannel& c : image.channels) {
+    for (const ImageChannel& c : image.channels) {
         // OpenEXR only reads through the frame buffer when writing.
         char* base = reinterpret_cast<char*>(const_cast<unsigned char*>(c.samples.data()));
-        const std::size_t element = sample_size(c.type);
+        const std::size_t element = sample_size(c.format);
         frame_buffer.insert(
-            c.name, Imf::Slice::Make(to_imf(c.type), base, window, element, element * width));
+            c.name, Imf::Slice::Make(to_imf(c.format), base, window, element, element * width));
     }
     Imf::OutputFile file(path.c_str(), header);
     file.setFrameBuffer(frame_buffer);
@@ -239,11 +244,11 @@ struct MagicAndVersion : Imf::GenericOutputFile {
 static_assert(std::endian::native == std::endian::little,
               "the samples are copied as they lie in memory into a little-endian file");
 
-std::vector<const ExrChannel*> channels_in_file_order(const ExrImage& image) {
-    std::vector<const ExrChannel*> channels;
-    for (const ExrChannel& c : image.channels) channels.push_back(&c);
+std::vector<const ImageChannel*> channels_in_file_order(const Image& image) {
+    std::vector<const ImageChannel*> channels;
+    for (const ImageChannel& c : image.channels) channels.push_back(&c);
     std::sort(channels.begin(), channels.end(),
-              [](const ExrChannel* a, const ExrChannel* b) { return a->name < b->name; });
+              [](const ImageChannel* a, const ImageChannel* b) { return a->name < b->name; });
     return channels;
 }
 
@@ -284,13 +289,13 @@ void predict(const unsigned char* in, std::size_t size, unsigned char* out) {
 // Packs, and for ZIP and ZIPS compresses, one chunk of scan lines.
 class ChunkEncoder {
   public:
-    ChunkEncoder(const ExrImage& image, int lines_per_chunk)
+    ChunkEncoder(const Image& image, int lines_per_chunk)
         : channels_(channels_in_file_order(image)),
           width_(static_cast<std::size_t>(image.data_window.width())),
           height_(image.data_window.height()),
           lines_per_chunk_(lines_per_chunk),
           compression_(image.compression) {
-        for (const ExrChannel* c : channels_) line_bytes_ += width_ * sample_size(c->type);
+        for (const ImageChannel* c : channels_) line_bytes_ += width_ * sample_size(c->format);
     }
 
     int chunk_count() const { return (height_ + lines_per_chunk_ - 1) / lines_per_chunk_; }
@@ -341,8 +346,8 @@ class ChunkEncoder {
         const int y0 = first_line(chunk);
         const int y1 = std::min(height_, y0 + lines_per_chunk_);
         for (int y = y0; y < y1; ++y)
-            for (const ExrChannel* c : channels_) {
-                const std::size_t bytes = width_ * sample_size(c->type);
+            for (const ImageChannel* c : channels_) {
+                const std::size_t bytes = width_ * sample_size(c->format);
                 visit(c->samples.data() + static_cast<std::size_t>(y) * bytes, bytes);
             }
     }
@@ -354,7 +359,7 @@ class ChunkEncoder {
         });
     }
 
-    std::vector<const ExrChannel*> channels_;
+    std::vector<const ImageChannel*> channels_;
     std::size_t width_;
     int height_;
     int lines_per_chunk_;
@@ -409,7 +414,7 @@ class OutputBytes {
 // exr_thread_count() of 0 or 1 the calling thread encodes them alone.
 constexpr std::size_t kRawBytesPerGroup = std::size_t{16} << 20;
 
-void write_exr_with_own_chunks(const std::string& path, const ExrImage& image,
+void write_exr_with_own_chunks(const std::string& path, const Image& image,
                                const Imf::Header& header) {
     header.sanityCheck();
     Imf::StdOSStream head;
@@ -459,7 +464,7 @@ void write_exr_with_own_chunks(const std::string& path, const ExrImage& image,
     file.close();
 }
 
-void write_exr_file(const std::string& path, const ExrImage& image) {
+void write_exr_file(const std::string& path, const Image& image) {
     const Imf::Header header = make_header(image);
     if (packs_chunks_itself(image.compression))
         write_exr_with_own_chunks(path, image, header);
@@ -467,7 +472,7 @@ void write_exr_file(const std::string& path, const ExrImage& image) {
         write_exr_with_openexr(path, image, header);
 }
 
-void require_image(const Image& image) {
+void require_image(const RgbImage& image) {
     if (image.width() <= 0 || image.height() <= 0)
         throw std::invalid_argument("the image is empty (" + std::to_string(image.width()) +
                                     "x" + std::to_string(image.height()) + ")");
@@ -507,92 +512,6 @@ std::string_view to_string(ExrCompression compression) {
     return "unknown";
 }
 
-std::string_view to_string(ExrPixelType type) {
-    switch (type) {
-        case ExrPixelType::uint32:
-            return "uint";
-        case ExrPixelType::half:
-            return "half";
-        case ExrPixelType::float32:
-            return "float";
-    }
-    return "unknown";
-}
-
-std::size_t sample_size(ExrPixelType type) { return type == ExrPixelType::half ? 2 : 4; }
-
-float ExrChannel::value(std::size_t k) const {
-    const unsigned char* p = samples.data() + k * sample_size(type);
-    switch (type) {
-        case ExrPixelType::half: {
-            half h;
-            std::uint16_t bits;
-            std::memcpy(&bits, p, sizeof bits);
-            h.setBits(bits);
-            return static_cast<float>(h);
-        }
-        case ExrPixelType::float32: {
-            float f;
-            std::memcpy(&f, p, sizeof f);
-            return f;
-        }
-        case ExrPixelType::uint32: {
-            std::uint32_t u;
-            std::memcpy(&u, p, sizeof u);
-            return static_cast<float>(u);
-        }
-    }
-    return 0.0f;
-}
-
-std::uint32_t ExrChannel::uint_value(std::size_t k) const {
-    if (type == ExrPixelType::uint32) {
-        std::uint32_t u;
-        std::memcpy(&u, samples.data() + k * sizeof u, sizeof u);
-        return u;
-    }
-    const float f = value(k);
-    // NaN and negatives give 0, values past the range the largest uint32.
-    if (!(f > 0.0f)) return 0;
-    if (f >= 4294967296.0f) return 0xffffffffu;
-    return static_cast<std::uint32_t>(f);
-}
-
-ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* values,
-                            std::size_t count, std::size_t stride,
-                            std::vector<unsigned char> storage) {
-    if (type == ExrPixelType::uint32)
-        throw std::invalid_argument("make_exr_channel: floats make half or float channels");
-    // Storage of another size is not kept: its capacity would outlast this channel.
-    if (storage.size() != count * sample_size(type)) storage = {};
-    storage.resize(count * sample_size(type));  // every byte is written below
-    ExrChannel c{std::move(name), type, std::move(storage)};
-    unsigned char* out = c.samples.data();
-    if (type == ExrPixelType::half) {
-        // The samples are bytes; std::vector's storage is aligned for any scalar type.
-        floats_to_half_bits(values, count, stride, reinterpret_cast<std::uint16_t*>(out));
-        return c;
-    }
-    for (std::size_t k = 0; k < count; ++k) {
-        const float v = values[k * stride];
-        std::memcpy(out + 4 * k, &v, sizeof v);
-    }
-    return c;
-}
-
-ExrChannel make_exr_channel(std::string name, const std::vector<std::uint32_t>& values) {
-    ExrChannel c{std::move(name), ExrPixelType::uint32,
-                 std::vector<unsigned char>(values.size() * sizeof(std::uint32_t))};
-    if (!values.empty()) std::memcpy(c.samples.data(), values.data(), c.samples.size());
-    return c;
-}
-
-const ExrChannel* ExrImage::find_channel(std::string_view name) const {
-    for (const ExrChannel& c : channels)
-        if (c.name == name) return &c;
-    return nullptr;
-}
-
 const int* ExrAttributes::find_int(std::string_view name) const {
     for (const auto& [key, value] : ints)
         if (key == name) return &value;
@@ -610,32 +529,32 @@ ExrRational exr_rational(double value) {
     return {r.n, r.d};
 }
 
-ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
-                        int full_height, const ExrWriteOptions& options,
-                        const ExrAttributes& attributes, std::vector<ExrChannel> spare) {
+Image make_image(const RgbImage& image, PixelRect data_window, int full_width, int full_height,
+                 const ExrWriteOptions& options, const ExrAttributes& attributes,
+                 std::vector<ImageChannel> spare) {
     if (image.width() != data_window.width() || image.height() != data_window.height())
-        throw std::invalid_argument("make_exr_image: a " + std::to_string(image.width()) + "x" +
+        throw std::invalid_argument("make_image: a " + std::to_string(image.width()) + "x" +
                                     std::to_string(image.height()) +
                                     " image cannot fill the data window " +
                                     window_text(data_window));
-    ExrImage exr;
+    Image exr;
     exr.display_window = PixelRect{0, 0, full_width, full_height};
     exr.data_window = data_window;
     exr.compression = options.compression;
     exr.attributes = attributes;
-    const ExrPixelType type = options.float32 ? ExrPixelType::float32 : ExrPixelType::half;
+    const PixelFormat type = options.float32 ? PixelFormat::float32 : PixelFormat::half;
     const float* rgb = reinterpret_cast<const float*>(image.data());
     const std::size_t n = image.pixel_count();
     const auto storage = [&spare](std::size_t k) {
         return k < spare.size() ? std::move(spare[k].samples) : std::vector<unsigned char>();
     };
-    exr.channels.push_back(make_exr_channel("R", type, rgb + 0, n, 3, storage(0)));
-    exr.channels.push_back(make_exr_channel("G", type, rgb + 1, n, 3, storage(1)));
-    exr.channels.push_back(make_exr_channel("B", type, rgb + 2, n, 3, storage(2)));
+    exr.channels.push_back(make_channel("R", type, rgb + 0, n, 3, storage(0)));
+    exr.channels.push_back(make_channel("G", type, rgb + 1, n, 3, storage(1)));
+    exr.channels.push_back(make_channel("B", type, rgb + 2, n, 3, storage(2)));
     return exr;
 }
 
-void write_exr(const std::string& path, const ExrImage& image) {
+void write_exr(const std::string& path, const Image& image) {
     try {
         check_exr_image(image);
     } catch (const std::exception& e) {
@@ -644,22 +563,22 @@ void write_exr(const std::string& path, const ExrImage& image) {
     write_file_atomically(path, [&](const std::string& tmp) { write_exr_file(tmp, image); });
 }
 
-void write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options,
+void write_exr(const std::string& path, const RgbImage& image, const ExrWriteOptions& options,
                const ExrAttributes& attributes) {
     try {
         require_image(image);
     } catch (const std::exception& e) {
         throw IoError("cannot write " + path + ": " + e.what());
     }
-    write_exr(path, make_exr_image(image, PixelRect{0, 0, image.width(), image.height()},
-                                   image.width(), image.height(), options, attributes));
+    write_exr(path, make_image(image, PixelRect{0, 0, image.width(), image.height()},
+                               image.width(), image.height(), options, attributes));
 }
 
 void set_exr_thread_count(int threads) { Imf::setGlobalThreadCount(threads); }
 
 int exr_thread_count() { return Imf::globalThreadCount(); }
 
-void detail::write_exr_by_openexr(const std::string& path, const ExrImage& image) {
+void detail::write_exr_by_openexr(const std::string& path, const Image& image) {
     check_exr_image(image);
     write_exr_with_openexr(path, image, make_header(image));
 }

@@ -1,6 +1,6 @@
 #pragma once
 // Floats to the bits of IEEE binary16 (OpenEXR's HALF), the conversion every half channel
-// octray writes goes through (make_exr_channel). Rounded to nearest even, bit for bit as
+// octray writes goes through (make_channel). Rounded to nearest even, bit for bit as
 // Imath's half(float): with the F16C instruction (8 at a time) where the CPU has it
 // (checked once, at run time), with Imath's slower software conversion otherwise
 // (measured: docs/performance-log.md, "Time to image on an AVX-512 Xeon").

@@ -50,26 +50,27 @@ std::string percent(double value) {
 }
 
 // Pairs each compared channel's index in A with its index in B.
-std::vector<std::pair<int, int>> match_channels(const ChannelImage& a, const ChannelImage& b,
+std::vector<std::pair<int, int>> match_channels(const Image& a, const Image& b,
                                                 const std::vector<std::string>& wanted) {
     std::vector<std::pair<int, int>> pairs;
     if (wanted.empty()) {
-        std::vector<std::string> names_a = a.channel_names, names_b = b.channel_names;
+        std::vector<std::string> names_a = a.channel_names(), names_b = b.channel_names();
         std::sort(names_a.begin(), names_a.end());
         std::sort(names_b.begin(), names_b.end());
         if (names_a != names_b)
-            throw ImageMismatch("channel mismatch: A has " + join(a.channel_names) +
-                                ", B has " + join(b.channel_names));
+            throw ImageMismatch("channel mismatch: A has " + join(a.channel_names()) +
+                                ", B has " + join(b.channel_names()));
         for (int c = 0; c < a.channel_count(); ++c)
-            pairs.emplace_back(c, b.find_channel(a.channel_names[static_cast<std::size_t>(c)]));
+            pairs.emplace_back(c,
+                               b.channel_index(a.channels[static_cast<std::size_t>(c)].name));
         return pairs;
     }
     for (const std::string& name : wanted) {
-        const int in_a = a.find_channel(name), in_b = b.find_channel(name);
+        const int in_a = a.channel_index(name), in_b = b.channel_index(name);
         if (in_a < 0 || in_b < 0)
             throw ImageMismatch("channel mismatch: '" + name + "' is not in " +
-                                (in_a < 0 ? "A (which has " + join(a.channel_names) + ")"
-                                          : "B (which has " + join(b.channel_names) + ")"));
+                                (in_a < 0 ? "A (which has " + join(a.channel_names()) + ")"
+                                          : "B (which has " + join(b.channel_names()) + ")"));
         if (std::find(pairs.begin(), pairs.end(), std::make_pair(in_a, in_b)) == pairs.end())
             pairs.emplace_back(in_a, in_b);
     }
@@ -241,28 +242,31 @@ std::vector<std::string> format_notes(std::string_view format_a, std::string_vie
     return notes;
 }
 
-CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
-                             const CompareOptions& options) {
+CompareResult compare_images(const Image& a, const Image& b, const CompareOptions& options) {
+    // The figures are over float values: half and uint channels compare as the floats they
+    // hold.
+    if (!a.all_float32() || !b.all_float32())
+        return compare_images(to_float32(a), to_float32(b), options);
     check_compare_options(options);
     if (a.pixel_count() == 0 || b.pixel_count() == 0)
-        throw ImageMismatch("an image without pixels: A is " + std::to_string(a.width) + "x" +
-                            std::to_string(a.height) + ", B is " + std::to_string(b.width) +
-                            "x" + std::to_string(b.height) + "; expected at least 1x1");
-    if (a.width != b.width || a.height != b.height)
-        throw ImageMismatch("size mismatch: A is " + std::to_string(a.width) + "x" +
-                            std::to_string(a.height) + ", B is " + std::to_string(b.width) +
-                            "x" + std::to_string(b.height));
-    if (a.origin_x != b.origin_x || a.origin_y != b.origin_y)
-        throw ImageMismatch("data window mismatch: A starts at (" + std::to_string(a.origin_x) +
-                            ", " + std::to_string(a.origin_y) + "), B at (" +
-                            std::to_string(b.origin_x) + ", " + std::to_string(b.origin_y) +
-                            ")");
+        throw ImageMismatch("an image without pixels: A is " + std::to_string(a.width()) + "x" +
+                            std::to_string(a.height()) + ", B is " + std::to_string(b.width()) +
+                            "x" + std::to_string(b.height()) + "; expected at least 1x1");
+    if (a.width() != b.width() || a.height() != b.height())
+        throw ImageMismatch("size mismatch: A is " + std::to_string(a.width()) + "x" +
+                            std::to_string(a.height()) + ", B is " + std::to_string(b.width()) +
+                            "x" + std::to_string(b.height()));
+    if (a.data_window.x0 != b.data_window.x0 || a.data_window.y0 != b.data_window.y0)
+        throw ImageMismatch(
+            "data window mismatch: A starts at (" + std::to_string(a.data_window.x0) + ", " +
+            std::to_string(a.data_window.y0) + "), B at (" + std::to_string(b.data_window.x0) +
+            ", " + std::to_string(b.data_window.y0) + ")");
 
     CompareResult result;
-    result.width = a.width;
-    result.height = a.height;
-    result.origin_x = a.origin_x;
-    result.origin_y = a.origin_y;
+    result.width = a.width();
+    result.height = a.height();
+    result.origin_x = a.data_window.x0;
+    result.origin_y = a.data_window.y0;
     result.channel_indices = match_channels(a, b, options.channels);
 
     const std::size_t pixels = a.pixel_count();
@@ -278,14 +282,14 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
     std::size_t all_first_nonfinite = pixels;
 
     const auto sample_at = [&](std::size_t i, const std::string& name, float va, float vb) {
-        return PixelSample{a.origin_x + static_cast<int>(i % static_cast<std::size_t>(a.width)),
-                           a.origin_y + static_cast<int>(i / static_cast<std::size_t>(a.width)),
-                           name, va, vb};
+        const std::size_t width = static_cast<std::size_t>(a.width());
+        return PixelSample{a.data_window.x0 + static_cast<int>(i % width),
+                           a.data_window.y0 + static_cast<int>(i / width), name, va, vb};
     };
 
     for (const auto& [index_a, index_b] : result.channel_indices) {
         ErrorStats stats;
-        stats.channel = a.channel_names[static_cast<std::size_t>(index_a)];
+        stats.channel = a.channels[static_cast<std::size_t>(index_a)].name;
         Accumulator sums;
         std::size_t worst_index = 0;
         const float* plane_a = a.plane(index_a);
@@ -377,20 +381,22 @@ CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
         all.nonfinite_pixels += (f & nonfinite) != 0;
         result.hard_fail_pixels += (f & over_hard) != 0;
     }
-    result.notes = format_notes(a.format, b.format);
+    result.notes = format_notes(a.file_format, b.file_format);
     finish(all, all_sums, pixels);
     judge(result, options);
     return result;
 }
 
-ChannelImage difference_image(const ChannelImage& a, const ChannelImage& b,
-                              const CompareResult& result) {
+Image difference_image(const Image& a, const Image& b, const CompareResult& result) {
+    if (!a.all_float32() || !b.all_float32())
+        return difference_image(to_float32(a), to_float32(b), result);
     std::vector<std::string> names;
     for (const ErrorStats& stats : result.channels) names.push_back(stats.channel);
-    ChannelImage diff(a.width, a.height, std::move(names));
-    diff.origin_x = a.origin_x;
-    diff.origin_y = a.origin_y;
-    diff.format = "OpenEXR float";
+    Image diff(a.width(), a.height(), names);
+    diff.data_window = a.data_window;
+    diff.display_window = a.data_window;
+    diff.compression = ExrCompression::zip;
+    diff.file_format = "OpenEXR float";
     const std::size_t pixels = a.pixel_count();
     for (std::size_t k = 0; k < result.channel_indices.size(); ++k) {
         const float* plane_a = a.plane(result.channel_indices[k].first);
@@ -403,20 +409,6 @@ ChannelImage difference_image(const ChannelImage& a, const ChannelImage& b,
                                                         static_cast<double>(plane_b[i])));
     }
     return diff;
-}
-
-void write_channel_exr(const std::string& path, const ChannelImage& image) {
-    const PixelRect window{image.origin_x, image.origin_y, image.origin_x + image.width,
-                           image.origin_y + image.height};
-    ExrImage exr;
-    exr.display_window = window;
-    exr.data_window = window;
-    exr.compression = ExrCompression::zip;
-    for (int c = 0; c < image.channel_count(); ++c)
-        exr.channels.push_back(
-            make_exr_channel(image.channel_names[static_cast<std::size_t>(c)],
-                             ExrPixelType::float32, image.plane(c), image.pixel_count()));
-    write_exr(path, exr);
 }
 
 // ---- Reports -------------------------------------------------------------------------

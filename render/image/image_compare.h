@@ -105,23 +105,19 @@ struct CompareResult {
     std::string reason;  // one line: the verdict and why
 };
 
-// The notes of CompareResult for images in these formats (ChannelImage::format): empty when
+// The notes of CompareResult for images in these formats (Image::format): empty when
 // they are the same or unknown.
 std::vector<std::string> format_notes(std::string_view format_a, std::string_view format_b);
 
 // Compares B against A. Throws ImageMismatch when they cannot be compared.
-CompareResult compare_images(const ChannelImage& a, const ChannelImage& b,
+CompareResult compare_images(const Image& a, const Image& b,
                              const CompareOptions& options = {});
 
 // |A - B| for each compared channel (NaN where either value is NaN, Inf for an Inf against
 // a finite value or the other infinity, 0 for equal infinities), named as the channels
-// compared.
-ChannelImage difference_image(const ChannelImage& a, const ChannelImage& b,
-                              const CompareResult& result);
-
-// Writes `image` as a 32-bit float OpenEXR file (ZIP), all its channels, keeping its
-// data-window origin. Atomic (see write_file_atomically); throws IoError.
-void write_channel_exr(const std::string& path, const ChannelImage& image);
+// compared: a float32 image of A's data window (also its display window), ZIP-compressed
+// when written (write_exr).
+Image difference_image(const Image& a, const Image& b, const CompareResult& result);
 
 // The human-readable report: a table per channel plus "all", the threshold counts, the
 // NaN/Inf census, and the reason line last. `label_a` / `label_b` name the inputs.

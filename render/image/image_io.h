@@ -2,7 +2,7 @@
 // Writing images: OpenEXR (the product) and 8-bit PNG previews, and the types an OpenEXR
 // image is made of. Every writer goes through write_file_atomically(), so an interrupted
 // run never leaves a partial image behind. Every OpenEXR file octray writes goes through
-// write_exr(path, ExrImage) (exr_write.cpp); every PNG through png.cpp.
+// write_exr(path, Image) (exr_write.cpp); every PNG through png.cpp.
 
 #include <array>
 #include <cstddef>
@@ -17,6 +17,7 @@
 
 #include "core/image.h"
 #include "core/pixel_rect.h"
+#include "render/image/image.h"
 
 namespace octray {
 
@@ -48,127 +49,34 @@ void write_file_atomically(const std::string& path,
 // stays too.
 std::vector<std::string> remove_stale_temporaries(const std::string& target);
 
-enum class ExrCompression { none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab };
-
-std::optional<ExrCompression> parse_exr_compression(std::string_view name);
-// The scan lines the codec compresses as one block (OpenEXR's line buffer): none, rle and
-// zips 1, zip and pxr24 16, piz, b44, b44a and dwaa 32, dwab 256.
-int exr_lines_per_chunk(ExrCompression compression);
-std::string_view to_string(ExrCompression compression);
-
 struct ExrWriteOptions {
     bool float32 = false;  // 32-bit float channels instead of half
     ExrCompression compression = ExrCompression::zip;
 };
 
-// A 4x4 float matrix as OpenEXR's M44f (Imath) holds it: element (row, col) at
-// [4 * row + col], applied to row vectors (p' = p * M, translation in the last row).
-using Matrix44 = std::array<float, 16>;
-
-// OpenEXR's Rational (the framesPerSecond attribute): numerator / denominator.
-struct ExrRational {
-    int numerator = 0;
-    unsigned int denominator = 1;
-    friend bool operator==(const ExrRational&, const ExrRational&) = default;
-};
-
-// OpenEXR's own "nice fraction" for a value: 24 -> 24/1, 30000.0/1001 -> 30000/1001.
-ExrRational exr_rational(double value);
-
-// A header attribute of a type octray does not interpret, kept as OpenEXR serialized it
-// (read from one file, written to another unchanged: `octray assemble`).
-struct ExrOpaqueAttribute {
-    std::string name;
-    std::string type;                  // OpenEXR's type name: "v2f", "chromaticities", ...
-    std::vector<unsigned char> value;  // the attribute's bytes as stored in a file
-};
-
-// Extra header attributes, written as OpenEXR string / float / int / double / M44f /
-// rational attributes, plus opaque ones carried over from a file. A name given twice, or
-// one of the structural attributes the writer sets itself (channels, compression,
-// dataWindow, displayWindow, lineOrder, ...), is refused by the writer.
-struct ExrAttributes {
-    std::vector<std::pair<std::string, std::string>> strings;
-    std::vector<std::pair<std::string, float>> floats;
-    std::vector<std::pair<std::string, int>> ints;
-    std::vector<std::pair<std::string, double>> doubles;
-    std::vector<std::pair<std::string, Matrix44>> matrices;      // M44f: worldToCamera, ...
-    std::vector<std::pair<std::string, ExrRational>> rationals;  // framesPerSecond
-    std::vector<ExrOpaqueAttribute> opaque;
-
-    // The value of the int / string attribute called `name`, or nullptr.
-    const int* find_int(std::string_view name) const;
-    const std::string* find_string(std::string_view name) const;
-};
-
-// ---- Images of any channel set, with windows -----------------------------------------
-
-// OpenEXR's pixel types: UINT, HALF, FLOAT.
-enum class ExrPixelType { uint32, half, float32 };
-std::string_view to_string(ExrPixelType type);  // "uint", "half", "float"
-std::size_t sample_size(ExrPixelType type);     // 4, 2, 4 bytes
-
-// One channel: a sample per pixel of the data window, row by row (top row first), each in
-// the channel's own type and native byte order (half: the 16 bits of an IEEE binary16).
-struct ExrChannel {
-    std::string name;
-    ExrPixelType type = ExrPixelType::half;
-    std::vector<unsigned char> samples;
-
-    std::size_t size() const { return samples.size() / sample_size(type); }
-    // Sample k as a float (a uint32 is converted and may round above 2^24).
-    float value(std::size_t k) const;
-    // Sample k of a uint32 channel (else the float value truncated; negative -> 0).
-    std::uint32_t uint_value(std::size_t k) const;
-};
-
-// A half or float32 channel from `count` floats at `values`, `stride` floats apart
-// (half rounds to nearest even, as OpenEXR's half does). Its samples go into `storage`
-// (a written frame's, handed on) where it is of the right size, which is then neither
-// zeroed nor mapped afresh; storage of another size is freed first.
-ExrChannel make_exr_channel(std::string name, ExrPixelType type, const float* values,
-                            std::size_t count, std::size_t stride = 1,
-                            std::vector<unsigned char> storage = {});
-// A uint32 channel.
-ExrChannel make_exr_channel(std::string name, const std::vector<std::uint32_t>& values);
-
-// A scanline OpenEXR image: its windows, channels, compression and extra attributes.
-// The display window is the whole picture; the data window the pixels the file holds
-// (a crop of a render: the crop inside the full image).
-struct ExrImage {
-    PixelRect display_window;
-    PixelRect data_window;
-    std::vector<ExrChannel> channels;  // any order: OpenEXR stores them sorted by name
-    ExrCompression compression = ExrCompression::zip;
-    ExrAttributes attributes;
-
-    // The channel called `name`, or nullptr.
-    const ExrChannel* find_channel(std::string_view name) const;
-};
+// ---- From a render to a file ----------------------------------------------------------
 
 // R, G, B channels (half, or float32 with options.float32) of `image`; the data window is
 // `data_window` (the image's size) inside a display window of (0, 0)-(full_width,
 // full_height). Throws std::invalid_argument if the sizes disagree.
 // `spare`: channels of an image already written, whose storage R, G and B take in turn
-// (make_exr_channel), so that a frame loop converts each frame into the same memory.
-ExrImage make_exr_image(const Image& image, PixelRect data_window, int full_width,
-                        int full_height, const ExrWriteOptions& options,
-                        const ExrAttributes& attributes = {},
-                        std::vector<ExrChannel> spare = {});
-// (A render's make_exr_image(RenderResult, ...) is in render/batch/result_exr.h.)
+// (make_channel), so that a frame loop converts each frame into the same memory.
+Image make_image(const RgbImage& image, PixelRect data_window, int full_width, int full_height,
+                 const ExrWriteOptions& options, const ExrAttributes& attributes = {},
+                 std::vector<ImageChannel> spare = {});
 
 // Writes `image` as a scanline OpenEXR file, atomically. Throws IoError naming the path
 // and the reason (an empty window, a channel whose sample count is not the data window's,
 // two channels or attributes of one name, ...).
-void write_exr(const std::string& path, const ExrImage& image);
+void write_exr(const std::string& path, const Image& image);
 
 // Writes R, G, B channels (row 0 on top); data window = display window = the image.
 // Throws IoError.
-void write_exr(const std::string& path, const Image& image, const ExrWriteOptions& options,
+void write_exr(const std::string& path, const RgbImage& image, const ExrWriteOptions& options,
                const ExrAttributes& attributes = {});
 
 // An 8-bit sRGB preview: linear values clamped to [0, 1], sRGB-encoded. Throws IoError.
-void write_png_preview(const std::string& path, const Image& image);
+void write_png_preview(const std::string& path, const RgbImage& image);
 
 // A linear value clamped to [0, 1] (NaN and negatives to 0) through the sRGB OETF
 // (IEC 61966-2-1), rounded to 8 bits: what the PNG preview stores. Found in a table of the
@@ -190,6 +98,10 @@ std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_
 // height), for pictures that are not renders: the compare heatmap. Throws IoError.
 void write_png_rgb8(const std::string& path, int width, int height,
                     const std::vector<std::uint8_t>& rgb);
+// The same of an image of uint8 channels R, G, B (sRGB values; the data window is the
+// picture): the compare heatmap. Throws IoError for other channels.
+void write_png(const std::string& path, const Image& image);
+std::string encode_png(const Image& image);
 
 // The threads OpenEXR compresses and decompresses the blocks of a file on (its global
 // pool, Imf::setGlobalThreadCount): 0 means none, the calling thread does the work. The
@@ -204,7 +116,7 @@ namespace detail {
 // (libdeflate, in parallel) and leaves the other compressions to OpenEXR. For the tests
 // that hold the first to OpenEXR's writer: `image` written by OpenEXR's OutputFile, with
 // the same header, not atomically.
-void write_exr_by_openexr(const std::string& path, const ExrImage& image);
+void write_exr_by_openexr(const std::string& path, const Image& image);
 }  // namespace detail
 
 }  // namespace octray

@@ -40,19 +40,6 @@
 
 namespace octray {
 
-ChannelImage::ChannelImage(int width_, int height_, std::vector<std::string> names)
-    : width(width_),
-      height(height_),
-      channel_names(std::move(names)),
-      planes(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) *
-             channel_names.size()) {}
-
-int ChannelImage::find_channel(std::string_view name) const {
-    for (std::size_t c = 0; c < channel_names.size(); ++c)
-        if (channel_names[c] == name) return static_cast<int>(c);
-    return -1;
-}
-
 void fail_reading(const std::string& path, std::string reason) {
     // Callers print the message as one line, and OpenEXR's own messages may hold newlines.
     std::replace(reason.begin(), reason.end(), '\n', ' ');
@@ -253,10 +240,10 @@ ExrCompression from_imf(Imf::Compression compression) {
     }
 }
 
-ExrPixelType from_imf(Imf::PixelType type) {
-    return type == Imf::HALF    ? ExrPixelType::half
-           : type == Imf::FLOAT ? ExrPixelType::float32
-                                : ExrPixelType::uint32;
+PixelFormat from_imf(Imf::PixelType type) {
+    return type == Imf::HALF    ? PixelFormat::half
+           : type == Imf::FLOAT ? PixelFormat::float32
+                                : PixelFormat::uint32;
 }
 
 // "R, G, B float; id uint": the channels as the header declares them, for messages.
@@ -381,44 +368,56 @@ void read_exr_pixels(Imf::InputFile& file, const Imf::FrameBuffer& frame_buffer)
     file.readPixels(window.min.y, window.max.y);
 }
 
-ChannelImage read_exr_file(const std::string& path) {
+PixelRect from_box(const Imath::Box2i& box) {
+    return PixelRect{box.min.x, box.min.y, box.max.x + 1, box.max.y + 1};
+}
+
+// "OpenEXR half float": the pixel types of the file's channels, for reports.
+std::string exr_format_text(const Imf::Header& header) {
+    std::set<Imf::PixelType> types;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+        types.insert(it.channel().type);
+    std::string format = "OpenEXR";
+    for (Imf::PixelType type : types)
+        format += type == Imf::HALF ? " half" : type == Imf::FLOAT ? " float" : " uint";
+    return format;
+}
+
+Image read_exr_file(const std::string& path) {
     return read_exr(path, true, [&](Imf::InputFile& file) {
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
         const auto [w, h] = window_size(window);
 
         std::vector<std::string> names;
-        std::set<Imf::PixelType> types;
-        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
             names.emplace_back(it.name());
-            types.insert(it.channel().type);
-        }
         std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
             return exr_channel_key(a) < exr_channel_key(b);
         });
 
-        ChannelImage image(static_cast<int>(w), static_cast<int>(h), names);
-        image.origin_x = window.min.x;
-        image.origin_y = window.min.y;
-        std::string format = "OpenEXR";
-        for (Imf::PixelType type : types)
-            format += type == Imf::HALF ? " half" : type == Imf::FLOAT ? " float" : " uint";
-        image.format = format;
+        Image image(static_cast<int>(w), static_cast<int>(h), names);
+        image.data_window = from_box(window);
+        // A display window OpenEXR would refuse to write is the data window here: what is
+        // compared is the pixels.
+        const Imath::Box2i display = header.displayWindow();
+        if (static_cast<long long>(display.max.x) >= display.min.x &&
+            static_cast<long long>(display.max.y) >= display.min.y)
+            image.display_window = from_box(display);
+        else
+            image.display_window = image.data_window;
+        image.file_format = exr_format_text(header);
 
         // Every channel is read as FLOAT; OpenEXR converts HALF and UINT on the way.
         Imf::FrameBuffer frame_buffer;
         for (int c = 0; c < image.channel_count(); ++c)
             frame_buffer.insert(
-                image.channel_names[static_cast<std::size_t>(c)],
+                image.channels[static_cast<std::size_t>(c)].name,
                 Imf::Slice::Make(Imf::FLOAT, image.plane(c), window, sizeof(float),
                                  sizeof(float) * static_cast<std::size_t>(w)));
         read_exr_pixels(file, frame_buffer);
         return image;
     });
-}
-
-PixelRect from_box(const Imath::Box2i& box) {
-    return PixelRect{box.min.x, box.min.y, box.max.x + 1, box.max.y + 1};
 }
 
 // The attributes write_exr() derives from the image itself, and so does not carry.
@@ -461,7 +460,7 @@ ExrAttributes read_attributes(const Imf::Header& header) {
     return out;
 }
 
-ExrImage read_exr_image_file(const std::string& path) {
+Image read_exr_image_file(const std::string& path) {
     return read_exr(path, true, [&](Imf::InputFile& file) {
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
@@ -471,19 +470,20 @@ ExrImage read_exr_image_file(const std::string& path) {
             static_cast<long long>(display.max.y) < display.min.y)
             fail(path, "OpenEXR file has an empty display window");
 
-        ExrImage image;
+        Image image;
         image.display_window = from_box(display);
         image.data_window = from_box(window);
         image.compression = from_imf(header.compression());
         image.attributes = read_attributes(header);
+        image.file_format = exr_format_text(header);
         const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
         Imf::FrameBuffer frame_buffer;
         for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
             const Imf::PixelType t = it.channel().type;
-            const ExrPixelType type = from_imf(t);
+            const PixelFormat type = from_imf(t);
             const std::size_t element = sample_size(type);
             image.channels.push_back(
-                ExrChannel{it.name(), type, std::vector<unsigned char>(pixels * element)});
+                ImageChannel{it.name(), type, std::vector<unsigned char>(pixels * element)});
             frame_buffer.insert(
                 it.name(), Imf::Slice::Make(t, image.channels.back().samples.data(), window,
                                             element, element * static_cast<std::size_t>(w)));
@@ -495,7 +495,7 @@ ExrImage read_exr_image_file(const std::string& path) {
 
 }  // namespace
 
-ChannelImage read_image(const std::string& path) {
+Image read_image(const std::string& path) {
     const std::vector<unsigned char> signature = read_signature(path);
     if (signature.empty()) fail(path, "empty file, not an image");
     switch (kind_of(signature)) {
@@ -531,7 +531,7 @@ void check_exr_pixel_data(const std::string& path) {
     read_exr(path, true, [](Imf::InputFile&) {});
 }
 
-ExrImage read_exr_image(const std::string& path) {
+Image read_exr_image(const std::string& path) {
     const std::vector<unsigned char> signature = read_signature(path);
     if (signature.empty()) fail(path, "empty file, not an OpenEXR image");
     if (kind_of(signature) != FileKind::exr)

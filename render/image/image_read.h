@@ -13,52 +13,13 @@
 
 namespace octray {
 
-// A float image of named channels, stored planar (one full plane per channel), so that
-// comparing one channel walks contiguous memory. Row 0 is the top row.
-struct ChannelImage {
-    int width = 0;
-    int height = 0;
-    // The data window's corner (OpenEXR files may store pixels off the origin); pixel
-    // (x, y) of the planes is pixel (origin_x + x, origin_y + y) of the file.
-    int origin_x = 0;
-    int origin_y = 0;
-    std::vector<std::string> channel_names;
-    // Channel c, row y, column x at planes[(c * height + y) * width + x].
-    std::vector<float> planes;
-    // "OpenEXR half", "PNG 8-bit", ...: what the file held, for reports.
-    std::string format;
-
-    ChannelImage() = default;
-    ChannelImage(int width_, int height_, std::vector<std::string> names);
-
-    int channel_count() const { return static_cast<int>(channel_names.size()); }
-    std::size_t pixel_count() const {
-        return static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    }
-    // The index of the channel called `name`, or -1.
-    int find_channel(std::string_view name) const;
-
-    float* plane(int c) { return planes.data() + static_cast<std::size_t>(c) * pixel_count(); }
-    const float* plane(int c) const {
-        return planes.data() + static_cast<std::size_t>(c) * pixel_count();
-    }
-    float& at(int c, int x, int y) { return plane(c)[index(x, y)]; }
-    float at(int c, int x, int y) const { return plane(c)[index(x, y)]; }
-
-  private:
-    std::size_t index(int x, int y) const {
-        return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-               static_cast<std::size_t>(x);
-    }
-};
-
 // Reads an OpenEXR or PNG file. Values are raw: PNG samples are scaled to [0, 1] but not
 // linearized from sRGB and alpha is not premultiplied (idiff compares stored values, and so
 // do we). EXR channels come back ordered R, G, B, A within each layer ("", then
 // "diffuse.", ...), other names alphabetically after them; a PNG's channels are Y, YA, RGB
 // or RGBA. Throws IoError naming the path and the reason: missing, unreadable, not an image
 // (unknown magic bytes), truncated or corrupt.
-ChannelImage read_image(const std::string& path);
+Image read_image(const std::string& path);
 
 // Reads a scanline or tiled OpenEXR file (its first part) as it is stored: the display and
 // data windows, every channel in its own pixel type (half stays half, bit for bit), the
@@ -66,7 +27,7 @@ ChannelImage read_image(const std::string& path);
 // rationals by type, any other type as an opaque blob), so that write_exr() can write
 // the same image again. Throws IoError naming the path and the reason, as read_image()
 // does; also for a PNG or a subsampled channel.
-ExrImage read_exr_image(const std::string& path);
+Image read_exr_image(const std::string& path);
 
 // What an OpenEXR file's header declares, read without the pixels: its data window, its
 // channels (in the file's order) and codec, and whether it is tiled.

@@ -335,7 +335,7 @@ class PngReadHandle {
     png_infop info_ = nullptr;
 };
 
-void require_image(const std::string& path, const Image& image) {
+void require_image(const std::string& path, const RgbImage& image) {
     if (image.width() <= 0 || image.height() <= 0)
         throw IoError("cannot write " + path + ": the image is empty (" +
                       std::to_string(image.width()) + "x" + std::to_string(image.height()) +
@@ -344,7 +344,7 @@ void require_image(const std::string& path, const Image& image) {
 
 }  // namespace
 
-void write_png_preview(const std::string& path, const Image& image) {
+void write_png_preview(const std::string& path, const RgbImage& image) {
     require_image(path, image);
     const std::string bytes = encode_png(
         image.width(), image.height(),
@@ -368,6 +368,33 @@ void write_png_rgb8(const std::string& path, int width, int height,
     write_file_atomically(path, [&](const std::string& tmp) { write_bytes(tmp, bytes); });
 }
 
+namespace {
+
+// The uint8 channels R, G, B of `image` interleaved; `what` names the target in the error.
+std::vector<std::uint8_t> interleaved_rgb8(const Image& image, const std::string& what) {
+    const ImageChannel* planes[3] = {image.find_channel("R"), image.find_channel("G"),
+                                     image.find_channel("B")};
+    for (const ImageChannel* c : planes)
+        if (c == nullptr || c->format != PixelFormat::uint8 || c->size() != image.pixel_count())
+            throw IoError(what + ": a PNG is made from uint8 channels R, G and B of the image");
+    std::vector<std::uint8_t> rgb(3 * image.pixel_count());
+    for (std::size_t i = 0; i < image.pixel_count(); ++i)
+        for (std::size_t c = 0; c < 3; ++c) rgb[3 * i + c] = planes[c]->samples[i];
+    return rgb;
+}
+
+}  // namespace
+
+void write_png(const std::string& path, const Image& image) {
+    write_png_rgb8(path, image.width(), image.height(),
+                   interleaved_rgb8(image, "cannot write '" + path + "'"));
+}
+
+std::string encode_png(const Image& image) {
+    return encode_png_rgb8(image.width(), image.height(),
+                           interleaved_rgb8(image, "cannot encode a PNG"));
+}
+
 std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_t>& rgb) {
     if (!rgb8_size_matches(width, height, rgb))
         throw IoError("cannot encode a PNG: " + std::to_string(rgb.size()) +
@@ -376,8 +403,7 @@ std::string encode_png_rgb8(int width, int height, const std::vector<std::uint8_
     return encode_png(width, height, rgb8_row(width, rgb), SrgbChunks::srgb);
 }
 
-ChannelImage read_png_channels(const std::string& path,
-                               const std::vector<unsigned char>& bytes) {
+Image read_png_channels(const std::string& path, const std::vector<unsigned char>& bytes) {
     PngIo io;
     io.data = bytes.data();
     io.size = bytes.size();
@@ -409,15 +435,15 @@ ChannelImage read_png_channels(const std::string& path,
 
     static const std::vector<std::string> names_by_count[4] = {
         {"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
-    ChannelImage image(static_cast<int>(layout.width), static_cast<int>(layout.height),
-                       names_by_count[layout.channels - 1]);
-    image.format = layout.bit_depth == 16 ? "PNG 16-bit" : "PNG 8-bit";
+    Image image(static_cast<int>(layout.width), static_cast<int>(layout.height),
+                names_by_count[layout.channels - 1]);
+    image.file_format = layout.bit_depth == 16 ? "PNG 16-bit" : "PNG 8-bit";
 
     // Raw samples scaled to [0, 1]; 16-bit samples are big-endian in the file.
     const int channels = layout.channels;
-    for (int y = 0; y < image.height; ++y) {
+    for (int y = 0; y < image.height(); ++y) {
         const png_byte* row = rows[static_cast<std::size_t>(y)];
-        for (int x = 0; x < image.width; ++x) {
+        for (int x = 0; x < image.width(); ++x) {
             for (int c = 0; c < channels; ++c) {
                 const std::size_t sample = static_cast<std::size_t>(x) * channels + c;
                 float value;

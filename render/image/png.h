@@ -18,7 +18,6 @@ inline constexpr std::size_t max_read_float_values = std::size_t{1} << 30;
 [[noreturn]] void fail_reading(const std::string& path, std::string reason);
 
 // The PNG file `path`, whose bytes are `bytes`, as read_image() returns it (png.cpp).
-ChannelImage read_png_channels(const std::string& path,
-                               const std::vector<unsigned char>& bytes);
+Image read_png_channels(const std::string& path, const std::vector<unsigned char>& bytes);
 
 }  // namespace octray

@@ -13,7 +13,7 @@
 #include "output_fixtures.h"
 #include "render/aov.h"
 #include "render/batch/camera_matrices.h"
-#include "render/batch/result_exr.h"
+#include "render/image/image_io.h"
 #include "render/image/image_read.h"
 
 namespace octray::batch {
@@ -22,7 +22,7 @@ namespace {
 constexpr int kWidth = 29, kHeight = 19;
 
 // What `octray render --crop R --aov depth,normal,albedo,id` writes for one crop.
-ExrImage render_part(const Scene& scene, std::optional<PixelRect> crop, bool float32) {
+Image render_part(const Scene& scene, std::optional<PixelRect> crop, bool float32) {
     RenderOptions options;
     options.crop = crop;
     const RenderResult result = render_packet(scene, options);
@@ -30,10 +30,10 @@ ExrImage render_part(const Scene& scene, std::optional<PixelRect> crop, bool flo
     attributes.strings.emplace_back("software", "octray test");
     attributes.rationals.emplace_back("framesPerSecond", ExrRational{24, 1});
     add_camera_attributes(attributes, scene);
-    ExrImage exr =
-        make_exr_image(result, ExrWriteOptions{float32, ExrCompression::zip}, attributes);
+    Image exr = make_image(result.image, result.rect, result.full_width, result.full_height,
+                           ExrWriteOptions{float32, ExrCompression::zip}, attributes);
     append_aov_channels(exr, compute_aovs(scene, options, AovSet{true, true, true, true}),
-                        float32 ? ExrPixelType::float32 : ExrPixelType::half);
+                        float32 ? PixelFormat::float32 : PixelFormat::half);
     return exr;
 }
 
@@ -50,14 +50,14 @@ std::vector<std::string> write_parts(const Scene& scene, const std::vector<Pixel
     return paths;
 }
 
-void expect_same_image(const ExrImage& a, const ExrImage& b) {
+void expect_same_image(const Image& a, const Image& b) {
     EXPECT_EQ(a.display_window, b.display_window);
     EXPECT_EQ(a.data_window, b.data_window);
     EXPECT_EQ(a.compression, b.compression);
     ASSERT_EQ(a.channels.size(), b.channels.size());
     for (std::size_t k = 0; k < a.channels.size(); ++k) {
         EXPECT_EQ(a.channels[k].name, b.channels[k].name);
-        EXPECT_EQ(a.channels[k].type, b.channels[k].type);
+        EXPECT_EQ(a.channels[k].format, b.channels[k].format);
         EXPECT_TRUE(a.channels[k].samples == b.channels[k].samples) << a.channels[k].name;
     }
     EXPECT_EQ(a.attributes.strings, b.attributes.strings);
@@ -86,7 +86,7 @@ TEST(Assemble, PartsMakeTheFullRenderBitForBit) {
         const std::filesystem::path dir = testing::test_dir();
         const std::string whole = (dir / "whole.exr").string();
         write_exr(whole, render_part(scene, std::nullopt, float32));
-        const ExrImage expected = read_exr_image(whole);
+        const Image expected = read_exr_image(whole);
         for (std::size_t s = 0; s < splits.size(); ++s) {
             SCOPED_TRACE(std::string(float32 ? "float" : "half") + " split " +
                          std::to_string(s));
@@ -102,7 +102,7 @@ TEST(Assemble, PartsMakeTheFullRenderBitForBit) {
 }
 
 // The message of the AssembleError that assembling `parts` throws.
-std::string assemble_error(const std::vector<ExrImage>& parts) {
+std::string assemble_error(const std::vector<Image>& parts) {
     std::vector<std::string> names;
     for (std::size_t k = 0; k < parts.size(); ++k) {
         std::string name = "p";
@@ -117,10 +117,10 @@ std::string assemble_error(const std::vector<ExrImage>& parts) {
     return "(no error)";
 }
 
-ExrImage blank(PixelRect data, PixelRect display = {0, 0, 8, 6}, bool float32 = false) {
-    Image image(data.width(), data.height());
-    ExrImage exr = make_exr_image(image, data, display.x1, display.y1,
-                                  ExrWriteOptions{float32, ExrCompression::zip});
+Image blank(PixelRect data, PixelRect display = {0, 0, 8, 6}, bool float32 = false) {
+    RgbImage image(data.width(), data.height());
+    Image exr = make_image(image, data, display.x1, display.y1,
+                           ExrWriteOptions{float32, ExrCompression::zip});
     return exr;
 }
 
@@ -155,12 +155,12 @@ TEST(Assemble, OverlapsGapsAndMismatchesAreNamed) {
         << e;
     EXPECT_NE(e.find("'p0' has R (half), G (half), B (half)"), std::string::npos) << e;
 
-    ExrImage extra = blank(right);
-    extra.channels.push_back(make_exr_channel("id", std::vector<std::uint32_t>(24, 1u)));
+    Image extra = blank(right);
+    extra.channels.push_back(make_channel("id", std::vector<std::uint32_t>(24, 1u)));
     e = assemble_error({blank(left), extra});
     EXPECT_NE(e.find("id (uint)"), std::string::npos) << e;
 
-    ExrImage outside = blank({4, 0, 9, 6}, {0, 0, 8, 6});
+    Image outside = blank({4, 0, 9, 6}, {0, 0, 8, 6});
     e = assemble_error({blank(left), outside});
     EXPECT_NE(e.find("data window (4, 0)-(9, 6), which is not inside the display window"),
               std::string::npos)

@@ -216,9 +216,9 @@ TEST_F(FrameLoopTest, EveryFrameIsRenderedWrittenAndReportedOnce) {
         // The renderer advanced the observer's counter over every pixel of the frame.
         EXPECT_EQ(observer.pixels_at_finish[k], frame_work);
         EXPECT_EQ(observer.finished_work[k], frame_work);
-        const ChannelImage image = read_image(r.output);
-        EXPECT_EQ(image.width, kWidth);
-        EXPECT_EQ(image.height, kHeight);
+        const Image image = read_image(r.output);
+        EXPECT_EQ(image.width(), kWidth);
+        EXPECT_EQ(image.height(), kHeight);
     }
     EXPECT_EQ(summary.rendered, 3u);
     EXPECT_EQ(summary.skipped + summary.failed + summary.not_started, 0u);
@@ -340,11 +340,11 @@ std::size_t pixels_unlike_alone(const Scene& scene, int frame, const fs::path& f
     options.frame = static_cast<std::uint32_t>(frame);
     const RenderResult alone =
         render_packet(scene_at_frame(scene, frame), options, resolve_isa(Isa::automatic));
-    const ChannelImage image = read_image(file.string());
+    const Image image = read_image(file.string());
     if (image.pixel_count() != alone.image.pixel_count()) return alone.image.pixel_count();
-    const float* r = image.plane(image.find_channel("R"));
-    const float* g = image.plane(image.find_channel("G"));
-    const float* b = image.plane(image.find_channel("B"));
+    const float* r = image.plane(image.channel_index("R"));
+    const float* g = image.plane(image.channel_index("G"));
+    const float* b = image.plane(image.channel_index("B"));
     std::size_t differ = 0;
     for (std::size_t k = 0; k < alone.image.pixel_count(); ++k) {
         const Rgb c = alone.image.data()[k];
@@ -526,7 +526,7 @@ TEST_F(FrameLoopTest, CancelWhileAFrameIsWrittenBehindKeepsThatFrame) {
     EXPECT_EQ(summary.interrupted_frames, 1u);
     EXPECT_EQ(summary.not_started, 1u);
     EXPECT_EQ(files(), (std::set<std::string>{"w.0.exr"}));
-    EXPECT_EQ(read_image(output(0).string()).width, kWidth);
+    EXPECT_EQ(read_image(output(0).string()).width(), kWidth);
 }
 
 }  // namespace

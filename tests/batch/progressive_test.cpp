@@ -88,7 +88,7 @@ TEST(Progressive, PassesAgreeBetweenPaths) {
 
 TEST(Progressive, BadSampleRangesAreRefused) {
     const Scene scene = golden_scene("pinhole_checker", 8, 8, 4);
-    const Image sums(8, 8), wrong(4, 8);
+    const RgbImage sums(8, 8), wrong(4, 8);
     for (Path path : {Path::reference, Path::packet}) {
         SCOPED_TRACE(path_name(path));
         RenderOptions o;

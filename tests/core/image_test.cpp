@@ -10,8 +10,8 @@
 namespace octray {
 namespace {
 
-TEST(Image, RowZeroIsTheTopRowStoredFirst) {
-    Image img(3, 2);
+TEST(RgbImage, RowZeroIsTheTopRowStoredFirst) {
+    RgbImage img(3, 2);
     img.at(0, 0) = Rgb(1.0f);  // top-left
     img.at(2, 1) = Rgb(2.0f);  // bottom-right
     EXPECT_EQ(img.data()[0], Rgb(1.0f));
@@ -19,8 +19,8 @@ TEST(Image, RowZeroIsTheTopRowStoredFirst) {
     EXPECT_EQ(img.pixel_count(), 6u);
 }
 
-TEST(Image, NonSquareDimensionsAreKeptApart) {
-    Image img(4, 2);
+TEST(RgbImage, NonSquareDimensionsAreKeptApart) {
+    RgbImage img(4, 2);
     img.at(3, 0) = Rgb(7.0f);
     EXPECT_EQ(img.width(), 4);
     EXPECT_EQ(img.height(), 2);
@@ -28,17 +28,17 @@ TEST(Image, NonSquareDimensionsAreKeptApart) {
 }
 
 // A batch renders each frame into the last one's storage (RenderOptions::spare_image).
-TEST(Image, ReuseTakesTheSparesStorageOnlyWhenThePixelCountsAgreeAndFreesItElse) {
-    Image spare(6, 4);
+TEST(RgbImage, ReuseTakesTheSparesStorageOnlyWhenThePixelCountsAgreeAndFreesItElse) {
+    RgbImage spare(6, 4);
     const Rgb* storage = spare.data();
-    const Image taken = Image::reuse(std::move(spare), 8, 3);  // 24 pixels either way
+    const RgbImage taken = RgbImage::reuse(std::move(spare), 8, 3);  // 24 pixels either way
     EXPECT_EQ(taken.data(), storage);
     EXPECT_EQ(taken.width(), 8);
     EXPECT_EQ(taken.height(), 3);
     EXPECT_EQ(spare.pixel_count(), 0u);  // NOLINT(bugprone-use-after-move): left empty
 
-    Image other(5, 5);
-    const Image fresh = Image::reuse(std::move(other), 8, 3);
+    RgbImage other(5, 5);
+    const RgbImage fresh = RgbImage::reuse(std::move(other), 8, 3);
     EXPECT_EQ(fresh.pixel_count(), 24u);
     EXPECT_EQ(fresh.width(), 8);
     EXPECT_EQ(other.pixel_count(), 0u);  // NOLINT(bugprone-use-after-move): freed first

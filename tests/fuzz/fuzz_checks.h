@@ -159,9 +159,9 @@ inline bool check_builtin_spec(const std::string& spec) {
 // A value OpenEXR can hold in a channel of `type`: any half for HALF (NaN and Inf
 // included), a whole number in [0, 2^32] for UINT (a float rounds 2^32 - 1 up), anything for
 // FLOAT.
-inline bool fits_pixel_type(float v, ExrPixelType type) {
-    if (type == ExrPixelType::float32 || std::isnan(v)) return true;
-    if (type == ExrPixelType::uint32)
+inline bool fits_pixel_type(float v, PixelFormat type) {
+    if (type == PixelFormat::float32 || std::isnan(v)) return true;
+    if (type == PixelFormat::uint32)
         return v >= 0.0f && v <= 4294967296.0f && std::trunc(v) == v;  // 2^32 - 1 rounds up
     if (std::isinf(v)) return true;
     // half: 11 significant bits, exponents -24 (subnormal) to 15.
@@ -178,7 +178,7 @@ inline bool fits_pixel_type(float v, ExrPixelType type) {
 // channels, the formats they were stored in, every value one that the declared type can
 // hold, and (the check behind "files that lie") every chunk unpacking to the size the
 // header implies.
-inline void check_exr_read_matches_header(const std::string& path, const ChannelImage& image) {
+inline void check_exr_read_matches_header(const std::string& path, const Image& image) {
     ExrLayout layout;
     try {
         layout = read_exr_layout(path);
@@ -187,18 +187,18 @@ inline void check_exr_read_matches_header(const std::string& path, const Channel
         throw InvariantBroken("an EXR that reads has chunks matching its header", e.what());
     }
     const PixelRect& window = layout.data_window;
-    if (image.width != window.x1 - window.x0 || image.height != window.y1 - window.y0 ||
-        image.origin_x != window.x0 || image.origin_y != window.y0)
-        throw InvariantBroken("an EXR reads with its header's data window", image.format);
+    if (image.width() != window.x1 - window.x0 || image.height() != window.y1 - window.y0 ||
+        image.data_window.x0 != window.x0 || image.data_window.y0 != window.y0)
+        throw InvariantBroken("an EXR reads with its header's data window", image.file_format);
     if (static_cast<std::size_t>(image.channel_count()) != layout.channels.size())
-        throw InvariantBroken("an EXR reads with its header's channels", image.format);
+        throw InvariantBroken("an EXR reads with its header's channels", image.file_format);
     for (const ExrChunkChannel& channel : layout.channels) {
-        const int c = image.find_channel(channel.name);
+        const int c = image.channel_index(channel.name);
         if (c < 0)
             throw InvariantBroken("an EXR reads with its header's channels", channel.name);
         const std::string type(to_string(channel.type));
-        if (image.format.find(type) == std::string::npos)
-            throw InvariantBroken("the format names every declared type", image.format);
+        if (image.file_format.find(type) == std::string::npos)
+            throw InvariantBroken("the format names every declared type", image.file_format);
         const float* plane = image.plane(c);
         for (std::size_t i = 0; i < image.pixel_count(); ++i)
             if (!fits_pixel_type(plane[i], channel.type))
@@ -210,27 +210,32 @@ inline void check_exr_read_matches_header(const std::string& path, const Channel
 
 // read_image on a file holding `bytes`: an IoError, or a consistent image.
 inline void check_image_file(const std::string& path) {
-    ChannelImage image;
+    Image image;
     try {
         image = read_image(path);
     } catch (const IoError&) {
         return;
     }
-    if (image.width <= 0 || image.height <= 0) {
-        throw InvariantBroken("a read image has pixels", image.format);
+    if (image.width() <= 0 || image.height() <= 0) {
+        throw InvariantBroken("a read image has pixels", image.file_format);
     }
     if (image.channel_count() < 1)
-        throw InvariantBroken("a read image has channels", image.format);
-    if (image.planes.size() != image.pixel_count() * image.channel_names.size()) {
-        throw InvariantBroken("the planes hold every channel of every pixel", image.format);
+        throw InvariantBroken("a read image has channels", image.file_format);
+    std::size_t values = 0;
+    for (const ImageChannel& c : image.channels)
+        values += c.format == PixelFormat::float32 ? c.size() : 0;
+    if (values != image.pixel_count() * image.channels.size()) {
+        throw InvariantBroken("the planes hold every channel of every pixel",
+                              image.file_format);
     }
     // Touch every value (ASan sees a short plane); PNG samples lie in [0, 1].
-    const bool png = image.format.rfind("PNG", 0) == 0;
-    for (float v : image.planes) {
-        if (png && !(v >= 0.0f && v <= 1.0f)) {
-            throw InvariantBroken("PNG samples lie in [0, 1]", image.format);
+    const bool png = image.file_format.rfind("PNG", 0) == 0;
+    for (const ImageChannel& c : image.channels)
+        for (const float v : std::vector<float>(c.floats(), c.floats() + c.size())) {
+            if (png && !(v >= 0.0f && v <= 1.0f)) {
+                throw InvariantBroken("PNG samples lie in [0, 1]", image.file_format);
+            }
         }
-    }
     if (!png) check_exr_read_matches_header(path, image);
 }
 

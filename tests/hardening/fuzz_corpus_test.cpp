@@ -78,7 +78,7 @@ TEST(FuzzCorpus, EveryImageSeedReads) {
         const std::string name = f.filename().string();
         if (name.rfind("lie_", 0) == 0 || name.rfind("cut_", 0) == 0) continue;
         SCOPED_TRACE(name);
-        const ChannelImage image = read_image(f.string());
+        const Image image = read_image(f.string());
         EXPECT_GT(image.pixel_count(), 0u);
     }
 }

@@ -62,7 +62,7 @@ Rendered render_both(const Scene& scene, const std::string& what) {
     RenderOptions options;
     options.threads = 2;
     Rendered r{render_reference(scene, options), render_packet(scene, options)};
-    const Image &a = r.reference.image, &b = r.packet.image;
+    const RgbImage &a = r.reference.image, &b = r.packet.image;
     EXPECT_EQ(a.width(), b.width());
     EXPECT_EQ(a.height(), b.height());
     if (a.pixel_count() != b.pixel_count()) return r;
@@ -84,7 +84,7 @@ Rendered render_both(const Scene& scene, const std::string& what) {
     return r;
 }
 
-bool all_pixels(const Image& image, Rgb value) {
+bool all_pixels(const RgbImage& image, Rgb value) {
     return std::all_of(image.pixels().begin(), image.pixels().end(),
                        [&](const Rgb& p) { return p == value; });
 }

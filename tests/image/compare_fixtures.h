@@ -47,21 +47,20 @@ class ScratchDirTest : public ::testing::Test {
 };
 
 // A w x h image with the given channels, every value `fill`.
-inline ChannelImage make_image(int w, int h, std::vector<std::string> names,
-                               float fill = 0.0f) {
-    ChannelImage image(w, h, std::move(names));
-    for (float& v : image.planes) v = fill;
+inline Image make_image(int w, int h, std::vector<std::string> names, float fill = 0.0f) {
+    Image image(w, h, names);
+    for (ImageChannel& c : image.channels) std::fill(c.floats(), c.floats() + c.size(), fill);
     return image;
 }
 
 // Writes every channel of `image` with pixel type `type` (values converted by OpenEXR),
-// its data window at (origin_x, origin_y).
-inline void write_test_exr(const std::string& path, const ChannelImage& image,
+// its data window where the image's is.
+inline void write_test_exr(const std::string& path, const Image& image,
                            Imf::PixelType type = Imf::FLOAT,
                            Imf::Compression compression = Imf::ZIP_COMPRESSION) {
-    const Imath::Box2i window(
-        Imath::V2i(image.origin_x, image.origin_y),
-        Imath::V2i(image.origin_x + image.width - 1, image.origin_y + image.height - 1));
+    const Imath::Box2i window(Imath::V2i(image.data_window.x0, image.data_window.y0),
+                              Imath::V2i(image.data_window.x0 + image.width() - 1,
+                                         image.data_window.y0 + image.height() - 1));
     Imf::Header header(window, window);
     header.compression() = compression;
     const std::size_t n = image.pixel_count();
@@ -70,7 +69,7 @@ inline void write_test_exr(const std::string& path, const ChannelImage& image,
     std::vector<std::vector<unsigned>> uints;
     Imf::FrameBuffer fb;
     for (int c = 0; c < image.channel_count(); ++c) {
-        const std::string& name = image.channel_names[static_cast<std::size_t>(c)];
+        const std::string& name = image.channels[static_cast<std::size_t>(c)].name;
         header.channels().insert(name, Imf::Channel(type));
         const float* plane = image.plane(c);
         const char* base = nullptr;
@@ -88,12 +87,12 @@ inline void write_test_exr(const std::string& path, const ChannelImage& image,
             base = reinterpret_cast<const char*>(plane);
         }
         fb.insert(name, Imf::Slice::Make(type, base, window, size,
-                                         size * static_cast<std::size_t>(image.width)));
+                                         size * static_cast<std::size_t>(image.width())));
     }
     // (The inner vectors' buffers survive the outer ones growing: a move keeps them.)
     Imf::OutputFile file(path.c_str(), header);
     file.setFrameBuffer(fb);
-    file.writePixels(image.height);
+    file.writePixels(image.height());
 }
 
 namespace detail {

@@ -85,12 +85,12 @@ TEST_F(ExrChunksTest, HonestFilesOfEveryCodecAndTypeRead) {
                              std::to_string(static_cast<int>(type)));
                 const std::string file = path("honest.exr");
                 testing::write_smooth_exr(file, codec.compression, type, tiled, 41, 70);
-                const ChannelImage image = read_image(file);
-                EXPECT_EQ(image.width, 41);
-                EXPECT_EQ(image.height, 70);
+                const Image image = read_image(file);
+                EXPECT_EQ(image.width(), 41);
+                EXPECT_EQ(image.height(), 70);
                 const float expected =
                     type == Imf::UINT ? 40.0f + 69.0f + 3.0f : 0.1f + 0.4f + 1.38f + 0.6f;
-                const float got = image.at(image.find_channel("R"), 40, 69);
+                const float got = image.at(image.channel_index("R"), 40, 69);
                 // Lossy codecs (B44, DWA) keep values near.
                 EXPECT_NEAR(got, expected, 0.05f * expected);
                 EXPECT_NO_THROW(read_exr_image(file));
@@ -105,9 +105,9 @@ TEST_F(ExrChunksTest, HonestMixedChannelFilesRead) {
     for (const auto& codec : all_exr_codecs()) {
         SCOPED_TRACE(codec.name);
         testing::write_mixed_exr(path("mixed.exr"), codec.compression);
-        const ChannelImage image = read_image(path("mixed.exr"));
+        const Image image = read_image(path("mixed.exr"));
         EXPECT_EQ(image.channel_count(), 7);
-        EXPECT_EQ(image.at(image.find_channel("id"), 18, 34), static_cast<float>(664 % 13));
+        EXPECT_EQ(image.at(image.channel_index("id"), 18, 34), static_cast<float>(664 % 13));
         EXPECT_NO_THROW(read_exr_image(path("mixed.exr")));
     }
 }
@@ -121,10 +121,10 @@ TEST_F(ExrChunksTest, ConstantAndTinyImagesRead) {
                     SCOPED_TRACE(std::string(codec.name) + " type " +
                                  std::to_string(static_cast<int>(type)) + " value " +
                                  std::to_string(value) + " size " + std::to_string(size));
-                    const ChannelImage image =
+                    const Image image =
                         testing::make_image(size, size + 1, {"R", "G", "B", "A"}, value);
                     testing::write_test_exr(path("flat.exr"), image, type, codec.compression);
-                    const ChannelImage read = read_image(path("flat.exr"));
+                    const Image read = read_image(path("flat.exr"));
                     EXPECT_NEAR(read.at(0, size - 1, size), value, 0.01f);  // B44, DWA: lossy
                 }
             }
@@ -135,7 +135,7 @@ TEST_F(ExrChunksTest, ConstantAndTinyImagesRead) {
 TEST(ExrChunkProblem, SizesAgainstTheHeader) {
     ExrChunkShape shape;
     shape.compression = ExrCompression::zip;
-    shape.channels = {{"R", ExrPixelType::float32}, {"Y", ExrPixelType::half}};
+    shape.channels = {{"R", PixelFormat::float32}, {"Y", PixelFormat::half}};
     shape.width = 3;
     shape.height = 2;
     EXPECT_EQ(exr_unpacked_size(shape), 36u);

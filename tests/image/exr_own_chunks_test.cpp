@@ -53,8 +53,8 @@ struct Noise {
 // Channels of every type, with names whose file order (by bytes) differs from the order
 // given, one longer than 31 characters (the version field's long-names flag), smooth or
 // noisy samples.
-ExrImage test_image(PixelRect display, PixelRect data, ExrCompression compression, bool noisy) {
-    ExrImage image;
+Image test_image(PixelRect display, PixelRect data, ExrCompression compression, bool noisy) {
+    Image image;
     image.display_window = display;
     image.data_window = data;
     image.compression = compression;
@@ -69,28 +69,26 @@ ExrImage test_image(PixelRect display, PixelRect data, ExrCompression compressio
                               : scale * static_cast<float>(k % 97) / 97.0f;
     };
     fill(1.0f);
-    image.channels.push_back(make_exr_channel("R", ExrPixelType::half, values.data(), n));
+    image.channels.push_back(make_channel("R", PixelFormat::half, values.data(), n));
     fill(3.0f);
-    image.channels.push_back(make_exr_channel("B", ExrPixelType::float32, values.data(), n));
+    image.channels.push_back(make_channel("B", PixelFormat::float32, values.data(), n));
     fill(1e4f);
-    image.channels.push_back(
-        make_exr_channel("depth.Z", ExrPixelType::float32, values.data(), n));
+    image.channels.push_back(make_channel("depth.Z", PixelFormat::float32, values.data(), n));
     std::vector<std::uint32_t> ids(n);
     for (std::size_t k = 0; k < n; ++k)
         ids[k] = noisy ? noise.next() : static_cast<std::uint32_t>(k / 7);
-    image.channels.push_back(make_exr_channel("id", ids));
+    image.channels.push_back(make_channel("id", ids));
     fill(0.5f);
-    image.channels.push_back(
-        make_exr_channel("a.channel.name.longer.than.thirty.one.characters", ExrPixelType::half,
-                         values.data(), n));
+    image.channels.push_back(make_channel("a.channel.name.longer.than.thirty.one.characters",
+                                          PixelFormat::half, values.data(), n));
     fill(2.0f);
-    image.channels.push_back(make_exr_channel("A", ExrPixelType::half, values.data(), n));
+    image.channels.push_back(make_channel("A", PixelFormat::half, values.data(), n));
     return image;
 }
 
 // Every channel's samples as OpenEXR's reader returns them, in the channel's own type.
 std::map<std::string, std::vector<unsigned char>> read_samples(const fs::path& path,
-                                                               const ExrImage& expected) {
+                                                               const Image& expected) {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();
     EXPECT_EQ(window.min.x, expected.data_window.x0);
@@ -119,10 +117,10 @@ std::map<std::string, std::vector<unsigned char>> read_samples(const fs::path& p
     return samples;
 }
 
-void expect_reads_back(const fs::path& path, const ExrImage& image) {
+void expect_reads_back(const fs::path& path, const Image& image) {
     const auto samples = read_samples(path, image);
     ASSERT_EQ(samples.size(), image.channels.size());
-    for (const ExrChannel& c : image.channels) {
+    for (const ImageChannel& c : image.channels) {
         const auto it = samples.find(c.name);
         ASSERT_NE(it, samples.end()) << c.name;
         EXPECT_TRUE(it->second == c.samples) << "channel " << c.name << " of " << path;
@@ -139,7 +137,7 @@ TEST(ExrOwnChunks, AnUncompressedFileIsOpenExrsOwnByteForByte) {
     const fs::path dir = test_dir();
     for (const auto& [display, data] :
          {std::pair{kWhole, kWhole}, std::pair{kCropDisplay, kCrop}}) {
-        const ExrImage image = test_image(display, data, ExrCompression::none, false);
+        const Image image = test_image(display, data, ExrCompression::none, false);
         write_exr((dir / "ours.exr").string(), image);
         detail::write_exr_by_openexr((dir / "openexr.exr").string(), image);
         const std::string ours = file_bytes(dir / "ours.exr");
@@ -164,7 +162,7 @@ TEST(ExrOwnChunks, ZipAndZipsReadBackBitForBitLikeOpenExrsOwn) {
                 SCOPED_TRACE(std::string(to_string(compression)) +
                              (noisy ? ", noise" : ", smooth") + ", y0 " +
                              std::to_string(data.y0));
-                const ExrImage image = test_image(display, data, compression, noisy);
+                const Image image = test_image(display, data, compression, noisy);
                 write_exr((dir / "ours.exr").string(), image);
                 detail::write_exr_by_openexr((dir / "openexr.exr").string(), image);
                 expect_reads_back(dir / "ours.exr", image);
@@ -174,7 +172,7 @@ TEST(ExrOwnChunks, ZipAndZipsReadBackBitForBitLikeOpenExrsOwn) {
                                                            ? Imf::ZIP_COMPRESSION
                                                            : Imf::ZIPS_COMPRESSION);
                 // No chunk is stored larger than raw; smooth samples compress.
-                ExrImage raw = image;
+                Image raw = image;
                 raw.compression = ExrCompression::none;
                 write_exr((dir / "raw.exr").string(), raw);
                 const auto size = fs::file_size(dir / "ours.exr");
@@ -196,11 +194,11 @@ TEST(ExrOwnChunks, ChunksThatDoNotCompressAreStoredRaw) {
     for (std::uint32_t& id : ids) id = noise.next();
     for (ExrCompression compression :
          {ExrCompression::zip, ExrCompression::zips, ExrCompression::none}) {
-        ExrImage image;
+        Image image;
         image.display_window = kWhole;
         image.data_window = kWhole;
         image.compression = compression;
-        image.channels.push_back(make_exr_channel("id", ids));
+        image.channels.push_back(make_channel("id", ids));
         const std::string name = std::string(to_string(compression)) + ".exr";
         write_exr((dir / name).string(), image);
         expect_reads_back(dir / name, image);
@@ -217,7 +215,7 @@ TEST(ExrOwnChunks, ChunksThatDoNotCompressAreStoredRaw) {
 TEST(ExrOwnChunks, AnImageOfSeveralChunkGroupsReadsBack) {
     const fs::path dir = test_dir();
     const PixelRect window{0, 0, 1201, 1203};  // 17.3 MB of float RGB
-    ExrImage image;
+    Image image;
     image.display_window = window;
     image.data_window = window;
     const std::size_t n = window.pixel_count();
@@ -225,8 +223,7 @@ TEST(ExrOwnChunks, AnImageOfSeveralChunkGroupsReadsBack) {
     for (const char* name : {"R", "G", "B"}) {
         for (std::size_t k = 0; k < n; ++k)
             values[k] = static_cast<float>((k * (name[0] - 'A' + 3)) % 1009) / 1009.0f;
-        image.channels.push_back(
-            make_exr_channel(name, ExrPixelType::float32, values.data(), n));
+        image.channels.push_back(make_channel(name, PixelFormat::float32, values.data(), n));
     }
     for (int threads : {0, 2}) {
         const int before = exr_thread_count();
@@ -244,7 +241,7 @@ TEST(ExrOwnChunks, AnImageOfSeveralChunkGroupsReadsBack) {
 // (SIGXFSZ, whose default action would kill the process, is ignored meanwhile).
 TEST(ExrOwnChunks, AWriteThatFailsSaysTheOsReasonAndLeavesNothing) {
     const fs::path dir = test_dir();
-    const ExrImage image = test_image(kWhole, kWhole, ExrCompression::zip, true);
+    const Image image = test_image(kWhole, kWhole, ExrCompression::zip, true);
     struct rlimit saved {};
     ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
     const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);

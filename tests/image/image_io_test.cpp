@@ -67,8 +67,8 @@ class ImageIoTest : public ::testing::Test {
 
 // A smooth HDR image (lossy codecs are built for such content) whose rows and columns are
 // all distinguishable: red grows to the right, green downwards, blue goes above 1.
-Image gradient_image(int width, int height, float scale = 1.0f) {
-    Image image(width, height);
+RgbImage gradient_image(int width, int height, float scale = 1.0f) {
+    RgbImage image(width, height);
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
             image.at(x, y) =
@@ -79,18 +79,18 @@ Image gradient_image(int width, int height, float scale = 1.0f) {
 }
 
 struct ReadExr {
-    Image image;
+    RgbImage image;
     Imf::Header header;
     std::vector<Imf::PixelType> channel_types;
 };
 
 ReadExr read_exr(const std::string& path) {
     Imf::InputFile file(path.c_str());
-    ReadExr out{Image(), file.header(), {}};
+    ReadExr out{RgbImage(), file.header(), {}};
     const Imath::Box2i window = file.header().dataWindow();
     const int width = window.max.x - window.min.x + 1;
     const int height = window.max.y - window.min.y + 1;
-    out.image = Image(width, height);
+    out.image = RgbImage(width, height);
     for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it)
         out.channel_types.push_back(it.channel().type);
 
@@ -150,19 +150,19 @@ TEST(ExrCompressionNames, RoundTripEveryName) {
     EXPECT_FALSE(parse_exr_compression("jpeg").has_value());
 }
 
-// A frame loop converts each frame into the last one's channels (make_exr_image's spare):
+// A frame loop converts each frame into the last one's channels (make_image's spare):
 // the same storage, and values as from fresh storage, half or float, larger or smaller.
 TEST(ExrChannels, SpareStorageIsTakenAndFullyOverwritten) {
-    const Image first = gradient_image(9, 5), second = gradient_image(9, 5, 0.5f);
+    const RgbImage first = gradient_image(9, 5), second = gradient_image(9, 5, 0.5f);
     for (const bool float32 : {false, true}) {
         SCOPED_TRACE(float32 ? "float" : "half");
         const ExrWriteOptions options{float32, ExrCompression::zip};
-        ExrImage a = make_exr_image(first, PixelRect{0, 0, 9, 5}, 9, 9, options);
+        Image a = make_image(first, PixelRect{0, 0, 9, 5}, 9, 9, options);
         std::vector<const unsigned char*> storage;
-        for (const ExrChannel& c : a.channels) storage.push_back(c.samples.data());
-        const ExrImage fresh = make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options);
-        const ExrImage reused = make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options, {},
-                                               std::move(a.channels));
+        for (const ImageChannel& c : a.channels) storage.push_back(c.samples.data());
+        const Image fresh = make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options);
+        const Image reused =
+            make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options, {}, std::move(a.channels));
         ASSERT_EQ(reused.channels.size(), 3u);
         for (std::size_t k = 0; k < 3; ++k) {
             EXPECT_EQ(reused.channels[k].samples.data(), storage[k]);
@@ -171,16 +171,15 @@ TEST(ExrChannels, SpareStorageIsTakenAndFullyOverwritten) {
         }
     }
     // Spare channels of another size are not kept: the values are still the image's.
-    const ExrImage small =
-        make_exr_image(gradient_image(2, 2), PixelRect{0, 0, 2, 2}, 2, 2, {});
-    const ExrImage big = make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}, {},
-                                        std::vector<ExrChannel>(small.channels));
+    const Image small = make_image(gradient_image(2, 2), PixelRect{0, 0, 2, 2}, 2, 2, {});
+    const Image big = make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}, {},
+                                 std::vector<ImageChannel>(small.channels));
     EXPECT_EQ(big.channels[0].samples,
-              make_exr_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}).channels[0].samples);
+              make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}).channels[0].samples);
 }
 
 TEST_F(ImageIoTest, ExrRoundTripsEveryCompressionHalfAndFloat) {
-    const Image image = gradient_image(37, 21);  // odd sizes: partial codec blocks
+    const RgbImage image = gradient_image(37, 21);  // odd sizes: partial codec blocks
     for (const bool float32 : {false, true}) {
         for (const ExrCompression c : kAllCompressions) {
             SCOPED_TRACE(std::string(to_string(c)) + (float32 ? " float" : " half"));
@@ -222,7 +221,7 @@ TEST_F(ImageIoTest, ExrRoundTripsEveryCompressionHalfAndFloat) {
 }
 
 TEST_F(ImageIoTest, ExrCompressionIsTheOneAskedFor) {
-    const Image image = gradient_image(8, 8);
+    const RgbImage image = gradient_image(8, 8);
     const std::string path = (dir_ / "c.exr").string();
     write_exr(path, image, {false, ExrCompression::piz});
     EXPECT_EQ(read_exr(path).header.compression(), Imf::PIZ_COMPRESSION);
@@ -261,7 +260,7 @@ TEST_F(ImageIoTest, ExrCarriesEveryAttribute) {
 
 TEST_F(ImageIoTest, ExrRowZeroIsTheTopRow) {
     // Only row 0 is bright; a flipped writer would put it at the bottom of the file.
-    Image image(5, 4);
+    RgbImage image(5, 4);
     for (int x = 0; x < 5; ++x) image.at(x, 0) = Rgb(1.0f, 0.5f, 0.25f);
     image.at(4, 3) = Rgb(0.0f, 0.0f, 2.0f);  // bottom-right marker
     const std::string path = (dir_ / "rows.exr").string();
@@ -292,7 +291,7 @@ TEST_F(ImageIoTest, ExrRowZeroIsTheTopRow) {
 
 TEST_F(ImageIoTest, NonFinitePixelsSurviveInExr) {
     // The EXR is the HDR product: infinities and NaNs are stored, not clamped.
-    Image image(3, 1);
+    RgbImage image(3, 1);
     image.at(0, 0) = Rgb(std::numeric_limits<float>::infinity(), 0.0f, 0.0f);
     image.at(1, 0) = Rgb(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
     image.at(2, 0) = Rgb(1.0e6f, 0.0f, 0.0f);  // above half's range
@@ -327,7 +326,7 @@ TEST_F(ImageIoTest, WriteIntoMissingDirectoryThrowsAndLeavesNothing) {
 // (SIGXFSZ, whose default action would kill the process, is ignored meanwhile).
 TEST_F(ImageIoTest, PngWriteFailureSaysTheOsReason) {
     // Noise does not compress: both PNGs are far over the limit and over stdio's buffer.
-    Image noise(128, 128);
+    RgbImage noise(128, 128);
     std::vector<std::uint8_t> bytes(3 * 128 * 128);
     std::uint32_t state = 12345;
     const auto next = [&] { return state = state * 1664525u + 1013904223u; };
@@ -421,8 +420,8 @@ TEST_F(ImageIoTest, TargetThatIsADirectoryFailsCleanly) {
 }
 
 TEST_F(ImageIoTest, EmptyImageIsRefused) {
-    EXPECT_THROW(write_exr((dir_ / "e.exr").string(), Image(), {}), IoError);
-    EXPECT_THROW(write_png_preview((dir_ / "e.png").string(), Image(0, 3)), IoError);
+    EXPECT_THROW(write_exr((dir_ / "e.exr").string(), RgbImage(), {}), IoError);
+    EXPECT_THROW(write_png_preview((dir_ / "e.png").string(), RgbImage(0, 3)), IoError);
     EXPECT_TRUE(entries().empty());
 }
 
@@ -460,7 +459,7 @@ PngPixels read_png(const std::string& path) {
 TEST_F(ImageIoTest, PngEncodesKnownValues) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const float inf = std::numeric_limits<float>::infinity();
-    Image image(4, 2);
+    RgbImage image(4, 2);
     image.at(0, 0) = Rgb(0.0f, 1.0f, 0.5f);
     image.at(1, 0) = Rgb(2.0f, -1.0f, nan);
     image.at(2, 0) = Rgb(0.002f, 0.0031308f, 0.2f);
@@ -495,7 +494,7 @@ TEST_F(ImageIoTest, PngEncodesKnownValues) {
 }
 
 TEST_F(ImageIoTest, PngOfLargerImageIsReadable) {
-    const Image image = gradient_image(320, 200);
+    const RgbImage image = gradient_image(320, 200);
     const std::string path = (dir_ / "big.png").string();
     write_png_preview(path, image);
     const PngPixels png = read_png(path);
@@ -611,7 +610,7 @@ TEST_F(ImageIoTest, PngOfIncompressiblePixelsReadsBack) {
 // do not depend on it.
 TEST_F(ImageIoTest, ExrThreadCountIsSetAndDoesNotChangeTheBytes) {
     const int before = exr_thread_count();
-    const Image image = gradient_image(64, 48);
+    const RgbImage image = gradient_image(64, 48);
     set_exr_thread_count(0);
     EXPECT_EQ(exr_thread_count(), 0);
     write_exr((dir_ / "serial.exr").string(), image, ExrWriteOptions{});

@@ -14,7 +14,7 @@
 #include <tuple>
 
 #include "output_fixtures.h"
-#include "render/batch/result_exr.h"
+#include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "scene/builtin.h"
@@ -22,6 +22,23 @@
 
 namespace octray {
 namespace {
+
+// Pixel k of an AOV image (render/aov.h), read by channel name.
+float aov_depth(const Image& aovs, std::size_t k) {
+    return aovs.find_channel("Z")->floats()[k];
+}
+Vec3 aov_normal(const Image& aovs, std::size_t k) {
+    return {aovs.find_channel("N.X")->floats()[k], aovs.find_channel("N.Y")->floats()[k],
+            aovs.find_channel("N.Z")->floats()[k]};
+}
+Rgb aov_albedo(const Image& aovs, std::size_t k) {
+    return {aovs.find_channel("albedo.R")->floats()[k],
+            aovs.find_channel("albedo.G")->floats()[k],
+            aovs.find_channel("albedo.B")->floats()[k]};
+}
+std::uint32_t aov_id(const Image& aovs, std::size_t k) {
+    return aovs.find_channel("id")->uint_value(k);
+}
 
 TEST(Aov, ParsesListsAndNamesMistakes) {
     EXPECT_EQ(parse_aov_list("depth"), (AovSet{true, false, false, false}));
@@ -57,56 +74,56 @@ Scene known_scene(int spp = 1) {
 
 TEST(Aov, KnownValuesOfASphereAPlaneAndAMiss) {
     Scene scene = known_scene();
-    const AovImages a = compute_aovs(scene, {}, AovSet{true, true, true, true});
-    ASSERT_EQ(a.rect, (PixelRect{0, 0, 33, 33}));
+    const Image a = compute_aovs(scene, {}, AovSet{true, true, true, true});
+    ASSERT_EQ(a.data_window, (PixelRect{0, 0, 33, 33}));
     const auto at = [&](int x, int y) { return static_cast<std::size_t>(y) * 33 + x; };
     // Straight ahead: the sphere's front at distance 4, normal -view = +Z, Cd, id 1.
-    EXPECT_EQ(a.depth[at(16, 16)], 4.0f);
-    EXPECT_EQ(a.normal[at(16, 16)], (Vec3{0, 0, 1}));
-    EXPECT_EQ(a.albedo[at(16, 16)], (Rgb{0.8f, 0.1f, 0.1f}));
-    EXPECT_EQ(a.id[at(16, 16)], 1u);
+    EXPECT_EQ(aov_depth(a, at(16, 16)), 4.0f);
+    EXPECT_EQ(aov_normal(a, at(16, 16)), (Vec3{0, 0, 1}));
+    EXPECT_EQ(aov_albedo(a, at(16, 16)), (Rgb{0.8f, 0.1f, 0.1f}));
+    EXPECT_EQ(aov_id(a, at(16, 16)), 1u);
     // A corner sees the plane from behind: the normal is flipped towards the eye, the
     // depth is the distance along the ray (8 / cos of the angle off axis), id 2.
     const std::size_t c = at(0, 0);
-    EXPECT_EQ(a.id[c], 2u);
-    EXPECT_EQ(a.normal[c], (Vec3{0, 0, 1}));
+    EXPECT_EQ(aov_id(a, c), 2u);
+    EXPECT_EQ(aov_normal(a, c), (Vec3{0, 0, 1}));
     ReferenceTracer tracer(scene);
     const Ray ray = *tracer.camera_ray(0, 0, 0);
-    EXPECT_NEAR(a.depth[c], 8.0f / -ray.direction.z, 1e-5f);
+    EXPECT_NEAR(aov_depth(a, c), 8.0f / -ray.direction.z, 1e-5f);
     // The checker's two colors both occur on the plane, and nothing else.
     std::set<std::tuple<float, float, float>> plane_colors;
-    for (std::size_t k = 0; k < a.id.size(); ++k)
-        if (a.id[k] == 2u) plane_colors.insert({a.albedo[k].r, a.albedo[k].g, a.albedo[k].b});
+    for (std::size_t k = 0; k < a.pixel_count(); ++k)
+        if (aov_id(a, k) == 2u)
+            plane_colors.insert({aov_albedo(a, k).r, aov_albedo(a, k).g, aov_albedo(a, k).b});
     EXPECT_EQ(plane_colors, (std::set<std::tuple<float, float, float>>{{0.2f, 0.3f, 0.4f},
                                                                        {0.9f, 0.8f, 0.7f}}));
 
     // Without the plane the corner misses: Z = +inf, N = 0, albedo = 0, id = 0.
     scene.objects.pop_back();
-    const AovImages m = compute_aovs(scene, {}, AovSet{true, true, true, true});
-    EXPECT_TRUE(std::isinf(m.depth[c]) && m.depth[c] > 0.0f);
-    EXPECT_EQ(m.normal[c], (Vec3{0, 0, 0}));
-    EXPECT_EQ(m.albedo[c], (Rgb{0, 0, 0}));
-    EXPECT_EQ(m.id[c], 0u);
-    EXPECT_EQ(m.id[at(16, 16)], 1u);
+    const Image m = compute_aovs(scene, {}, AovSet{true, true, true, true});
+    EXPECT_TRUE(std::isinf(aov_depth(m, c)) && aov_depth(m, c) > 0.0f);
+    EXPECT_EQ(aov_normal(m, c), (Vec3{0, 0, 0}));
+    EXPECT_EQ(aov_albedo(m, c), (Rgb{0, 0, 0}));
+    EXPECT_EQ(aov_id(m, c), 0u);
+    EXPECT_EQ(aov_id(m, at(16, 16)), 1u);
 }
 
 TEST(Aov, OnlyTheAskedAovsAndCropsAreTheFullImagesPixels) {
     const Scene scene = testing::golden_scene("thinlens_spp4", 23, 17);
-    const AovImages full = compute_aovs(scene, {}, AovSet{true, true, true, true});
+    const Image full = compute_aovs(scene, {}, AovSet{true, true, true, true});
     RenderOptions options;
     options.crop = PixelRect{4, 3, 15, 9};
     options.threads = 1;
-    const AovImages part = compute_aovs(scene, options, AovSet{true, false, false, true});
-    EXPECT_EQ(part.rect, *options.crop);
-    EXPECT_TRUE(part.normal.empty());
-    EXPECT_TRUE(part.albedo.empty());
-    ASSERT_EQ(part.depth.size(), 11u * 6u);
+    const Image part = compute_aovs(scene, options, AovSet{true, false, false, true});
+    EXPECT_EQ(part.data_window, *options.crop);
+    EXPECT_EQ(part.channel_names(), (std::vector<std::string>{"Z", "id"}));
+    ASSERT_EQ(part.pixel_count(), 11u * 6u);
     for (int y = 3; y < 9; ++y)
         for (int x = 4; x < 15; ++x) {
             const std::size_t k = static_cast<std::size_t>(y - 3) * 11 + (x - 4);
             const std::size_t f = static_cast<std::size_t>(y) * 23 + x;
-            EXPECT_EQ(part.depth[k], full.depth[f]);
-            EXPECT_EQ(part.id[k], full.id[f]);
+            EXPECT_EQ(aov_depth(part, k), aov_depth(full, f));
+            EXPECT_EQ(aov_id(part, k), aov_id(full, f));
         }
     options.crop = PixelRect{0, 0, 24, 1};
     EXPECT_THROW(compute_aovs(scene, options, AovSet{true}), std::invalid_argument);
@@ -118,13 +135,9 @@ TEST(Aov, OnlyTheAskedAovsAndCropsAreTheFullImagesPixels) {
 TEST(Aov, FromThePacketPathsFirstHitsTheSameBits) {
     AovSet all;
     all.depth = all.normal = all.albedo = all.id = true;
-    const auto same = [](const AovImages& a, const AovImages& b) {
-        const auto bits = [](const auto& v) {
-            return std::string(reinterpret_cast<const char*>(v.data()),
-                               v.size() * sizeof(v[0]));
-        };
-        return bits(a.depth) == bits(b.depth) && bits(a.normal) == bits(b.normal) &&
-               bits(a.albedo) == bits(b.albedo) && a.id == b.id;
+    // Channels compare by name, format and bytes: the same bits.
+    const auto same = [](const Image& a, const Image& b) {
+        return a.data_window == b.data_window && a.channels == b.channels;
     };
     for (const char* spec : {"whitted", "random:300", "sphereflake:2"})
         for (const CameraType camera :
@@ -141,8 +154,8 @@ TEST(Aov, FromThePacketPathsFirstHitsTheSameBits) {
                 options.frame = 3;
                 options.crop = PixelRect{3, 2, 37, 21};
                 const PreparedScene prepared(scene, accel);
-                const AovImages scalar = compute_aovs(scene, options, all);
-                const AovImages packet =
+                const Image scalar = compute_aovs(scene, options, all);
+                const Image packet =
                     compute_aovs(scene, options, all, trace_first_hits(prepared, options));
                 EXPECT_TRUE(same(scalar, packet))
                     << spec << ", camera " << static_cast<int>(camera) << ", accel "
@@ -164,27 +177,28 @@ TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
         RenderOptions options;
         options.crop = PixelRect{10, 12, 20, 21};
         const RenderResult result = render_reference(scene, options);
-        const AovImages aovs = compute_aovs(scene, options, AovSet{true, true, true, true});
-        ExrImage exr = make_exr_image(result, ExrWriteOptions{float32, ExrCompression::zip});
-        const ExrPixelType color = float32 ? ExrPixelType::float32 : ExrPixelType::half;
+        const Image aovs = compute_aovs(scene, options, AovSet{true, true, true, true});
+        Image exr = make_image(result.image, result.rect, result.full_width, result.full_height,
+                               ExrWriteOptions{float32, ExrCompression::zip});
+        const PixelFormat color = float32 ? PixelFormat::float32 : PixelFormat::half;
         append_aov_channels(exr, aovs, color);
         const std::string path = (dir / "aovs.exr").string();
         write_exr(path, exr);
 
-        const ExrImage back = read_exr_image(path);
+        const Image back = read_exr_image(path);
         EXPECT_EQ(back.data_window, *options.crop);
         EXPECT_EQ(back.display_window, (PixelRect{0, 0, 33, 33}));
         ASSERT_EQ(back.channels.size(), 11u);
         const auto type_of = [&](const char* name) {
-            const ExrChannel* c = back.find_channel(name);
+            const ImageChannel* c = back.find_channel(name);
             EXPECT_NE(c, nullptr) << name;
-            return c != nullptr ? c->type : ExrPixelType::uint32;
+            return c != nullptr ? c->format : PixelFormat::uint32;
         };
         EXPECT_EQ(type_of("R"), color);
         EXPECT_EQ(type_of("N.X"), color);
         EXPECT_EQ(type_of("albedo.G"), color);
-        EXPECT_EQ(type_of("Z"), ExrPixelType::float32);
-        EXPECT_EQ(type_of("id"), ExrPixelType::uint32);
+        EXPECT_EQ(type_of("Z"), PixelFormat::float32);
+        EXPECT_EQ(type_of("id"), PixelFormat::uint32);
         // Pixel (16, 16) of the full image is (6, 4) of the crop.
         const std::size_t k = 4 * 10 + 6;
         EXPECT_EQ(back.find_channel("Z")->value(k), 4.0f);
@@ -192,13 +206,15 @@ TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
         EXPECT_EQ(back.find_channel("N.Z")->value(k), 1.0f);
         EXPECT_EQ(back.find_channel("albedo.R")->value(k), float32 ? 0.8f : float(half(0.8f)));
         for (std::size_t p = 0; p < exr.data_window.pixel_count(); ++p)
-            EXPECT_EQ(back.find_channel("Z")->value(p), aovs.depth[p]);
+            EXPECT_EQ(back.find_channel("Z")->value(p), aov_depth(aovs, p));
     }
-    ExrImage wrong = make_exr_image(render_reference(scene, {}), ExrWriteOptions{});
+    const RenderResult whole = render_reference(scene, {});
+    Image wrong = make_image(whole.image, whole.rect, whole.full_width, whole.full_height,
+                             ExrWriteOptions{});
     RenderOptions crop;
     crop.crop = PixelRect{0, 0, 5, 5};
     EXPECT_THROW(
-        append_aov_channels(wrong, compute_aovs(scene, crop, AovSet{true}), ExrPixelType::half),
+        append_aov_channels(wrong, compute_aovs(scene, crop, AovSet{true}), PixelFormat::half),
         std::invalid_argument);
 }
 

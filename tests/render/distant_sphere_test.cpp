@@ -95,7 +95,7 @@ Rgb brightest(const Scene& s) {
     return s.ambient * (m.color * m.kd) + l * (m.color * m.kd + Rgb(m.ks));
 }
 
-void expect_disc(const Scene& s, const Image& image, const std::string& what) {
+void expect_disc(const Scene& s, const RgbImage& image, const std::string& what) {
     SCOPED_TRACE(what);
     const std::vector<int> want = analytic_row_coverage(s);
     const Rgb top = brightest(s) * 1.0001f;  // room for the rounding of the sums

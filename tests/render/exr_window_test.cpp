@@ -18,7 +18,6 @@
 
 #include "output_fixtures.h"
 #include "render/batch/camera_matrices.h"
-#include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "scene_builders.h"
@@ -35,7 +34,9 @@ TEST(ExrWindows, CroppedRenderRoundTrips) {
     for (bool float32 : {false, true}) {
         SCOPED_TRACE(float32 ? "float" : "half");
         const std::string path = (dir / "crop.exr").string();
-        write_exr(path, make_exr_image(result, ExrWriteOptions{float32, ExrCompression::piz}));
+        write_exr(path,
+                  make_image(result.image, result.rect, result.full_width, result.full_height,
+                             ExrWriteOptions{float32, ExrCompression::piz}));
 
         // OpenEXR's own view: inclusive boxes.
         Imf::InputFile file(path.c_str());
@@ -47,14 +48,14 @@ TEST(ExrWindows, CroppedRenderRoundTrips) {
         EXPECT_EQ(display.max, Imath::V2i(39, 29));
         EXPECT_EQ(file.header().compression(), Imf::PIZ_COMPRESSION);
 
-        const ExrImage back = read_exr_image(path);
+        const Image back = read_exr_image(path);
         EXPECT_EQ(back.data_window, *options.crop);
         EXPECT_EQ(back.display_window, (PixelRect{0, 0, 40, 30}));
         EXPECT_EQ(back.compression, ExrCompression::piz);
         ASSERT_EQ(back.channels.size(), 3u);
-        const ExrChannel* g = back.find_channel("G");
+        const ImageChannel* g = back.find_channel("G");
         ASSERT_NE(g, nullptr);
-        EXPECT_EQ(g->type, float32 ? ExrPixelType::float32 : ExrPixelType::half);
+        EXPECT_EQ(g->format, float32 ? PixelFormat::float32 : PixelFormat::half);
         ASSERT_EQ(g->size(), options.crop->pixel_count());
         for (int y = 0; y < 21; ++y)
             for (int x = 0; x < 22; ++x) {
@@ -65,42 +66,42 @@ TEST(ExrWindows, CroppedRenderRoundTrips) {
         // Written again unchanged: the same samples, byte for byte.
         const std::string again = (dir / "again.exr").string();
         write_exr(again, back);
-        const ExrImage twice = read_exr_image(again);
+        const Image twice = read_exr_image(again);
         EXPECT_EQ(twice.data_window, back.data_window);
         EXPECT_EQ(twice.channels.size(), back.channels.size());
-        for (const ExrChannel& c : back.channels)
+        for (const ImageChannel& c : back.channels)
             EXPECT_EQ(twice.find_channel(c.name)->samples, c.samples) << c.name;
 
         // compare's reader keeps working and reports the data window's corner.
-        const ChannelImage image = read_image(path);
-        EXPECT_EQ(image.width, 22);
-        EXPECT_EQ(image.height, 21);
-        EXPECT_EQ(image.origin_x, 7);
-        EXPECT_EQ(image.origin_y, 5);
+        const Image image = read_image(path);
+        EXPECT_EQ(image.width(), 22);
+        EXPECT_EQ(image.height(), 21);
+        EXPECT_EQ(image.data_window.x0, 7);
+        EXPECT_EQ(image.data_window.y0, 5);
     }
 }
 
 TEST(ExrWindows, WriterRefusesInconsistentImages) {
     const std::filesystem::path dir = testing::test_dir();
     const std::string path = (dir / "bad.exr").string();
-    const Image image(4, 3);
-    ExrImage good = make_exr_image(image, PixelRect{1, 1, 5, 4}, 8, 8, ExrWriteOptions{});
+    const RgbImage image(4, 3);
+    Image good = make_image(image, PixelRect{1, 1, 5, 4}, 8, 8, ExrWriteOptions{});
     EXPECT_NO_THROW(write_exr(path, good));
 
-    ExrImage short_channel = good;
+    Image short_channel = good;
     short_channel.channels[1].samples.pop_back();
     EXPECT_THROW(write_exr(path, short_channel), IoError);
-    ExrImage twice = good;
+    Image twice = good;
     twice.channels.push_back(twice.channels[0]);
     EXPECT_THROW(write_exr(path, twice), IoError);
-    ExrImage structural = good;
+    Image structural = good;
     structural.attributes.ints.emplace_back("dataWindow", 3);
     EXPECT_THROW(write_exr(path, structural), IoError);
-    ExrImage duplicate = good;
+    Image duplicate = good;
     duplicate.attributes.ints.emplace_back("frame", 3);
     duplicate.attributes.floats.emplace_back("frame", 3.0f);
     EXPECT_THROW(write_exr(path, duplicate), IoError);
-    ExrImage empty = good;
+    Image empty = good;
     empty.data_window = PixelRect{2, 2, 2, 5};
     try {
         write_exr(path, empty);
@@ -110,7 +111,7 @@ TEST(ExrWindows, WriterRefusesInconsistentImages) {
                   std::string::npos)
             << e.what();
     }
-    EXPECT_THROW(make_exr_image(image, PixelRect{0, 0, 4, 4}, 8, 8, ExrWriteOptions{}),
+    EXPECT_THROW(make_image(image, PixelRect{0, 0, 4, 4}, 8, 8, ExrWriteOptions{}),
                  std::invalid_argument);
     // The failed writes left nothing behind but the good file.
     std::size_t files = 0;
@@ -128,7 +129,7 @@ TEST(ExrAttributes, MatricesRationalsAndOpaqueAttributesReadBack) {
     attributes.rationals.emplace_back("framesPerSecond", exr_rational(24000.0 / 1001.0));
     attributes.strings.emplace_back("octray:scene", "whitted");
     attributes.ints.emplace_back("octray:frame", 12);
-    write_exr(path, Image(3, 2), ExrWriteOptions{}, attributes);
+    write_exr(path, RgbImage(3, 2), ExrWriteOptions{}, attributes);
 
     {
         Imf::InputFile file(path.c_str());
@@ -144,7 +145,7 @@ TEST(ExrAttributes, MatricesRationalsAndOpaqueAttributesReadBack) {
     EXPECT_EQ(exr_rational(24.0), (ExrRational{24, 1}));
     EXPECT_EQ(exr_rational(25.0), (ExrRational{25, 1}));
 
-    const ExrImage back = read_exr_image(path);
+    const Image back = read_exr_image(path);
     ASSERT_EQ(back.attributes.matrices.size(), 1u);
     EXPECT_EQ(back.attributes.matrices[0].first, "worldToCamera");
     EXPECT_EQ(back.attributes.matrices[0].second, m);

@@ -37,15 +37,15 @@ inline RenderResult render_with(Path path, const Scene& scene, const RenderOptio
                                    : render_packet(scene, options);
 }
 
-// Bit-for-bit equality (Image's == treats -0 as +0 and NaN as unequal).
-inline bool same_bits(const Image& a, const Image& b) {
+// Bit-for-bit equality (RgbImage's == treats -0 as +0 and NaN as unequal).
+inline bool same_bits(const RgbImage& a, const RgbImage& b) {
     return a.width() == b.width() && a.height() == b.height() &&
            std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
 }
 
 // Pixels x0..x1, y0..y1 of `full` as their own image.
-inline Image sub_image(const Image& full, const PixelRect& r) {
-    Image out(r.width(), r.height());
+inline RgbImage sub_image(const RgbImage& full, const PixelRect& r) {
+    RgbImage out(r.width(), r.height());
     for (int y = r.y0; y < r.y1; ++y)
         for (int x = r.x0; x < r.x1; ++x) out.at(x - r.x0, y - r.y0) = full.at(x, y);
     return out;

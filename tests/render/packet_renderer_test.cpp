@@ -41,7 +41,7 @@ struct Agreement {
     bool finite = true;
 };
 
-Agreement agreement(const Image& a, const Image& b) {
+Agreement agreement(const RgbImage& a, const RgbImage& b) {
     Agreement g;
     g.pixels = a.pixel_count();
     for (std::size_t k = 0; k < a.pixel_count(); ++k) {

@@ -236,10 +236,8 @@ void expect_same_images(Scene scene, const std::string& what, int width = 96, in
     EXPECT_EQ(a.rays.refracted, b.rays.refracted);
     AovSet all;
     all.depth = all.normal = all.albedo = all.id = true;
-    const AovImages x = compute_aovs(scene, with_bvh, all), y = compute_aovs(scene, brute, all);
-    EXPECT_TRUE(x.depth == y.depth && x.normal == y.normal && x.albedo == y.albedo &&
-                x.id == y.id)
-        << "the AOVs differ";
+    const Image x = compute_aovs(scene, with_bvh, all), y = compute_aovs(scene, brute, all);
+    EXPECT_TRUE(x.channels == y.channels) << "the AOVs differ";
 }
 
 TEST(ReferenceBvh, BuiltInScenesRenderTheSameBitsAsBruteForce) {

@@ -132,7 +132,7 @@ TEST(ReferenceCamera, RowZeroIsTheTopOfTheImage) {
     Scene s = empty_scene(32, 32);
     add_sphere(s, {0, 2, 0}, 1.0f);  // above the view axis
     add_point_light(s, {0, 0, 10}, Rgb(1.0f));
-    const Image img = render_reference(s).image;
+    const RgbImage img = render_reference(s).image;
     EXPECT_GT(img.at(16, 6).r, 0.0f);   // near the top: the sphere
     EXPECT_EQ(img.at(16, 26).r, 0.0f);  // near the bottom: black background
 }
@@ -141,7 +141,7 @@ TEST(ReferenceCamera, LeftIsLeft) {
     Scene s = empty_scene(32, 32);
     add_sphere(s, {-2, 0, 0}, 1.0f);
     add_point_light(s, {0, 0, 10}, Rgb(1.0f));
-    const Image img = render_reference(s).image;
+    const RgbImage img = render_reference(s).image;
     EXPECT_GT(img.at(6, 16).r, 0.0f);
     EXPECT_EQ(img.at(26, 16).r, 0.0f);
 }
@@ -215,7 +215,7 @@ TEST(ReferenceCamera, FisheyeIsBlackOutsideTheImageCircle) {
     const float r = std::hypot(0.484375f, -0.015625f);
     EXPECT_NEAR(std::acos(-right.direction.z), r * std::numbers::pi_v<float> / 2, 1e-4f);
     EXPECT_GT(right.direction.x, 0.0f);
-    const Image img = render_reference(s).image;
+    const RgbImage img = render_reference(s).image;
     EXPECT_EQ(img.at(0, 0), Rgb(0.0f));
     EXPECT_EQ(img.at(32, 16), Rgb(1.0f));
 }
@@ -236,7 +236,7 @@ TEST(ReferenceShading, HeadOnDiffuseSphereCenterPixelClosedForm) {
     s.materials[0].material = diffuse(cd, kd);
     add_sphere(s, {0, 0, 0}, 1.0f);
     add_point_light(s, {0, 0, 10}, light);
-    const Image img = render_reference(s).image;
+    const RgbImage img = render_reference(s).image;
     // ambient.kd.Cd + kd.Cd.(N.L).L with N.L = 1
     const Rgb expected = ambient * (cd * kd) + light * (cd * kd);
     expect_rgb_near(img.at(16, 16), expected, 1e-6f);
@@ -311,7 +311,7 @@ int count_freckles(float epsilon_override) {
     s.camera.fov = 30.0f;
     add_sphere(s, {0.3f, 0.2f, 0}, 1.0f);
     add_point_light(s, {0, 0, 6}, Rgb(1.0f));
-    const Image img = render_reference(s).image;
+    const RgbImage img = render_reference(s).image;
     const ReferenceTracer tr(s);
     int freckles = 0;
     for (int j = 0; j < 64; ++j)

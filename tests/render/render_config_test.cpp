@@ -137,10 +137,10 @@ TEST(RenderConfig, ItsRenderOptionsRenderTheCropOfTheWholeImage) {
     c.resolve_isa();
     FrameRenderer whole(scene, c.path, c.isa, c.accel, c.threads);
     whole.prepare(0);
-    const Image full = whole.render(c.render_options()).image;
+    const RgbImage full = whole.render(c.render_options()).image;
     c.crop = PixelRect{3, 5, 20, 17};
     c.check_crop(32, 24);
-    const Image part = whole.render(c.render_options()).image;
+    const RgbImage part = whole.render(c.render_options()).image;
     ASSERT_EQ(part.width(), 17);
     ASSERT_EQ(part.height(), 12);
     for (int y = 0; y < 12; ++y)

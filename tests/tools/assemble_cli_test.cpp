@@ -12,7 +12,7 @@
 #include "render/aov.h"
 #include "render/batch/assemble.h"
 #include "render/batch/camera_matrices.h"
-#include "render/batch/result_exr.h"
+#include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
 #include "run_octray.h"
@@ -48,11 +48,11 @@ class AssembleCliTest : public ::testing::Test {
         ExrAttributes attributes;
         batch::add_camera_attributes(attributes, scene_);
         attributes.ints.emplace_back("octray:frame", 3);
-        ExrImage exr =
-            make_exr_image(render_packet(scene_, options),
-                           ExrWriteOptions{float32, ExrCompression::zip}, attributes);
+        const RenderResult result = render_packet(scene_, options);
+        Image exr = make_image(result.image, result.rect, result.full_width, result.full_height,
+                               ExrWriteOptions{float32, ExrCompression::zip}, attributes);
         append_aov_channels(exr, compute_aovs(scene_, options, AovSet{true, true, false, true}),
-                            float32 ? ExrPixelType::float32 : ExrPixelType::half);
+                            float32 ? PixelFormat::float32 : PixelFormat::half);
         write_exr(path(name), exr);
     }
 
@@ -77,14 +77,14 @@ TEST_F(AssembleCliTest, QuartersMakeTheFullRender) {
     EXPECT_NE(r.output.find("Z (float)"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("id (uint)"), std::string::npos) << r.output;
 
-    const ExrImage out = read_exr_image(path("out.exr"));
-    const ExrImage full = read_exr_image(path("full.exr"));
+    const Image out = read_exr_image(path("out.exr"));
+    const Image full = read_exr_image(path("full.exr"));
     EXPECT_EQ(out.data_window, (PixelRect{0, 0, 24, 14}));
     EXPECT_EQ(out.display_window, full.display_window);
     ASSERT_EQ(out.channels.size(), full.channels.size());
     for (std::size_t k = 0; k < out.channels.size(); ++k) {
         EXPECT_EQ(out.channels[k].name, full.channels[k].name);
-        EXPECT_EQ(out.channels[k].type, full.channels[k].type);
+        EXPECT_EQ(out.channels[k].format, full.channels[k].format);
         EXPECT_TRUE(out.channels[k].samples == full.channels[k].samples)
             << out.channels[k].name;
     }
@@ -191,10 +191,10 @@ TEST_F(AssembleCliTest, OutputFormatFollowsTheExtension) {
     EXPECT_EQ(read_exr_image(path("OUT.EXR")).data_window, (PixelRect{0, 0, 24, 14}));
     r = assemble({"a.exr", "b.exr", "-o", "out.png"});
     ASSERT_EQ(r.status, 0) << r.output;
-    const ChannelImage png = read_image(path("out.png"));
-    EXPECT_EQ(png.format, "PNG 8-bit");
-    EXPECT_EQ(png.width, 24);
-    EXPECT_EQ(png.height, 14);
+    const Image png = read_image(path("out.png"));
+    EXPECT_EQ(png.file_format, "PNG 8-bit");
+    EXPECT_EQ(png.width(), 24);
+    EXPECT_EQ(png.height(), 14);
 }
 
 }  // namespace

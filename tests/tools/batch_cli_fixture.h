@@ -90,9 +90,7 @@ class BatchCliTest : public ::testing::Test {
         return found;
     }
 
-    ChannelImage read(const std::string& name) const {
-        return read_image((dir_ / name).string());
-    }
+    Image read(const std::string& name) const { return read_image((dir_ / name).string()); }
 
     // Runs a shell command line in the test directory; returns its exit status.
     int shell(const std::string& command) const {
@@ -104,12 +102,11 @@ class BatchCliTest : public ::testing::Test {
     fs::path dir_;
 };
 
-inline void expect_same_pixels(const ChannelImage& a, const ChannelImage& b,
-                               const std::string& what) {
-    ASSERT_EQ(a.width, b.width) << what;
-    ASSERT_EQ(a.height, b.height) << what;
-    ASSERT_EQ(a.channel_names, b.channel_names) << what;
-    EXPECT_TRUE(a.planes == b.planes) << what << ": pixels differ";
+inline void expect_same_pixels(const Image& a, const Image& b, const std::string& what) {
+    ASSERT_EQ(a.width(), b.width()) << what;
+    ASSERT_EQ(a.height(), b.height()) << what;
+    ASSERT_EQ(a.channel_names(), b.channel_names()) << what;
+    EXPECT_TRUE(a.channels == b.channels) << what << ": pixels differ";
 }
 
 }  // namespace octray::testing

@@ -24,7 +24,7 @@ TEST_F(BatchCliTest, FrameRenderedAloneEqualsTheSameFrameOfTheSequence) {
     ASSERT_EQ(alone.status, 0) << alone.output;
     expect_same_pixels(read("out/shot.0003.exr"), read("alone.0003.exr"), "frame 3");
     // The animation moves things: frames differ.
-    EXPECT_FALSE(read("out/shot.0000.exr").planes == read("out/shot.0005.exr").planes);
+    EXPECT_FALSE(read("out/shot.0000.exr").channels == read("out/shot.0005.exr").channels);
 }
 
 TEST_F(BatchCliTest, FrameSpecsPickTheFramesInOrder) {

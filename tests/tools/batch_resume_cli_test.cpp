@@ -147,7 +147,7 @@ TEST_F(BatchCliTest, AnUnfinishedPassIsAClaimWhileItsOwnerLives) {
             const std::string name = "out/u." + std::to_string(f) + ".exr";
             EXPECT_TRUE(contains(r.output, "-> " + name + "  ")) << option << "\n" << r.output;
             EXPECT_FALSE(unfinished(dir_ / name)) << option << " " << name;
-            EXPECT_EQ(read(name).width, 40) << option << " " << name;
+            EXPECT_EQ(read(name).width(), 40) << option << " " << name;
         }
         write_unfinished_pass(dir_ / "out/u.1.exr",
                               std::string(host) + ":" + std::to_string(child) + ":12345");

@@ -322,11 +322,12 @@ TEST_F(CliTest, VerifyWritesTheDifferenceAndTheHeatmap) {
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_TRUE(contains(r.output, "wrote    d.exr (|scalar - simd|, float)")) << r.output;
     EXPECT_TRUE(contains(r.output, "wrote    h.png (error heatmap, linear")) << r.output;
-    const ChannelImage diff = read_image(path("d.exr"));
-    EXPECT_EQ(diff.width, 16);
-    EXPECT_EQ(diff.channel_names, (std::vector<std::string>{"R", "G", "B"}));
-    for (const float v : diff.planes) EXPECT_EQ(v, 0.0f);
-    EXPECT_EQ(read_image(path("h.png")).format, "PNG 8-bit");
+    const Image diff = read_image(path("d.exr"));
+    EXPECT_EQ(diff.width(), 16);
+    EXPECT_EQ(diff.channel_names(), (std::vector<std::string>{"R", "G", "B"}));
+    for (int c = 0; c < diff.channel_count(); ++c)
+        for (std::size_t i = 0; i < diff.pixel_count(); ++i) EXPECT_EQ(diff.plane(c)[i], 0.0f);
+    EXPECT_EQ(read_image(path("h.png")).file_format, "PNG 8-bit");
 
     const std::string bounce = std::string(OCTRAY_SOURCE_DIR) + "/scene/examples/bounce.json";
     const RunResult frames = octray({"verify", bounce, "--frames", "0,20", "--width", "16",

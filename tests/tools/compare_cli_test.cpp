@@ -32,10 +32,11 @@ class CompareCliTest : public testing::ScratchDirTest {
 
     // The reference: 8x8 RGB, a ramp; and a copy whose pixel (5, 3) is off in G by `delta`.
     void write_pair(float delta) {
-        ChannelImage a = make_image(8, 8, {"R", "G", "B"});
-        for (std::size_t i = 0; i < a.planes.size(); ++i)
-            a.planes[i] = static_cast<float>(i % 64) / 64.0f;
-        ChannelImage b = a;
+        Image a = make_image(8, 8, {"R", "G", "B"});
+        for (int c = 0; c < a.channel_count(); ++c)
+            for (std::size_t i = 0; i < a.pixel_count(); ++i)
+                a.plane(c)[i] = static_cast<float>(i % 64) / 64.0f;
+        Image b = a;
         b.at(1, 5, 3) += delta;
         write_test_exr(path("a.exr"), a);
         write_test_exr(path("b.exr"), b);
@@ -119,7 +120,7 @@ TEST_F(CompareCliTest, FileErrorsExit4WithOneLineReasons) {
 }
 
 TEST_F(CompareCliTest, TruncatedExrExits4WithAClearMessage) {
-    ChannelImage big = make_image(64, 64, {"R", "G", "B"}, 0.25f);
+    Image big = make_image(64, 64, {"R", "G", "B"}, 0.25f);
     write_test_exr(path("ref.exr"), big);
     write_test_exr(path("cut.exr"), big, Imf::FLOAT, Imf::NO_COMPRESSION);
     testing::truncate_file(path("cut.exr"), testing::fs::file_size(path("cut.exr")) / 2);
@@ -134,8 +135,8 @@ TEST_F(CompareCliTest, TruncatedExrExits4WithAClearMessage) {
 }
 
 TEST_F(CompareCliTest, NanAndInfAreReportedNotCrashedOn) {
-    ChannelImage a = make_image(4, 4, {"R", "G", "B"}, 0.5f);
-    ChannelImage b = a;
+    Image a = make_image(4, 4, {"R", "G", "B"}, 0.5f);
+    Image b = a;
     a.at(0, 1, 2) = std::numeric_limits<float>::quiet_NaN();
     b.at(2, 3, 3) = std::numeric_limits<float>::infinity();
     write_test_exr(path("a.exr"), a);
@@ -155,13 +156,13 @@ TEST_F(CompareCliTest, DiffAndHeatmapFilesAreWritten) {
     write_pair(0.125f);
     const RunResult r = compare({"a.exr", "b.exr", "--diff", "d.exr", "--heatmap", "h.png"});
     EXPECT_EQ(r.status, 2) << r.output;
-    const ChannelImage diff = read_image(path("d.exr"));
-    EXPECT_EQ(diff.channel_names, (std::vector<std::string>{"R", "G", "B"}));
+    const Image diff = read_image(path("d.exr"));
+    EXPECT_EQ(diff.channel_names(), (std::vector<std::string>{"R", "G", "B"}));
     EXPECT_EQ(diff.at(1, 5, 3), 0.125f);
     EXPECT_EQ(diff.at(1, 4, 3), 0.0f);
-    const ChannelImage heatmap = read_image(path("h.png"));
-    EXPECT_EQ(heatmap.format, "PNG 8-bit");
-    EXPECT_GE(heatmap.width, 256);
+    const Image heatmap = read_image(path("h.png"));
+    EXPECT_EQ(heatmap.file_format, "PNG 8-bit");
+    EXPECT_GE(heatmap.width(), 256);
 }
 
 TEST_F(CompareCliTest, UnwritableOutputExits4) {
@@ -251,7 +252,7 @@ TEST_F(CompareCliTest, InfinityIsAValidThreshold) {
 // +inf matches itself with --fail 0. Different infinities, or one against a number, fail.
 TEST_F(CompareCliTest, EqualInfinitiesAreEqual) {
     constexpr float inf = std::numeric_limits<float>::infinity();
-    ChannelImage z = make_image(4, 4, {"Z"}, 2.0f);
+    Image z = make_image(4, 4, {"Z"}, 2.0f);
     z.at(0, 1, 1) = inf;
     z.at(0, 3, 2) = -inf;
     write_test_exr(path("z.exr"), z);
@@ -259,17 +260,17 @@ TEST_F(CompareCliTest, EqualInfinitiesAreEqual) {
     RunResult r = compare({"z.exr", "z2.exr", "--fail", "0", "--diff", "d.exr"});
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_EQ(last_line(r.output), "PASS: images are identical");
-    const ChannelImage diff = read_image(path("d.exr"));
+    const Image diff = read_image(path("d.exr"));
     EXPECT_EQ(diff.at(0, 1, 1), 0.0f);
     EXPECT_EQ(diff.at(0, 3, 2), 0.0f);
 
-    ChannelImage w = z;
+    Image w = z;
     w.at(0, 1, 1) = -inf;
     write_test_exr(path("w.exr"), w);
     r = compare({"z.exr", "w.exr", "--fail", "0"});
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(last_line(r.output).find("(1 with NaN or Inf)"), std::string::npos) << r.output;
-    ChannelImage f = z;
+    Image f = z;
     f.at(0, 1, 1) = 1e30f;
     write_test_exr(path("f.exr"), f);
     EXPECT_EQ(compare({"z.exr", "f.exr"}).status, 2);
@@ -289,7 +290,7 @@ TEST_F(CompareCliTest, DiffOutputMustBeAnExr) {
     }
     const RunResult r = compare({"a.exr", "b.exr", "--diff", "D.EXR"});
     EXPECT_EQ(r.status, 0) << r.output;
-    EXPECT_EQ(read_image(path("D.EXR")).channel_names,
+    EXPECT_EQ(read_image(path("D.EXR")).channel_names(),
               (std::vector<std::string>{"R", "G", "B"}));
 }
 
@@ -376,9 +377,10 @@ TEST_F(CompareCliTest, BadHeatmapScalesAreUsageErrors) {
 // against float (the same image differs by half's rounding) and a display-referred PNG
 // against a linear OpenEXR.
 TEST_F(CompareCliTest, TheReportNotesFormatsThatDiffer) {
-    ChannelImage image = make_image(8, 8, {"R", "G", "B"});
-    for (std::size_t i = 0; i < image.planes.size(); ++i)
-        image.planes[i] = 0.1f + 0.731f * static_cast<float>(i % 64) / 64.0f;
+    Image image = make_image(8, 8, {"R", "G", "B"});
+    for (int c = 0; c < image.channel_count(); ++c)
+        for (std::size_t i = 0; i < image.pixel_count(); ++i)
+            image.plane(c)[i] = 0.1f + 0.731f * static_cast<float>(i % 64) / 64.0f;
     write_test_exr(path("half.exr"), image, Imf::HALF);
     write_test_exr(path("float.exr"), image, Imf::FLOAT);
     RunResult r = compare({"half.exr", "float.exr"});
@@ -429,9 +431,10 @@ TEST_F(CompareCliTest, RelativeThresholdsAndAllowedFailuresAsIdiffs) {
               "PASS: max error 0.125; 1 of 64 pixels (1.562%) over 1e-06, within the 0% + 1 "
               "pixel allowed");
     // Two failing pixels are one too many.
-    ChannelImage b = make_image(8, 8, {"R", "G", "B"});
-    for (std::size_t i = 0; i < b.planes.size(); ++i)
-        b.planes[i] = static_cast<float>(i % 64) / 64.0f;
+    Image b = make_image(8, 8, {"R", "G", "B"});
+    for (int c = 0; c < b.channel_count(); ++c)
+        for (std::size_t i = 0; i < b.pixel_count(); ++i)
+            b.plane(c)[i] = static_cast<float>(i % 64) / 64.0f;
     b.at(0, 1, 1) += 0.5f;
     b.at(0, 2, 2) += 0.5f;
     write_test_exr(path("b2.exr"), b);

@@ -25,13 +25,13 @@
 namespace {
 
 using nlohmann::json;
-using octray::ChannelImage;
+using octray::Image;
 using octray::view::CompareView;
 using octray::view::ServerOptions;
 using octray::view::ViewServer;
 
-ChannelImage gradient(int width, int height, float offset) {
-    ChannelImage image(width, height, {"R", "G", "B"});
+Image gradient(int width, int height, float offset) {
+    Image image(width, height, {"R", "G", "B"});
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             image.at(0, x, y) = 0.01f * static_cast<float>(x) + offset;
@@ -62,8 +62,8 @@ class CompareViewTest : public ::testing::Test {
         std::filesystem::create_directories(dir_);
         a_ = (dir_ / "a.exr").string();
         b_ = (dir_ / "b.exr").string();
-        octray::write_channel_exr(a_, gradient(40, 24, 0.0f));
-        octray::write_channel_exr(b_, gradient(40, 24, 0.125f));
+        octray::write_exr(a_, gradient(40, 24, 0.0f));
+        octray::write_exr(b_, gradient(40, 24, 0.125f));
         view_ = octray::view::load_compare_view(a_, b_);
         server_ = std::make_unique<ViewServer>(view_, ServerOptions{});
         server_->start();
@@ -93,17 +93,17 @@ TEST_F(CompareViewTest, ThePicturesAreTheFilesPixels) {
         const auto result = get(std::string("/api/image.f32?picture=") + name);
         ASSERT_TRUE(result);
         ASSERT_EQ(result->status, 200);
-        const ChannelImage file = octray::read_image(path);
+        const Image file = octray::read_image(path);
         ASSERT_EQ(result->body.size(), file.pixel_count() * 3 * sizeof(float));
         std::vector<float> served(file.pixel_count() * 3);
         std::memcpy(served.data(), result->body.data(), result->body.size());
-        for (int y = 0; y < file.height; ++y) {
-            for (int x = 0; x < file.width; ++x) {
+        for (int y = 0; y < file.height(); ++y) {
+            for (int x = 0; x < file.width(); ++x) {
                 for (int c = 0; c < 3; ++c) {
-                    const std::size_t i = (static_cast<std::size_t>(y) * file.width + x) * 3;
-                    ASSERT_EQ(served[i + c], file.at(file.find_channel(c == 0   ? "R"
-                                                                       : c == 1 ? "G"
-                                                                                : "B"),
+                    const std::size_t i = (static_cast<std::size_t>(y) * file.width() + x) * 3;
+                    ASSERT_EQ(served[i + c], file.at(file.channel_index(c == 0   ? "R"
+                                                                        : c == 1 ? "G"
+                                                                                 : "B"),
                                                      x, y))
                         << name << " " << x << "," << y << " c" << c;
                 }
@@ -142,9 +142,7 @@ TEST_F(CompareViewTest, TheHeatmapIsComparesAndTheOthersArePngs) {
     const auto heatmap = get("/api/image.png?picture=heatmap");
     ASSERT_TRUE(heatmap);
     ASSERT_EQ(heatmap->status, 200);
-    EXPECT_EQ(heatmap->body,
-              octray::encode_png_rgb8(expected.image.width, expected.image.height,
-                                      expected.image.rgb));
+    EXPECT_EQ(heatmap->body, octray::encode_png(expected.image));
     for (const char* name : {"a", "b", "diff"}) {
         const auto png = get(std::string("/api/image.png?exposure=1&picture=") + name);
         ASSERT_TRUE(png);
@@ -194,7 +192,7 @@ TEST(CompareViewLayers, EachAovLayerIsAPicture) {
                      ("octray_compare_layers_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const auto with_aovs = [](float offset) {
-        ChannelImage image(8, 4, {"R", "G", "B", "N.X", "N.Y", "N.Z", "id"});
+        Image image(8, 4, {"R", "G", "B", "N.X", "N.Y", "N.Z", "id"});
         for (int c = 0; c < image.channel_count(); ++c)
             for (int y = 0; y < 4; ++y)
                 for (int x = 0; x < 8; ++x)
@@ -204,8 +202,8 @@ TEST(CompareViewLayers, EachAovLayerIsAPicture) {
         return image;
     };
     const std::string a = (dir / "a.exr").string(), b = (dir / "b.exr").string();
-    octray::write_channel_exr(a, with_aovs(0.0f));
-    octray::write_channel_exr(b, with_aovs(0.25f));
+    octray::write_exr(a, with_aovs(0.0f));
+    octray::write_exr(b, with_aovs(0.25f));
     const CompareView view = octray::view::load_compare_view(a, b);
     EXPECT_EQ(view.layers, (std::vector<std::string>{"", "N", "id"}));
     ViewServer server(view, ServerOptions{});
@@ -219,14 +217,14 @@ TEST(CompareViewLayers, EachAovLayerIsAPicture) {
     ASSERT_TRUE(status);
     EXPECT_EQ(json::parse(status->body)["layers"], json::array({"", "N", "id"}));
 
-    const ChannelImage file = octray::read_image(a);
+    const Image file = octray::read_image(a);
     const auto normal = get("/api/image.f32?picture=a&layer=N");
     ASSERT_TRUE(normal);
     ASSERT_EQ(normal->status, 200);
     std::vector<float> served(file.pixel_count() * 3);
     ASSERT_EQ(normal->body.size(), served.size() * sizeof(float));
     std::memcpy(served.data(), normal->body.data(), normal->body.size());
-    const int nx = file.find_channel("N.X"), id = file.find_channel("id");
+    const int nx = file.channel_index("N.X"), id = file.channel_index("id");
     for (int c = 0; c < 3; ++c) EXPECT_EQ(served[c], file.at(nx + c, 0, 0)) << c;
     EXPECT_EQ(served[3 * 13 + 1], file.at(nx + 1, 5, 1));
 
@@ -258,8 +256,8 @@ TEST(CompareViewLoad, FailsAsCompareFails) {
                      ("octray_compare_view_load_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const std::string a = (dir / "a.exr").string(), small = (dir / "small.exr").string();
-    octray::write_channel_exr(a, gradient(8, 8, 0.0f));
-    octray::write_channel_exr(small, gradient(8, 4, 0.0f));
+    octray::write_exr(a, gradient(8, 8, 0.0f));
+    octray::write_exr(small, gradient(8, 4, 0.0f));
     EXPECT_THROW(octray::view::load_compare_view(a, small), octray::ImageMismatch);
     EXPECT_THROW(octray::view::load_compare_view(a, (dir / "missing.exr").string()),
                  octray::IoError);

@@ -15,12 +15,12 @@
 namespace {
 
 using octray::encode_png_rgb8;
-using octray::Image;
 using octray::Rgb;
+using octray::RgbImage;
 using octray::view::tone_map_srgb8;
 
 TEST(ViewToneMap, ScalesByTwoToTheExposureThenEncodesSrgb) {
-    Image image(4, 1);
+    RgbImage image(4, 1);
     image.at(0, 0) = Rgb{0.0f, 0.25f, 0.5f};
     image.at(1, 0) = Rgb{1.0f, 2.0f, -1.0f};
     image.at(2, 0) = Rgb{std::numeric_limits<float>::quiet_NaN(), 0.001f, 0.2f};

@@ -22,7 +22,6 @@
 #include <string>
 #include <thread>
 
-#include "render/batch/result_exr.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "render/packet_renderer.h"
@@ -43,7 +42,7 @@ using octray::view::ViewSettings;
 using octray::view::testing::small_whitted;
 
 // An image's raw bytes, as /api/image.f32 returns them.
-std::string bytes_of(const octray::Image& image) {
+std::string bytes_of(const octray::RgbImage& image) {
     return std::string(reinterpret_cast<const char*>(image.data()),
                        image.pixel_count() * sizeof(octray::Rgb));
 }
