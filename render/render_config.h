@@ -17,7 +17,7 @@
 #include "render/accel.h"
 #include "render/aov.h"
 #include "render/memory_estimate.h"
-#include "render/types.h"
+#include "render/render_options.h"
 #include "scene/scene.h"
 
 namespace octray {

@@ -18,7 +18,7 @@
 #include "kernels/isa.h"
 #include "render/packet_renderer.h"
 #include "render/render_config.h"
-#include "render/types.h"
+#include "render/render_options.h"
 #include "scene/scene.h"
 
 namespace octray::view {

@@ -4,7 +4,7 @@
 
 #include "kernels/dispatch.h"
 #include "render/render_config.h"
-#include "render/types.h"
+#include "render/render_options.h"
 #include "scene/max_depth.h"
 #include "view/http_error.h"
 #include "view/request_json.h"
