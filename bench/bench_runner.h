@@ -17,7 +17,7 @@
 #include "kernels/isa.h"
 #include "render/accel.h"
 #include "render/prepare/scene_view.h"
-#include "render/types.h"
+#include "render/render_options.h"
 
 namespace octray::bench {
 
@@ -57,7 +57,8 @@ struct BenchOptions {
     std::vector<TileSize> tiles{TileSize{16, 16}};
     std::vector<PixelOrder> orders{PixelOrder::tiled};
     std::vector<Isa> isas{Isa::automatic};
-    std::vector<RenderPath> paths{RenderPath::simd};  // which renderer (render/types.h)
+    std::vector<RenderPath> paths{
+        RenderPath::simd};  // which renderer (render/render_options.h)
     // The SIMD path's sphere acceleration (auto: a BVH from kBvhAutoMinSpheres spheres on)
     // and, with a BVH, the live lanes below which a packet goes on ray by ray.
     std::vector<Accel> accels{Accel::automatic};

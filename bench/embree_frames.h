@@ -12,7 +12,7 @@
 #include "bench/embree_baseline.h"
 #include "kernels/isa.h"
 #include "kernels/kernel_table.h"
-#include "render/types.h"
+#include "render/render_result.h"
 #include "scene/compile.h"
 
 namespace octray::bench {

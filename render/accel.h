@@ -2,7 +2,7 @@
 // Which acceleration structure the SIMD render path uses for spheres (`--accel`), and where
 // `auto` is resolved: the packet renderer (render/packet_renderer.cpp), the memory estimate
 // (render/batch/memory_estimate.cpp), `octray bench` and `octray info` ask accel_uses_bvh().
-// Plain declarations: the scalar reference sees Accel through render/types.h but never
+// Plain declarations: the scalar reference sees Accel through render/render_options.h but never
 // calls these (it links no kernels and no BVH).
 
 #include <cstdint>

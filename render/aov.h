@@ -13,7 +13,7 @@
 
 #include "core/vec3.h"
 #include "render/image/image_io.h"
-#include "render/types.h"
+#include "render/render_result.h"
 #include "scene/scene.h"
 
 namespace octray {

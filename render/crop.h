@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "render/types.h"
+#include "render/render_options.h"
 
 namespace octray {
 

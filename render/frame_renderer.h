@@ -14,7 +14,7 @@
 #include "render/accel.h"
 #include "render/aov.h"
 #include "render/packet_renderer.h"
-#include "render/types.h"
+#include "render/render_result.h"
 #include "scene/scene.h"
 
 namespace octray {

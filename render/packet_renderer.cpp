@@ -415,8 +415,8 @@ class PacketTracer {
     }
 
     // The closest hit of each pixel's sample-0 camera ray (the AOVs' hits: FirstHits in
-    // render/types.h), into `out` at the tile's place; a ray the camera drops (a fisheye
-    // pixel outside its circle) and a miss leave object -1 and t = +inf.
+    // render/render_result.h), into `out` at the tile's place; a ray the camera drops (a
+    // fisheye pixel outside its circle) and a miss leave object -1 and t = +inf.
     void first_hits(const Tile& tile, TileScratch& s, FirstHits& out) const {
         pixel_order_for(tile, s);
         const std::size_t pixels = static_cast<std::size_t>(tile.width) * tile.height;

@@ -14,8 +14,8 @@
 #include "kernels/kernel_table.h"
 #include "render/accel.h"
 #include "render/prepare/bvh_build.h"
+#include "render/render_result.h"
 #include "render/tile_layout.h"
-#include "render/types.h"
 #include "scene/compile.h"
 #include "scene/scene.h"
 

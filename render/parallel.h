@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "core/thread_check.h"
-#include "render/types.h"
+#include "render/render_options.h"
 
 namespace octray {
 

@@ -13,7 +13,7 @@
 
 #include "core/ray.h"
 #include "render/reference_bvh.h"
-#include "render/types.h"
+#include "render/render_result.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
 
@@ -30,8 +30,8 @@ struct SurfaceHit {
 // are always tested one by one), or every object in file order. Both give the same hits.
 enum class ReferenceAccel { bvh, brute_force };
 
-// The reference's choice for a render's `--accel` (render/types.h): none is brute force,
-// auto and bvh its BVH.
+// The reference's choice for a render's `--accel` (render/render_options.h): none is brute
+// force, auto and bvh its BVH.
 constexpr ReferenceAccel reference_accel(Accel accel) {
     return accel == Accel::none ? ReferenceAccel::brute_force : ReferenceAccel::bvh;
 }
@@ -97,8 +97,8 @@ class ReferenceTracer {
 };
 
 // Renders the whole image, or options.crop of it, and options.samples of each pixel (see
-// render/types.h); tiles may run in parallel (TBB), one ray at a time per thread. The image
-// is bit-identical for any thread count, tile size, crop and options.accel.
+// render/render_options.h); tiles may run in parallel (TBB), one ray at a time per thread. The
+// image is bit-identical for any thread count, tile size, crop and options.accel.
 RenderResult render_reference(const Scene& scene, const RenderOptions& options = {});
 
 // Renders the pixels of each of `blocks` into `target` at their places, as

@@ -16,7 +16,7 @@
 #include "kernels/isa.h"
 #include "render/accel.h"
 #include "render/aov.h"
-#include "render/types.h"
+#include "render/render_options.h"
 #include "scene/scene.h"
 
 namespace octray {

@@ -1,10 +1,13 @@
 #pragma once
-// The largest render.max_depth (reflection/refraction bounces): one constant for the
-// built-in specs' max_depth=D, `octray render --max-depth` (its check and its help text)
-// and, by the same value, scene files' render.max_depth (scene/README.md).
+// The largest render.max_depth (reflection/refraction bounces): the scene format's limit
+// (scene/json_rules.h, which both JSON readers apply), under the name the built-in specs'
+// max_depth=D, `octray render --max-depth` (its check and its help text) and the viewer's
+// switch use.
+
+#include "scene/json_rules.h"
 
 namespace octray {
 
-inline constexpr int kMaxDepthLimit = 64;
+inline constexpr int kMaxDepthLimit = scene_json::kMaxDepthLimit;
 
 }  // namespace octray

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/pixel_rect.h"
-#include "render/types.h"
+#include "render/render_options.h"
 
 namespace CLI {
 class App;

@@ -69,12 +69,16 @@ Image to_channels(const RgbImage& image) {
     return out;
 }
 
-// Renders one frame with both paths and reports; true when they agree. `diff` and
-// `heatmap` name the pictures of this frame, or are empty.
-bool verify_frame(const VerifyArguments& args, const Scene& scene, const RenderConfig& config,
-                  const std::string& diff, const std::string& heatmap) {
+// Renders frame `frame` of the posed `scene` with both paths and reports; true when they
+// agree. The frame number is the samples' hash counter, as `octray render` sets it, so the
+// jitter checked is the frame's own. `diff` and `heatmap` name the pictures of this frame,
+// or are empty.
+bool verify_frame(const VerifyArguments& args, const Scene& scene, int frame,
+                  const RenderConfig& config, const std::string& diff,
+                  const std::string& heatmap) {
     const Isa isa = config.isa;
-    const RenderOptions options = config.render_options();
+    RenderOptions options = config.render_options();
+    options.frame = static_cast<std::uint32_t>(frame);
     const RenderResult ref = render_reference(scene, options);
     const RenderResult simd = render_packet(scene, options, isa);
     std::printf("scalar   %.3f s, %llu rays\n", ref.seconds,
@@ -182,7 +186,7 @@ void run_verify(const VerifyArguments& args) {
         const std::string heatmap =
             args.heatmap.empty() ? "" : frame_file(args.heatmap, frame, several);
         failed += verify_frame(args, args.frames.empty() ? scene : scene_at_frame(scene, frame),
-                               config, diff, heatmap)
+                               frame, config, diff, heatmap)
                       ? 0
                       : 1;
     }

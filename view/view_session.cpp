@@ -84,10 +84,8 @@ Scene ViewSession::scene() const {
 
 RenderSwitches ViewSession::switches() const {
     std::lock_guard lock(mutex_);
-    return RenderSwitches{settings_.render.threads, scene_.image.spp,
-                          scene_.render.max_depth,  settings_.order,
-                          settings_.render.path,    settings_.render.isa,
-                          settings_.frame};
+    return RenderSwitches{settings_.render, scene_.image.spp, scene_.render.max_depth,
+                          settings_.order, settings_.frame};
 }
 
 RenderOptions ViewSession::render_options(int width) const {
@@ -121,7 +119,8 @@ std::uint64_t ViewSession::reconfigure(const RenderSwitches& switches) {
         throw std::out_of_range("frame " + std::to_string(switches.frame) +
                                 " is outside the animation's frames 0 to " +
                                 std::to_string(frame_count_ - 1));
-    if (switches.path == RenderPath::simd) resolve_isa(switches.isa);  // throws: no change
+    if (switches.render.path == RenderPath::simd)
+        resolve_isa(switches.render.isa);  // throws: no change
     // Only this function changes scene_, and only from here on: reading it needs no lock.
     Scene next = animated_
                      ? posed_scene(*animated_, switches.frame, switches.spp, switches.max_depth)
@@ -143,10 +142,8 @@ std::uint64_t ViewSession::reconfigure(const RenderSwitches& switches) {
         std::lock_guard lock(mutex_);
         if (frame_camera) camera_ = next.camera;
         scene_ = std::move(next);
-        settings_.render.threads = switches.threads;
+        settings_.render = switches.render;
         settings_.order = switches.order;
-        settings_.render.path = switches.path;
-        settings_.render.isa = switches.isa;
         settings_.frame = switches.frame;
         restart_ = false;
         cancel_ = false;

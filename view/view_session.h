@@ -18,7 +18,7 @@
 #include "kernels/isa.h"
 #include "render/packet_renderer.h"
 #include "render/render_config.h"
-#include "render/types.h"
+#include "render/render_options.h"
 #include "scene/scene.h"
 
 namespace octray::view {
@@ -46,12 +46,12 @@ struct ViewSettings {
 
 // What the page may switch while the viewer runs (POST /api/settings).
 struct RenderSwitches {
-    int threads = 0;
+    // The render's description, as `octray render` takes it (render/render_config.h): the
+    // switches change its path, ISA and threads; the rest stays the session's.
+    RenderConfig render;
     int spp = 1;
     int max_depth = 1;
     PixelOrder order = PixelOrder::tiled;
-    RenderPath path = RenderPath::simd;
-    Isa isa = Isa::automatic;
     int frame = 0;  // the animation's frame (0 for a still scene)
 };
 

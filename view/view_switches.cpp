@@ -4,7 +4,7 @@
 
 #include "kernels/dispatch.h"
 #include "render/render_config.h"
-#include "render/types.h"
+#include "render/render_options.h"
 #include "scene/max_depth.h"
 #include "view/http_error.h"
 #include "view/request_json.h"
@@ -62,7 +62,7 @@ RenderSwitches parse_switches(const std::string& body, RenderSwitches switches,
         throw BadRequest(400, "settings: expected a JSON object such as {\"spp\": 16}");
     for (const auto& [key, value] : request.items()) {
         if (key == "threads") {
-            switches.threads = integer(value, key, 0, kMaxRenderThreads);
+            switches.render.threads = integer(value, key, 0, kMaxRenderThreads);
         } else if (key == "spp") {
             switches.spp = integer(value, key, 1, kMaxSamplesPerPixel);
         } else if (key == "max_depth") {
@@ -74,16 +74,14 @@ RenderSwitches parse_switches(const std::string& body, RenderSwitches switches,
                 throw BadRequest(400, "settings.order: expected tiled, rows or frameless");
             switches.order = *order;
         } else if (key == "path") {
-            const auto path =
-                value.is_string() ? parse_render_path(value.get<std::string>()) : std::nullopt;
-            if (!path)
-                throw BadRequest(400,
-                                 "settings.path: expected simd (8-ray packets) or scalar (the "
-                                 "reference renderer), found " +
-                                     value.dump());
-            switches.path = *path;
+            try {  // the command line's parser and message (RenderConfig::set_path)
+                switches.render.set_path(value.is_string() ? value.get<std::string>()
+                                                           : value.dump());
+            } catch (const ConfigError& e) {
+                throw BadRequest(400, "settings.path: " + e.detail());
+            }
         } else if (key == "isa") {
-            switches.isa = isa_from(value, limits);
+            switches.render.isa = isa_from(value, limits);
         } else if (key == "frame") {
             if (limits.frames <= 1 && value.is_number_integer() && value.get<long long>() != 0)
                 throw BadRequest(400,
@@ -107,12 +105,12 @@ std::string path_label(RenderPath path, Isa isa) {
 }
 
 json switches_json(const RenderSwitches& switches) {
-    return json{{"threads", switches.threads},
+    return json{{"threads", switches.render.threads},
                 {"spp", switches.spp},
                 {"max_depth", switches.max_depth},
                 {"order", to_string(switches.order)},
-                {"path", render_path_name(switches.path)},
-                {"isa", isa_name(switches.isa)},
+                {"path", render_path_name(switches.render.path)},
+                {"isa", isa_name(switches.render.isa)},
                 {"frame", switches.frame}};
 }
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "kernels/isa.h"
-#include "render/types.h"
+#include "render/render_options.h"
 #include "view/view_session.h"
 
 namespace octray::view {

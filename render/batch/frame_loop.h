@@ -14,7 +14,7 @@
 #include "render/batch/plan.h"
 #include "render/image/image_io.h"
 #include "render/render_config.h"
-#include "render/types.h"
+#include "render/render_result.h"
 
 namespace octray::batch {
 

@@ -12,7 +12,7 @@
 #include <functional>
 #include <vector>
 
-#include "render/types.h"
+#include "render/render_result.h"
 
 namespace octray::batch {
 

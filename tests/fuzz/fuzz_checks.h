@@ -231,7 +231,8 @@ inline void check_image_file(const std::string& path) {
     // Touch every value (ASan sees a short plane); PNG samples lie in [0, 1].
     const bool png = image.file_format.rfind("PNG", 0) == 0;
     for (const ImageChannel& c : image.channels)
-        for (const float v : std::vector<float>(c.floats(), c.floats() + c.size())) {
+        for (std::size_t k = 0; k < c.size(); ++k) {
+            const float v = c.floats()[k];
             if (png && !(v >= 0.0f && v <= 1.0f)) {
                 throw InvariantBroken("PNG samples lie in [0, 1]", image.file_format);
             }

@@ -55,11 +55,11 @@ TEST(ViewSwitches, PathAndIsaAreParsedAndChecked) {
     const SwitchLimits limits{{Isa::sse2, Isa::sse4_1}};
     const RenderSwitches s =
         parse_switches(R"({"path": "scalar", "isa": "sse4.1", "spp": 3})", {}, limits);
-    EXPECT_EQ(s.path, RenderPath::scalar);
-    EXPECT_EQ(s.isa, Isa::sse4_1);
+    EXPECT_EQ(s.render.path, RenderPath::scalar);
+    EXPECT_EQ(s.render.isa, Isa::sse4_1);
     EXPECT_EQ(s.spp, 3);
-    EXPECT_EQ(parse_switches(R"({"isa": "auto"})", s, limits).isa, Isa::automatic);
-    EXPECT_EQ(parse_switches("{}", s, limits).path, RenderPath::scalar)
+    EXPECT_EQ(parse_switches(R"({"isa": "auto"})", s, limits).render.isa, Isa::automatic);
+    EXPECT_EQ(parse_switches("{}", s, limits).render.path, RenderPath::scalar)
         << "an absent key keeps its value";
 
     // A CPU without AVX2 (made up here: the limits say what the CPU runs).
@@ -71,11 +71,27 @@ TEST(ViewSwitches, PathAndIsaAreParsedAndChecked) {
     EXPECT_EQ(refusal(R"({"isa": "neon"})", limits).second,
               "settings.isa: expected one of auto, sse2, sse4.1, found \"neon\"");
     EXPECT_EQ(refusal(R"({"path": "gpu"})", limits).second,
-              "settings.path: expected simd (8-ray packets) or scalar (the reference "
-              "renderer), found \"gpu\"");
+              "settings.path: expected simd or scalar, not \"gpu\"");
     for (const char* body :
          {R"({"isa": 2})", R"({"path": null})", R"({"isa": "AVX2"})", R"({"fps": 3})"})
         EXPECT_EQ(refusal(body, limits).first, 400) << body;
+}
+
+// The switches carry the render's one description (RenderConfig): what they do not name
+// stays as the session's render has it.
+TEST(ViewSwitches, TheRestOfTheRenderDescriptionIsKept) {
+    const SwitchLimits limits{{Isa::sse2}, 1};
+    RenderSwitches current;
+    current.render.accel = octray::Accel::none;
+    current.render.tile = octray::TileSize{8, 4};
+    current.render.threads = 3;
+    const RenderSwitches s = parse_switches(R"({"path": "scalar"})", current, limits);
+    EXPECT_EQ(s.render.path, RenderPath::scalar);
+    EXPECT_EQ(s.render.accel, octray::Accel::none);
+    EXPECT_EQ(s.render.tile.width, 8);
+    EXPECT_EQ(s.render.tile.height, 4);
+    EXPECT_EQ(s.render.threads, 3);
+    EXPECT_EQ(parse_switches(R"({"threads": 1})", s, limits).render.threads, 1);
 }
 
 // Issue 38: one JSON rule everywhere. A duplicate key (which nlohmann would let the last

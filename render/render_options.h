@@ -1,5 +1,7 @@
 #pragma once
-// What both render paths take and give back.
+// What a render is asked: the path (RenderPath), the limits, the sample range and the
+// options both render paths take (RenderOptions), the ray counts they keep, and the
+// exception a cancelled render ends with. What it gives back: render/render_result.h.
 
 #include <atomic>
 #include <cstddef>
@@ -100,39 +102,6 @@ struct RenderOptions {
 class RenderCancelled : public std::runtime_error {
   public:
     RenderCancelled() : std::runtime_error("render cancelled") {}
-};
-
-// The closest hit of each pixel's sample-0 camera ray over `rect`, row by row (top row
-// first): the first hits the AOVs read, traced by either path. object is the hit's
-// Scene::objects index, or -1 (t = +inf) for a miss or a camera sample with no ray (a
-// fisheye pixel outside its image circle).
-struct FirstHits {
-    PixelRect rect;
-    std::vector<float> t;
-    std::vector<std::int32_t> object;
-};
-
-struct RenderResult {
-    RgbImage image;  // the pixels of `rect` (crop-sized); (0, 0) is pixel (rect.x0, rect.y0)
-    // Which pixels of the full_width x full_height image `image` holds: the crop, or the
-    // whole image. An EXR writer makes `rect` the data window and the full image the
-    // display window (render/image/image_io.h, make_image).
-    PixelRect rect;
-    int full_width = 0;
-    int full_height = 0;
-    // With RenderOptions::samples: the per-pixel sums of samples [0, samples->end), to pass
-    // on as the next pass's sample_sums. Empty otherwise.
-    RgbImage sample_sums;
-    RayCounts rays;
-    double seconds = 0.0;  // wall-clock time of the render itself
-    // The parts of `seconds` spent compiling the scene and building its BVH (0 where the
-    // render did neither: a precompiled scene, no BVH; summed over progressive passes).
-    double compile_seconds = 0.0;
-    double bvh_seconds = 0.0;
-    // The SIMD path: the largest tile scratch (bytes) of a thread that rendered tiles, after
-    // the render. A thread keeps its scratch from render to render and it never shrinks,
-    // so this is that thread's high-water mark so far. 0 for the scalar reference.
-    std::uint64_t scratch_bytes = 0;
 };
 
 }  // namespace octray
