@@ -23,6 +23,7 @@
 #include "kernels/dispatch.h"
 #include "render/batch/digest.h"
 #include "render/batch/frame_loop.h"
+#include "render/batch/memory_estimate.h"
 #include "render/batch/output_paths.h"
 #include "render/batch/plan.h"
 #include "render/batch/spec.h"
@@ -30,7 +31,6 @@
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
-#include "render/memory_estimate.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "render/render_config.h"
@@ -749,14 +749,15 @@ FrameFilesResult render_frames(const Scene& scene, const RenderOptions& options,
         }
         // A frame is written while the next renders, as `octray render` does, when the
         // memory estimate of two frames in flight fits this machine's memory.
-        RenderMemoryParams memory = config.memory_params();
+        batch::RenderMemoryParams memory = batch::memory_params(config);
         memory.float32_output = files.exr.float32;
         memory.png_preview = !files.png.empty();
         memory.write_behind = true;
-        const std::uint64_t machine = machine_memory_bytes();
+        const std::uint64_t machine = batch::machine_memory_bytes();
         settings.write_behind =
             jobs.size() > 1 &&
-            (machine == 0 || estimate_render_memory(scenes[0].scene, memory).total <= machine);
+            (machine == 0 ||
+             batch::estimate_render_memory(scenes[0].scene, memory).total <= machine);
         batch::prepare_output_directories(jobs);
 
         FrameFilesObserver observer(scenes, jobs);

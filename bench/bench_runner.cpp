@@ -24,9 +24,10 @@
 #include "bench/bench_detail.h"
 #include "bench/embree_baseline.h"
 #include "bench/embree_frames.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/packet_renderer.h"
+#include "render/prepare/bvh_build.h"
+#include "render/prepare/scene_view.h"
 #include "render/reference.h"
 #include "scene/compile.h"
 
@@ -381,7 +382,7 @@ void set_up_scene(BenchRun& run, BenchScene& bs) {
 // ---- Rows ----
 
 // The packets octray's kernels trace in: the ISA's traversal packets (16 rays with AVX-512,
-// kernels/bvh_packet.h), through the BVH and in brute force alike.
+// kernels/bvh/bvh_packet.h), through the BVH and in brute force alike.
 std::string octray_mode(Isa isa, bool /*bvh*/) {
     return "packet" + std::to_string(kernel_table(isa).traversal_width);
 }

@@ -16,6 +16,7 @@
 #include "kernels/dispatch.h"
 #include "kernels/isa.h"
 #include "render/accel.h"
+#include "render/prepare/scene_view.h"
 #include "render/render_options.h"
 
 namespace octray::bench {
@@ -143,8 +144,8 @@ struct SceneInfo {
     std::optional<double> embree_build_low_ms, embree_build_medium_ms;
     std::string embree_still_quality;               // "low", "medium"; empty without still rows
     std::optional<double> embree_bytes_per_sphere;  // Embree's device memory after the build
-    // octray's sphere BVH (kernels/bvh_build.h): build time, bytes per sphere (nodes and its
-    // copy of the spheres), 8-wide nodes, leaves, depth. Absent without spheres.
+    // octray's sphere BVH (render/prepare/bvh_build.h): build time, bytes per sphere (nodes and
+    // its copy of the spheres), 8-wide nodes, leaves, depth. Absent without spheres.
     std::optional<double> bvh_build_ms, bvh_bytes_per_sphere;
     std::uint32_t bvh_nodes = 0, bvh_leaves = 0, bvh_depth = 0;
     // Time to first pixel: from the scene spec to the first finished tile of a render with

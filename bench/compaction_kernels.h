@@ -1,5 +1,5 @@
 #pragma once
-// Stream compaction as the packet kernels do it (kernels/compaction.h: compaction()
+// Stream compaction as the packet kernels do it (kernels/stream/compaction.h: compaction()
 // and store_compacted(), the lanes of a mask packed to the front), exposed per ISA for the
 // microbenchmarks. Each ISA lives in its own translation unit with its own flags, like
 // the kernels: call one only after isa_supported() says the CPU has it.

@@ -3,7 +3,7 @@
 
 #define OCTRAY_KERNEL_NAMESPACE bench_avx2_fma
 #include "bench/compaction_kernels.h"
-#include "kernels/compaction.h"
+#include "kernels/stream/compaction.h"
 
 namespace octray::bench {
 

@@ -3,7 +3,7 @@
 
 #define OCTRAY_KERNEL_NAMESPACE bench_sse2
 #include "bench/compaction_kernels.h"
-#include "kernels/compaction.h"
+#include "kernels/stream/compaction.h"
 
 namespace octray::bench {
 

@@ -13,7 +13,7 @@ include(CMakePackageConfigHelpers)
 set(OCTRAY_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/octray)
 
 # Exported names: octray_scene -> octray::scene, ...
-foreach(lib core scene kernels render reference image warnings fp_model optimize)
+foreach(lib core scene kernels prepare render reference image warnings fp_model optimize)
   set_target_properties(octray_${lib} PROPERTIES EXPORT_NAME ${lib})
 endforeach()
 
@@ -26,7 +26,7 @@ install(FILES ${OCTRAY_SHARE_DIR}/bash-completion/completions/octray
         DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions)
 install(FILES ${OCTRAY_SHARE_DIR}/zsh/vendor-completions/_octray
         DESTINATION ${CMAKE_INSTALL_DATADIR}/zsh/vendor-completions)
-install(TARGETS octray_api octray_batch octray_frames octray_aov octray_core octray_scene octray_kernels octray_render
+install(TARGETS octray_api octray_batch octray_frames octray_aov octray_core octray_scene octray_kernels octray_prepare octray_render
                 octray_reference octray_image
                 octray_warnings octray_fp_model octray_optimize
         EXPORT octrayTargets

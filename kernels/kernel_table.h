@@ -15,7 +15,7 @@ struct KernelTable {
     const char* name;
     // 8 (AVX2, AVX-512) or 4 (SSE): registers per packet = 8 / this.
     std::uint32_t lanes_per_register;
-    // Rays per BVH traversal packet: 8, or 16 with AVX-512 (kernels/bvh_packet.h).
+    // Rays per BVH traversal packet: 8, or 16 with AVX-512 (kernels/bvh/bvh_packet.h).
     std::uint32_t traversal_width;
 
     // Primary rays for `count` camera samples; returns how many rays it wrote (the

@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-#include "kernels/bvh_node.h"
+#include "kernels/bvh/bvh_node.h"
 
 namespace octray::kernels {
 
@@ -70,8 +70,8 @@ struct SceneView {
     float epsilon;  // ε_s
     std::int32_t max_depth;
 
-    // The sphere BVH (kernels/bvh_build.h), or bvh_nodes == nullptr: closest_hit and any_hit
-    // test every sphere. Spheres in leaf order; node 0 is the root.
+    // The sphere BVH (render/prepare/bvh_build.h), or bvh_nodes == nullptr: closest_hit and
+    // any_hit test every sphere. Spheres in leaf order; node 0 is the root.
     const BvhNode8* bvh_nodes;
     const float *bvh_cx, *bvh_cy, *bvh_cz, *bvh_r2;
     const std::uint32_t* bvh_object;
@@ -83,13 +83,14 @@ struct SceneView {
     // The same for secondary rays (closest_hit with t_min 0: reflected and refracted rays,
     // which start on surfaces at any depth and spread). 9 in large BVHs, where neighbouring
     // pixels' secondary rays leave different tiny spheres in unrelated directions and share
-    // too few nodes for a packet to pay (kernels/dispatch.h).
+    // too few nodes for a packet to pay (render/prepare/scene_view.h).
     std::uint32_t bvh_secondary_min_lanes;
-    // Shadow rays are regrouped by origin and direction before tracing (hit_kernels.h,
+    // Shadow rays are regrouped by origin and direction before tracing (stream/hit_kernels.h,
     // any_hit) in BVHs of at least this many spheres.
     std::uint32_t bvh_shadow_sort_min_spheres;
     // In BVHs of at most this many spheres, shadow rays, and closest-hit rays that form no
-    // beam, test every sphere as without a BVH (hit_kernels.h; kernels/dispatch.h).
+    // beam, test every sphere as without a BVH (stream/hit_kernels.h;
+    // render/prepare/scene_view.h).
     std::uint32_t bvh_brute_force_max_spheres;
 };
 

@@ -4,16 +4,16 @@
 //
 // The BVH traversal takes 16 rays at a time, one 16-lane register per packet: two of the
 // stream's 8-ray packets share every node visit and every leaf's sphere loads
-// (OCTRAY_TRAVERSAL_ARCH, kernels/bvh_packet.h). Node tests (8 children), camera rays,
+// (OCTRAY_TRAVERSAL_ARCH, kernels/bvh/bvh_packet.h). Node tests (8 children), camera rays,
 // shading and the brute-force kernels stay 8 lanes wide: measured, AVX-512 encodings of
 // the 8-lane kernels gained nothing (docs/performance-log.md).
 
 #define OCTRAY_KERNEL_NAMESPACE avx512
 #define OCTRAY_TRAVERSAL_ARCH xsimd::avx512f
-#include "kernels/camera_rays.h"
-#include "kernels/hit_kernels.h"
 #include "kernels/kernel_table.h"
-#include "kernels/shading.h"
+#include "kernels/stream/camera_rays.h"
+#include "kernels/stream/hit_kernels.h"
+#include "kernels/stream/shading.h"
 
 namespace octray::kernels {
 

@@ -3,10 +3,10 @@
 // checked. Everything here lives in namespace octray::kernels::sse4_1.
 
 #define OCTRAY_KERNEL_NAMESPACE sse4_1
-#include "kernels/camera_rays.h"
-#include "kernels/hit_kernels.h"
 #include "kernels/kernel_table.h"
-#include "kernels/shading.h"
+#include "kernels/stream/camera_rays.h"
+#include "kernels/stream/hit_kernels.h"
+#include "kernels/stream/shading.h"
 
 namespace octray::kernels {
 

@@ -21,7 +21,7 @@
 // Packets are 8 rays (kPacketWidth). A kernel walks a stream in packets; a packet is
 // K = 8 / batch::size registers (one on AVX2, two on SSE). The AVX-512 translation unit
 // runs these kernels 8 lanes wide too, and only its BVH traversal 16 rays at a time
-// (bvh_packet.h, kTraversalWidth).
+// (bvh/bvh_packet.h, kTraversalWidth).
 
 #ifndef OCTRAY_KERNEL_NAMESPACE
 #error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"

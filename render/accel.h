@@ -1,7 +1,7 @@
 #pragma once
 // Which acceleration structure the SIMD render path uses for spheres (`--accel`), and where
 // `auto` is resolved: the packet renderer (render/packet_renderer.cpp), the memory estimate
-// (render/memory_estimate.cpp), `octray bench` and `octray info` ask accel_uses_bvh().
+// (render/batch/memory_estimate.cpp), `octray bench` and `octray info` ask accel_uses_bvh().
 // Plain declarations: the scalar reference sees Accel through render/render_options.h but never
 // calls these (it links no kernels and no BVH).
 
@@ -11,9 +11,9 @@
 
 namespace octray {
 
-// automatic: the BVH (kernels/bvh_build.h) from kBvhAutoMinSpheres spheres on, brute force
-// below; bvh: always the BVH; none: brute force (every ray against every sphere). The image
-// is the same whichever is used (kernels/README.md, section "The BVH").
+// automatic: the BVH (render/prepare/bvh_build.h) from kBvhAutoMinSpheres spheres on, brute
+// force below; bvh: always the BVH; none: brute force (every ray against every sphere). The
+// image is the same whichever is used (kernels/README.md, section "The BVH").
 enum class Accel { automatic, bvh, none };
 
 // The sphere count from which Accel::automatic builds a BVH: the crossover measured by

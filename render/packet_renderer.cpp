@@ -22,10 +22,11 @@
 
 #include "core/aligned.h"
 #include "core/random.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/crop.h"
 #include "render/parallel.h"
+#include "render/prepare/bvh_build.h"
+#include "render/prepare/scene_view.h"
 #include "render/stream_row.h"
 #include "render/tile_layout.h"
 #include "scene/camera.h"
@@ -35,7 +36,7 @@ namespace {
 
 using kernels::kPacketWidth;
 
-// The stream layout render/tile_layout.h states (and render/memory_estimate.cpp counts).
+// The stream layout render/tile_layout.h states (and render/batch/memory_estimate.cpp counts).
 static_assert(kTileStreamPacket == kPacketWidth);
 
 // Rounds a stream length up to whole packets, with one spare packet.
@@ -52,7 +53,7 @@ void grow(std::size_t n, Columns&... columns) {
                   "render/tile_layout.h: column element size");
     const std::size_t capacity = stream_capacity(n);
     // reserve first: resize alone may allocate up to twice the size (libstdc++ grows
-    // geometrically), and render/memory_estimate.cpp counts exactly `capacity` elements.
+    // geometrically), and render/batch/memory_estimate.cpp counts exactly `capacity` elements.
     ((columns.size() < capacity ? (columns.reserve(capacity), columns.resize(capacity))
                                 : void()),
      ...);

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "core/pixel_rect.h"
-#include "kernels/bvh_build.h"
 #include "kernels/isa.h"
 #include "kernels/kernel_table.h"
 #include "render/accel.h"
+#include "render/prepare/bvh_build.h"
 #include "render/render_result.h"
 #include "render/tile_layout.h"
 #include "scene/compile.h"

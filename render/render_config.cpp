@@ -109,18 +109,4 @@ RenderOptions RenderConfig::render_options() const {
     return o;
 }
 
-RenderMemoryParams RenderConfig::memory_params() const {
-    RenderMemoryParams p;
-    p.threads = threads;
-    p.tile_width = tile.width;
-    p.tile_height = tile.height;
-    p.packet_path = path == RenderPath::simd;
-    p.accel = accel;
-    p.aov_depth = aovs.depth;
-    p.aov_normal = aovs.normal;
-    p.aov_albedo = aovs.albedo;
-    p.aov_id = aovs.id;
-    return p;
-}
-
 }  // namespace octray

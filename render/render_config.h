@@ -16,7 +16,6 @@
 #include "kernels/isa.h"
 #include "render/accel.h"
 #include "render/aov.h"
-#include "render/memory_estimate.h"
 #include "render/render_options.h"
 #include "scene/scene.h"
 
@@ -86,10 +85,8 @@ struct RenderConfig {
     // What the renderers take from it: threads, tiles, acceleration and the crop (the
     // frame, cancel flag and progress are the caller's).
     RenderOptions render_options() const;
-    // What the memory estimate takes from it: threads, tiles, the path, acceleration and
-    // the AOVs; the caller adds what depends on the outputs (EXR type and codec, PNG,
-    // progressive passes, write behind, the scene file's size).
-    RenderMemoryParams memory_params() const;
+    // What the memory estimate takes from it: batch::memory_params(config)
+    // (render/batch/memory_estimate.h).
 };
 
 }  // namespace octray

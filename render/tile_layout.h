@@ -3,7 +3,7 @@
 // TileScratch): how many rays a tile traces at once, how its SoA streams are padded, and
 // how many columns each stream has. The renderer sizes its buffers from these constants
 // (it checks its column lists against them at compile time) and the memory estimate
-// (render/memory_estimate.cpp) counts them: one definition for both.
+// (render/batch/memory_estimate.cpp) counts them: one definition for both.
 
 #include <cstddef>
 #include <cstdint>

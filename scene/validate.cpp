@@ -114,7 +114,7 @@ class Validator {
                               " pixels; expected at most 2147483647 (2^31 - 1)");
         }
         // Whether the image fits in memory depends on the machine, not on the scene: the
-        // render command checks it (render/memory_estimate.h, `--max-memory`).
+        // render command checks it (render/batch/memory_estimate.h, `--max-memory`).
     }
 
     void camera() const {

@@ -18,6 +18,7 @@
 #include "core/thread_check.h"
 #include "kernels/dispatch.h"
 #include "render/image/image_io.h"
+#include "render/prepare/scene_view.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"
 

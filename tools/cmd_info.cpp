@@ -8,9 +8,9 @@
 #include <string>
 
 #include "core/version.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/accel.h"
+#include "render/prepare/bvh_build.h"
 #include "scene/compile.h"
 #include "scene/load.h"
 #include "tools/cli_checks.h"

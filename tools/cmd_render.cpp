@@ -25,11 +25,11 @@
 #include "kernels/dispatch.h"
 #include "render/aov.h"
 #include "render/batch/frame_loop.h"
+#include "render/batch/memory_estimate.h"
 #include "render/batch/output_paths.h"
 #include "render/batch/plan.h"
 #include "render/batch/spec.h"
 #include "render/image/image_io.h"
-#include "render/memory_estimate.h"
 #include "scene/animation.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
@@ -200,9 +200,9 @@ void run_render(const RenderArguments& args) {
     settings.placeholders = args.placeholders;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
     if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
-    std::uint64_t memory_limit = machine_memory_bytes();  // 0 if unknown: no limit
+    std::uint64_t memory_limit = batch::machine_memory_bytes();  // 0 if unknown: no limit
     if (!args.max_memory.empty()) {
-        const auto limit = parse_memory_size(args.max_memory);
+        const auto limit = batch::parse_memory_size(args.max_memory);
         if (!limit)
             throw UsageError("--max-memory: expected a size such as 512M, 4G or 1T, not " +
                              args.max_memory);
@@ -233,7 +233,7 @@ void run_render(const RenderArguments& args) {
         file_sizes[spec] = size;
         if (memory_limit > 0) {
             try {
-                check_load_memory_limit(spec, size, memory_limit);
+                batch::check_load_memory_limit(spec, size, memory_limit);
             } catch (const SceneError& e) {
                 throw UsageError(e.what() + limit_note());
             }
@@ -250,7 +250,7 @@ void run_render(const RenderArguments& args) {
         print_scene_warnings(scenes.back().scene, args.quiet);
     }
 
-    RenderMemoryParams memory = settings.render.memory_params();
+    batch::RenderMemoryParams memory = batch::memory_params(settings.render);
     memory.float32_output = args.float32;
     memory.exr_lines_per_chunk = exr_lines_per_chunk(*compression);
     memory.png_preview = !args.png.empty();
@@ -275,11 +275,11 @@ void run_render(const RenderArguments& args) {
             // limit, or the frames are written one after another instead.
             if (memory.write_behind) {
                 memory.write_behind =
-                    estimate_render_memory(scene.scene, memory).total <= memory_limit;
+                    batch::estimate_render_memory(scene.scene, memory).total <= memory_limit;
                 write_behind = memory.write_behind;
             }
             try {
-                check_memory_limit(scene.scene, memory_limit, memory);
+                batch::check_memory_limit(scene.scene, memory_limit, memory);
             } catch (const SceneError& e) {
                 throw UsageError(e.what() + limit_note());
             }

@@ -14,12 +14,12 @@
 
 #include "core/thread_check.h"
 #include "kernels/dispatch.h"
+#include "render/batch/memory_estimate.h"
 #include "render/batch/output_paths.h"
 #include "render/batch/spec.h"
 #include "render/image/error_heatmap.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_read.h"
-#include "render/memory_estimate.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "render/render_config.h"
@@ -165,9 +165,10 @@ void run_verify(const VerifyArguments& args) {
     apply_overrides(scene, config.overrides);
     validate_scene(scene);
     // Both renders' framebuffers must fit in this machine's memory; the estimate counts one
-    // render (render/memory_estimate.h). A scene's validity does not depend on the machine.
-    if (const std::uint64_t memory = machine_memory_bytes(); memory > 0)
-        check_memory_limit(scene, memory);
+    // render (render/batch/memory_estimate.h). A scene's validity does not depend on the
+    // machine.
+    if (const std::uint64_t memory = batch::machine_memory_bytes(); memory > 0)
+        batch::check_memory_limit(scene, memory);
 
     std::printf("scene    %s (%zu objects, %zu lights%s), %dx%d, %d spp\n", args.scene.c_str(),
                 scene.objects.size(), scene.lights.size(), scene.animation ? ", animated" : "",

@@ -21,10 +21,10 @@
 #include "core/thread_check.h"
 #include "kernels/dispatch.h"
 #include "render/batch/frame_loop.h"
+#include "render/batch/memory_estimate.h"
 #include "render/batch/plan.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_io.h"
-#include "render/memory_estimate.h"
 #include "render/render_config.h"
 #include "scene/load.h"
 #include "scene/max_depth.h"
@@ -192,20 +192,20 @@ RenderConfig view_config(const ViewArguments& args) {
 // starting and failing on its first picture with std::bad_alloc.
 void check_view_memory(const Scene& scene, const RenderConfig& config,
                        const ViewArguments& args) {
-    std::uint64_t limit = machine_memory_bytes();  // 0 if unknown: no limit
+    std::uint64_t limit = batch::machine_memory_bytes();  // 0 if unknown: no limit
     if (!args.max_memory.empty()) {
-        const auto parsed = parse_memory_size(args.max_memory);
+        const auto parsed = batch::parse_memory_size(args.max_memory);
         if (!parsed)
             throw UsageError("--max-memory: expected a size such as 512M, 4G or 1T, not " +
                              args.max_memory);
         limit = *parsed;
     }
     if (limit == 0) return;
-    RenderMemoryParams memory = config.memory_params();
+    batch::RenderMemoryParams memory = batch::memory_params(config);
     memory.progressive = true;
     memory.png_preview = true;
     try {
-        check_memory_limit(scene, limit, memory);
+        batch::check_memory_limit(scene, limit, memory);
     } catch (const SceneError& e) {
         throw UsageError(e.what() + (args.max_memory.empty()
                                          ? std::string(" (the limit is this machine's memory; "

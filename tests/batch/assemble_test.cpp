@@ -68,7 +68,7 @@ void expect_same_image(const Image& a, const Image& b) {
 }
 
 TEST(Assemble, PartsMakeTheFullRenderBitForBit) {
-    const Scene scene = test::golden_scene("thinlens_spp4", kWidth, kHeight);
+    const Scene scene = testing::golden_scene("thinlens_spp4", kWidth, kHeight);
     const std::vector<std::vector<PixelRect>> splits{
         // 2 x 2
         {{0, 0, 15, 10}, {15, 0, 29, 10}, {0, 10, 15, 19}, {15, 10, 29, 19}},
@@ -83,7 +83,7 @@ TEST(Assemble, PartsMakeTheFullRenderBitForBit) {
         {{0, 0, 29, 19}},
     };
     for (bool float32 : {false, true}) {
-        const std::filesystem::path dir = test::test_dir();
+        const std::filesystem::path dir = testing::test_dir();
         const std::string whole = (dir / "whole.exr").string();
         write_exr(whole, render_part(scene, std::nullopt, float32));
         const Image expected = read_exr_image(whole);
@@ -168,7 +168,7 @@ TEST(Assemble, OverlapsGapsAndMismatchesAreNamed) {
 }
 
 TEST(Assemble, UnreadablePartsAreIoErrorsAndNothingIsWritten) {
-    const std::filesystem::path dir = test::test_dir();
+    const std::filesystem::path dir = testing::test_dir();
     const std::string good = (dir / "good.exr").string();
     write_exr(good, blank({0, 0, 4, 6}));
     const std::string out = (dir / "out.exr").string();

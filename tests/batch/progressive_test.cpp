@@ -14,11 +14,11 @@
 namespace octray::batch {
 namespace {
 
-using test::golden_scene;
-using test::Path;
-using test::path_name;
-using test::render_with;
-using test::same_bits;
+using testing::golden_scene;
+using testing::Path;
+using testing::path_name;
+using testing::render_with;
+using testing::same_bits;
 
 TEST(Progressive, ScheduleDoublesAndEndsOnSpp) {
     EXPECT_EQ(progressive_schedule(1), (std::vector<int>{1}));

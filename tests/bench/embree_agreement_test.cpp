@@ -17,6 +17,7 @@
 #include "bench/embree_frames.h"
 #include "bench/ray_sets.h"
 #include "kernels/dispatch.h"
+#include "render/prepare/scene_view.h"
 #include "render/reference.h"
 #include "scene/compile.h"
 #include "scene/load.h"

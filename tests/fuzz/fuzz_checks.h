@@ -24,9 +24,9 @@
 #include <system_error>
 #include <vector>
 
+#include "render/batch/memory_estimate.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
-#include "render/memory_estimate.h"
 #include "scene/builtin.h"
 #include "scene/compile.h"
 #include "scene/load.h"
@@ -65,7 +65,7 @@ inline void check_loaded_scene(const Scene& scene) {
         throw InvariantBroken("writing a read-back scene gives the same text", written);
     }
     // Saturating arithmetic: a signed overflow here would be a UBSan report.
-    const RenderMemoryEstimate estimate = estimate_render_memory(scene);
+    const batch::RenderMemoryEstimate estimate = batch::estimate_render_memory(scene);
     if (estimate.total < estimate.framebuffer) {
         throw InvariantBroken("the memory estimate covers the framebuffer",
                               estimate.describe());

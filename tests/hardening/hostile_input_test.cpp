@@ -18,7 +18,7 @@
 #include <string>
 #include <string_view>
 
-#include "render/memory_estimate.h"
+#include "render/batch/memory_estimate.h"
 #include "scene/builtin.h"
 #include "scene/load.h"
 #include "scene/scene_error.h"
@@ -249,7 +249,7 @@ TEST(HostileImageSize, FramebufferOverPhysicalMemoryIsRefusedUpFront) {
         GTEST_SKIP() << "this machine has more memory than that";
     const Scene s = make_builtin_scene("whitted,width=46340,height=46340");
     try {
-        check_memory_limit(s, static_cast<std::uint64_t>(memory));
+        batch::check_memory_limit(s, static_cast<std::uint64_t>(memory));
         FAIL() << "a 24 GiB framebuffer was accepted";
     } catch (const SceneError& e) {
         const std::string what = e.what();
@@ -263,7 +263,7 @@ TEST(HostileImageSize, FramebufferOverPhysicalMemoryIsRefusedUpFront) {
 TEST(HostileImageSize, RenderOverTheMemoryLimitIsRefusedWithTheEstimate) {
     const Scene s = make_builtin_scene("whitted,width=30000,height=20000,spp=4");
     try {
-        check_memory_limit(s, std::uint64_t{2} << 30);
+        batch::check_memory_limit(s, std::uint64_t{2} << 30);
         FAIL() << "a 30000 x 20000 render fits in 2 GiB?";
     } catch (const SceneError& e) {
         const std::string what = e.what();

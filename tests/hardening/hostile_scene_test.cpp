@@ -20,11 +20,11 @@
 namespace octray {
 namespace {
 
-using test::add_material;
-using test::add_plane;
-using test::add_point_light;
-using test::add_sphere;
-using test::empty_scene;
+using testing::add_material;
+using testing::add_plane;
+using testing::add_point_light;
+using testing::add_sphere;
+using testing::empty_scene;
 
 Material diffuse(Rgb color, float kd = 1.0f) {
     Material m;

@@ -47,7 +47,7 @@ void expect_same_images(const Scene& scene, const std::string& what) {
 // Mirror, glass and diffuse spheres of mixed sizes (some overlapping) over a checkered
 // floor: reflected, refracted and shadow rays all go through the tree.
 Scene glass_and_mirrors(CameraType camera) {
-    Scene s = test::empty_scene(64, 48);
+    Scene s = testing::empty_scene(64, 48);
     s.camera.type = camera;
     s.camera.eye = {0.0f, 2.0f, 6.0f};
     s.camera.lookat = {0.0f, 0.5f, 0.0f};
@@ -64,18 +64,18 @@ Scene glass_and_mirrors(CameraType camera) {
     mirror.kd = 0.2f, mirror.ks = 0.5f, mirror.shininess = 40.0f, mirror.reflect = Rgb(0.7f);
     Material glass;
     glass.kd = 0.0f, glass.reflect = Rgb(0.1f), glass.transmit = 0.85f, glass.ior = 1.5f;
-    test::add_plane(s, {0, 0, 0}, {0, 1, 0}, test::add_material(s, floor));
-    const std::uint32_t materials[3] = {test::add_material(s, mirror),
-                                        test::add_material(s, glass), 0};
+    testing::add_plane(s, {0, 0, 0}, {0, 1, 0}, testing::add_material(s, floor));
+    const std::uint32_t materials[3] = {testing::add_material(s, mirror),
+                                        testing::add_material(s, glass), 0};
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f), size(0.05f, 0.5f);
     for (int i = 0; i < 150; ++i) {
         const float r = size(rng);
-        test::add_sphere(s, {3 * u(rng), r + 1.5f * (u(rng) + 1), 3 * u(rng)}, r,
-                         materials[i % 3]);
+        testing::add_sphere(s, {3 * u(rng), r + 1.5f * (u(rng) + 1), 3 * u(rng)}, r,
+                            materials[i % 3]);
     }
-    test::add_point_light(s, {-4, 6, 5}, Rgb(0.7f));
-    test::add_directional_light(s, {1, -1, -0.5f}, Rgb(0.3f));
+    testing::add_point_light(s, {-4, 6, 5}, Rgb(0.7f));
+    testing::add_directional_light(s, {1, -1, -0.5f}, Rgb(0.3f));
     return s;
 }
 
@@ -95,7 +95,7 @@ TEST(BvhRender, EveryCameraMatchesTheReference) {
 
 TEST(BvhRender, EyeInsideASphereMatchesTheReference) {
     Scene s = glass_and_mirrors(CameraType::pinhole);
-    test::add_sphere(s, s.camera.eye, 0.3f, 2);  // a glass sphere around the eye
+    testing::add_sphere(s, s.camera.eye, 0.3f, 2);  // a glass sphere around the eye
     s.render.max_depth = 8;
     expect_same_images(s, "eye inside glass");
 }

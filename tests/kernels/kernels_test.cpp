@@ -14,8 +14,9 @@
 
 #include "core/aligned.h"
 #include "core/random.h"
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
+#include "render/prepare/bvh_build.h"
+#include "render/prepare/scene_view.h"
 #include "render/reference.h"
 #include "scene/compile.h"
 #include "scene/load.h"
@@ -257,7 +258,7 @@ TYPED_TEST(KernelTest, GrazingAndTangentRays) {
 // from beside the sphere to 1e4 radii away, direction lengths from 1e-3 to 1e3, passing
 // the center at r (1 + delta) for delta from -2^-8 to 2^-6 (tangent within a few ulps
 // included). The BVH's leaves reject most spheres with a division-free test before the
-// exact one (kernels/sphere_test.h, sphere_may_hit); it must never reject a sphere the
+// exact one (kernels/geometry/sphere_test.h, sphere_may_hit); it must never reject a sphere the
 // exact test hits (without its |O'|^2 term, rays from 1e6 radii away fail here). Checked
 // for brute force and for the BVH's packet and single-ray leaves, against the reference
 // bit for bit.

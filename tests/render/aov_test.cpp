@@ -60,15 +60,15 @@ TEST(Aov, ParsesListsAndNamesMistakes) {
 // looks straight down -Z. A red unit sphere at the origin (object 0), behind it a plane at
 // z = -3 whose normal points away from the eye (object 1), with a checker.
 Scene known_scene(int spp = 1) {
-    Scene s = test::empty_scene(33, 33);
+    Scene s = testing::empty_scene(33, 33);
     s.image.spp = spp;
     Material red;
     red.color = {0.8f, 0.1f, 0.1f};
     Material floor;
     floor.color = {0.2f, 0.3f, 0.4f};
     floor.checker = Checker{{0.9f, 0.8f, 0.7f}, 0.5f};
-    test::add_sphere(s, {0, 0, 0}, 1.0f, test::add_material(s, red));
-    test::add_plane(s, {0, 0, -3}, {0, 0, -1}, test::add_material(s, floor));
+    testing::add_sphere(s, {0, 0, 0}, 1.0f, testing::add_material(s, red));
+    testing::add_plane(s, {0, 0, -3}, {0, 0, -1}, testing::add_material(s, floor));
     return s;
 }
 
@@ -109,7 +109,7 @@ TEST(Aov, KnownValuesOfASphereAPlaneAndAMiss) {
 }
 
 TEST(Aov, OnlyTheAskedAovsAndCropsAreTheFullImagesPixels) {
-    const Scene scene = test::golden_scene("thinlens_spp4", 23, 17);
+    const Scene scene = testing::golden_scene("thinlens_spp4", 23, 17);
     const Image full = compute_aovs(scene, {}, AovSet{true, true, true, true});
     RenderOptions options;
     options.crop = PixelRect{4, 3, 15, 9};
@@ -171,7 +171,7 @@ TEST(Aov, FromThePacketPathsFirstHitsTheSameBits) {
 
 TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
     const Scene scene = known_scene();
-    const std::filesystem::path dir = test::test_dir();
+    const std::filesystem::path dir = testing::test_dir();
     for (bool float32 : {false, true}) {
         SCOPED_TRACE(float32 ? "float" : "half");
         RenderOptions options;

@@ -12,12 +12,12 @@
 namespace octray {
 namespace {
 
-using test::golden_scene;
-using test::Path;
-using test::path_name;
-using test::render_with;
-using test::same_bits;
-using test::sub_image;
+using testing::golden_scene;
+using testing::Path;
+using testing::path_name;
+using testing::render_with;
+using testing::same_bits;
+using testing::sub_image;
 
 const std::vector<PixelRect> kCrops{
     {0, 0, 37, 23},    // the whole image

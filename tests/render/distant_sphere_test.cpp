@@ -42,7 +42,7 @@ DVec dvec(Vec3 v) { return {v.x, v.y, v.z}; }
 // A unit sphere `distance` from the eye along an oblique direction (every coordinate
 // matters), a field of view that makes it kDiscPixels in radius, a light beside the eye.
 Scene distant_sphere_scene(double distance) {
-    Scene s = test::empty_scene(kSize, kSize);
+    Scene s = testing::empty_scene(kSize, kSize);
     const DVec eye{3.0, -2.0, 7.0};
     const DVec center = eye + unit({0.3, 0.2, -1.0}) * distance;
     s.camera.eye = {3.0f, -2.0f, 7.0f};
@@ -57,9 +57,9 @@ Scene distant_sphere_scene(double distance) {
     m.color = {0.8f, 0.6f, 0.4f};
     m.ks = 0.5f;
     m.shininess = 32.0f;
-    test::add_sphere(s, s.camera.lookat, 1.0f, test::add_material(s, m));
+    testing::add_sphere(s, s.camera.lookat, 1.0f, testing::add_material(s, m));
     const DVec light = eye + DVec{distance * 0.05, distance * 0.05, 0.0};
-    test::add_point_light(
+    testing::add_point_light(
         s,
         {static_cast<float>(light.x), static_cast<float>(light.y), static_cast<float>(light.z)},
         Rgb(1.0f));

@@ -26,8 +26,8 @@ namespace octray {
 namespace {
 
 TEST(ExrWindows, CroppedRenderRoundTrips) {
-    const std::filesystem::path dir = test::test_dir();
-    const Scene scene = test::golden_scene("pinhole_checker", 40, 30);
+    const std::filesystem::path dir = testing::test_dir();
+    const Scene scene = testing::golden_scene("pinhole_checker", 40, 30);
     RenderOptions options;
     options.crop = PixelRect{7, 5, 29, 26};
     const RenderResult result = render_packet(scene, options);
@@ -82,7 +82,7 @@ TEST(ExrWindows, CroppedRenderRoundTrips) {
 }
 
 TEST(ExrWindows, WriterRefusesInconsistentImages) {
-    const std::filesystem::path dir = test::test_dir();
+    const std::filesystem::path dir = testing::test_dir();
     const std::string path = (dir / "bad.exr").string();
     const RgbImage image(4, 3);
     Image good = make_image(image, PixelRect{1, 1, 5, 4}, 8, 8, ExrWriteOptions{});
@@ -120,7 +120,7 @@ TEST(ExrWindows, WriterRefusesInconsistentImages) {
 }
 
 TEST(ExrAttributes, MatricesRationalsAndOpaqueAttributesReadBack) {
-    const std::filesystem::path dir = test::test_dir();
+    const std::filesystem::path dir = testing::test_dir();
     const std::string path = (dir / "attrs.exr").string();
     ExrAttributes attributes;
     Matrix44 m;
@@ -209,15 +209,15 @@ void expect_matrices_match_rays(const Scene& scene) {
 }
 
 TEST(CameraMatrices, ProjectThePixelsOwnRays) {
-    Scene pinhole = test::golden_scene("pinhole_checker", 48, 30, 1);
+    Scene pinhole = testing::golden_scene("pinhole_checker", 48, 30, 1);
     expect_matrices_match_rays(pinhole);
-    Scene ortho = test::golden_scene("orthographic", 30, 41, 1);
+    Scene ortho = testing::golden_scene("orthographic", 30, 41, 1);
     expect_matrices_match_rays(ortho);
-    Scene lens = test::golden_scene("thinlens_spp4", 32, 20, 1);
+    Scene lens = testing::golden_scene("thinlens_spp4", 32, 20, 1);
     lens.camera.aperture = 0.0f;  // its in-focus projection: the lens center's rays
     expect_matrices_match_rays(lens);
 
-    const Scene fisheye = test::golden_scene("fisheye", 16, 16);
+    const Scene fisheye = testing::golden_scene("fisheye", 16, 16);
     EXPECT_FALSE(batch::world_to_ndc(fisheye));
     ExrAttributes attributes;
     batch::add_camera_attributes(attributes, fisheye);

@@ -15,7 +15,7 @@
 #include "render/reference.h"
 #include "scene/load.h"
 
-namespace octray::test {
+namespace octray::testing {
 
 // A golden feature scene (tests/golden/scenes/<name>.json) at width x height, with spp
 // samples per pixel (0: the file's).
@@ -62,4 +62,4 @@ inline std::filesystem::path test_dir() {
     return dir;
 }
 
-}  // namespace octray::test
+}  // namespace octray::testing

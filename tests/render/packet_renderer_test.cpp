@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "kernels/dispatch.h"
-#include "render/memory_estimate.h"
+#include "render/batch/memory_estimate.h"
 #include "render/reference.h"
 #include "scene/load.h"
 #include "scene_builders.h"
@@ -26,12 +26,12 @@
 namespace octray {
 namespace {
 
-using test::add_directional_light;
-using test::add_material;
-using test::add_plane;
-using test::add_point_light;
-using test::add_sphere;
-using test::empty_scene;
+using testing::add_directional_light;
+using testing::add_material;
+using testing::add_plane;
+using testing::add_point_light;
+using testing::add_sphere;
+using testing::empty_scene;
 
 struct Agreement {
     double max_abs = 0.0;
@@ -267,8 +267,8 @@ TEST(PacketRenderer, RayChunksChangeNoPixel) {
 // The worst case for a breadth-first tile: every bounce spawns a mirror and a refracted
 // ray that the weight cut-off never stops (reflect = transmit = 1), depth 8, the eye
 // inside nested glass shells. A generation then has up to 2^8 times the tile's samples;
-// in chunks, a thread's scratch stays within render/memory_estimate.h's per-thread estimate
-// (which assumes one chunk per generation), and the image is still the reference's.
+// in chunks, a thread's scratch stays within render/batch/memory_estimate.h's per-thread
+// estimate (which assumes one chunk per generation), and the image is still the reference's.
 TEST(PacketRenderer, MirrorAndGlassEverywhereStaysWithinBoundedMemory) {
     Scene s = empty_scene(16, 16);
     s.image.spp = 8;
@@ -306,9 +306,9 @@ TEST(PacketRenderer, MirrorAndGlassEverywhereStaysWithinBoundedMemory) {
     EXPECT_EQ(chunked.rays.reflected, reference.rays.reflected);
     EXPECT_EQ(chunked.rays.refracted, reference.rays.refracted);
 
-    RenderMemoryParams params;
+    batch::RenderMemoryParams params;
     params.threads = 1;
-    const RenderMemoryEstimate estimate = estimate_render_memory(s, params);
+    const batch::RenderMemoryEstimate estimate = batch::estimate_render_memory(s, params);
     EXPECT_GT(chunked.scratch_bytes, 0u);
     EXPECT_LE(chunked.scratch_bytes, estimate.per_thread);
     // ... and the estimate itself is bounded: a chunk per generation, far below the

@@ -21,10 +21,10 @@
 namespace octray {
 namespace {
 
-using test::add_plane;
-using test::add_point_light;
-using test::add_sphere;
-using test::empty_scene;
+using testing::add_plane;
+using testing::add_point_light;
+using testing::add_sphere;
+using testing::empty_scene;
 
 // Closest hits and occlusion of `ray` with both tracers, compared to the bit.
 void expect_same_hits(const ReferenceTracer& bvh, const ReferenceTracer& brute, const Ray& ray,
@@ -260,7 +260,7 @@ TEST(ReferenceBvh, TheLecturesTrapsRenderTheSameBitsAsBruteForce) {
     s.camera.lookat = {0, 1, -1};
     Material mirror;
     mirror.reflect = Rgb(0.9f);
-    const std::uint32_t m = test::add_material(s, mirror);
+    const std::uint32_t m = testing::add_material(s, mirror);
     add_sphere(s, {0, 1, 0}, 0.5f);              // around the eye
     add_sphere(s, {0, 1, -6}, 1.0f, m);          // a mirror ahead
     add_sphere(s, {2, 1, -6}, 1.0f, m);          // touching it

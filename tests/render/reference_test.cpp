@@ -16,12 +16,12 @@
 namespace octray {
 namespace {
 
-using test::add_directional_light;
-using test::add_material;
-using test::add_plane;
-using test::add_point_light;
-using test::add_sphere;
-using test::empty_scene;
+using testing::add_directional_light;
+using testing::add_material;
+using testing::add_plane;
+using testing::add_point_light;
+using testing::add_sphere;
+using testing::empty_scene;
 
 void expect_rgb_near(Rgb a, Rgb b, float tol) {
     EXPECT_NEAR(a.r, b.r, tol);

@@ -1,8 +1,8 @@
-// Prepare once, render many (PreparedScene::update, kernels/bvh_build.h refit_sphere_bvh):
-// frames whose spheres move and change size, rendered from one prepared scene updated in
-// place and refitted, are bit for bit the frames rendered from a fresh compile and build;
-// a refit tree's boxes still hold their spheres and children; a pose that spreads the
-// spheres far apart grows the tree's cost past the limit and rebuilds it.
+// Prepare once, render many (PreparedScene::update, render/prepare/bvh_build.h
+// refit_sphere_bvh): frames whose spheres move and change size, rendered from one prepared
+// scene updated in place and refitted, are bit for bit the frames rendered from a fresh compile
+// and build; a refit tree's boxes still hold their spheres and children; a pose that spreads
+// the spheres far apart grows the tree's cost past the limit and rebuilds it.
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <random>
 #include <string>
 
-#include "kernels/bvh_build.h"
 #include "render/packet_renderer.h"
+#include "render/prepare/bvh_build.h"
 #include "scene/builtin.h"
 
 namespace octray {

@@ -1,6 +1,7 @@
 // The one description of a render (render/render_config.h): names parsed or refused with
 // the setting they belong to, ranges checked, a crop checked against the image, and what
-// the renderers, the memory estimate and the EXR's octray.path take from it.
+// the renderers and the EXR's octray.path take from it (the memory estimate's part:
+// tests/batch/memory_limits_test.cpp).
 
 #include "render/render_config.h"
 
@@ -98,29 +99,18 @@ TEST(RenderConfig, OverridesReplaceOnlyWhatTheySet) {
     EXPECT_EQ(scene.render.seed, 7u);
 }
 
-TEST(RenderConfig, WhatTheRenderersAndTheEstimateTake) {
+TEST(RenderConfig, WhatTheRenderersTake) {
     RenderConfig c;
     c.threads = 3;
     c.tile = {8, 4};
     c.accel = Accel::bvh;
     c.crop = PixelRect{1, 2, 3, 4};
-    c.aovs.normal = true;
     const RenderOptions o = c.render_options();
     EXPECT_EQ(o.threads, 3);
     EXPECT_EQ(o.tile_width, 8);
     EXPECT_EQ(o.tile_height, 4);
     EXPECT_EQ(o.accel, Accel::bvh);
     EXPECT_EQ(o.crop, c.crop);
-    const RenderMemoryParams m = c.memory_params();
-    EXPECT_EQ(m.threads, 3);
-    EXPECT_EQ(m.tile_width, 8);
-    EXPECT_EQ(m.tile_height, 4);
-    EXPECT_TRUE(m.packet_path);
-    EXPECT_EQ(m.accel, Accel::bvh);
-    EXPECT_TRUE(m.aov_normal);
-    EXPECT_FALSE(m.aov_depth || m.aov_albedo || m.aov_id);
-    c.path = RenderPath::scalar;
-    EXPECT_FALSE(c.memory_params().packet_path);
 }
 
 TEST(RenderConfig, TheIsaResolvesAndLabelsThePath) {

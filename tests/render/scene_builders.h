@@ -3,7 +3,7 @@
 
 #include "scene/scene.h"
 
-namespace octray::test {
+namespace octray::testing {
 
 inline Scene empty_scene(int width = 33, int height = 33) {
     Scene s;
@@ -58,4 +58,4 @@ inline void add_directional_light(Scene& s, Vec3 direction, Rgb color) {
     s.lights.push_back(l);
 }
 
-}  // namespace octray::test
+}  // namespace octray::testing

@@ -11,9 +11,9 @@
 #include <functional>
 #include <vector>
 
-#include "kernels/bvh_build.h"
 #include "kernels/dispatch.h"
 #include "render/packet_renderer.h"
+#include "render/prepare/bvh_build.h"
 #include "render/reference.h"
 #include "scene/compile.h"
 #include "scene/load.h"

@@ -1,6 +1,6 @@
 // JSON scene loading errors: every error with its file, JSON path and expectation. (An
 // image too large for the machine is no scene error: the render command refuses it,
-// tests/tools/memory_estimate_test.cpp.)
+// tests/batch/memory_estimate_test.cpp.)
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -22,7 +22,7 @@
 namespace octray {
 namespace {
 
-using namespace load_test;
+using namespace testing;
 
 // ---------------------------------------------------------------------------------------
 // Errors

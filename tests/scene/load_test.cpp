@@ -20,7 +20,7 @@
 namespace octray {
 namespace {
 
-using namespace load_test;
+using namespace testing;
 
 // ---------------------------------------------------------------------------------------
 // Valid scenes

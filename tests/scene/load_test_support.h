@@ -12,7 +12,7 @@
 
 #include "scene/load.h"
 
-namespace octray::load_test {
+namespace octray::testing {
 
 using Json = nlohmann::ordered_json;
 
@@ -90,4 +90,4 @@ inline Json minimal_scene() {
     return Json{{"camera", {{"eye", {0, 0, 5}}, {"lookat", {0, 0, 0}}}}};
 }
 
-}  // namespace octray::load_test
+}  // namespace octray::testing

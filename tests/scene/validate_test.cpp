@@ -19,7 +19,7 @@
 namespace octray {
 namespace {
 
-using namespace load_test;
+using namespace testing;
 
 // ---------------------------------------------------------------------------------------
 // validate_scene on in-memory scenes (after command-line overrides, or built in code)

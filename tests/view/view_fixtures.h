@@ -4,7 +4,7 @@
 #include "scene/builtin.h"
 #include "scene/scene.h"
 
-namespace octray::view::test {
+namespace octray::view::testing {
 
 inline Scene small_whitted() {
     Scene scene = make_builtin_scene("whitted");
@@ -14,4 +14,4 @@ inline Scene small_whitted() {
     return scene;
 }
 
-}  // namespace octray::view::test
+}  // namespace octray::view::testing

@@ -125,7 +125,7 @@ class ViewLoadTest : public ::testing::Test {
         return fd;
     }
 
-    const octray::Scene scene_ = octray::view::test::small_whitted();
+    const octray::Scene scene_ = octray::view::testing::small_whitted();
     std::unique_ptr<ViewSession> session_;
     std::unique_ptr<ViewServer> server_;
 };

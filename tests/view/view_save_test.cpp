@@ -31,7 +31,7 @@ using octray::view::ServerOptions;
 using octray::view::ViewServer;
 using octray::view::ViewSession;
 using octray::view::ViewSettings;
-using octray::view::test::small_whitted;
+using octray::view::testing::small_whitted;
 
 // A new empty directory for one test (this process's, under the temporary directory).
 std::filesystem::path empty_directory(const std::string& prefix) {

@@ -39,7 +39,7 @@ using octray::view::ServerOptions;
 using octray::view::ViewServer;
 using octray::view::ViewSession;
 using octray::view::ViewSettings;
-using octray::view::test::small_whitted;
+using octray::view::testing::small_whitted;
 
 // An image's raw bytes, as /api/image.f32 returns them.
 std::string bytes_of(const octray::RgbImage& image) {

@@ -138,7 +138,7 @@ TEST(ViewSwitches, TheChoicesAreTheIsasThisCpuRuns) {
 
 // small_whitted animated over 5 frames: the camera moves, and so does the glass sphere.
 Scene animated_whitted() {
-    Scene scene = octray::view::test::small_whitted();
+    Scene scene = octray::view::testing::small_whitted();
     octray::Animation animation;
     animation.frames = 5;
     animation.fps = 10.0;
@@ -233,7 +233,7 @@ class SwitchesTest : public ::testing::Test {
 // picture says which made it, and equals what that path renders. ISAs this CPU lacks are
 // refused with 400 and change nothing.
 TEST_F(SwitchesTest, PathAndIsaSwitchesRenderWithThem) {
-    const Scene scene = octray::view::test::small_whitted();
+    const Scene scene = octray::view::testing::small_whitted();
     start(scene, octray::view::PixelOrder::tiled, ".");
     const json first = status();
     EXPECT_EQ(first["settings"]["path"], "simd");

@@ -32,7 +32,7 @@
 // and its tie rule (the lower file index wins) decide the hits, in any order. So a sphere
 // may be dropped only where no ray of the pyramid could report it. A lane reports a
 // sphere only when its ray passes within r + 10u|O'| of the center (u = 2^-24; the bound
-// of kernels/bvh_packet.h), at a point in front of O, or when O lies within that distance
+// of kernels/bvh/bvh_packet.h), at a point in front of O, or when O lies within that distance
 // of the center (a root in front of an origin behind the sphere's center). Both put the
 // sphere's center within that distance of the pyramid, so within it of each of the
 // pyramid's planes: the sphere is kept while every plane's signed distance to the center
@@ -42,8 +42,8 @@
 // ulp of each) and the rounding of the plane distances themselves many times over. A
 // plane with normal (1, -u) in (p, w) has distance (p - u w) / sqrt(1 + u^2); the tests
 // multiply instead of dividing. The walk drops a node's child box only where each sphere
-// inside it would be dropped: the box holds the sphere's ball (kernels/bvh_build.cpp rounds
-// it outwards), so with the box's largest value F of a plane function, f(c) <= F - r|n|,
+// inside it would be dropped: the box holds the sphere's ball (render/prepare/bvh_build.cpp
+// rounds it outwards), so with the box's largest value F of a plane function, f(c) <= F - r|n|,
 // and a box is dropped where F < -delta |n| with
 //   delta = 2^-9 min_extent + 2^-12 E,   E = max over the box of |X - O|_1,
 // which exceeds 2^-8 r + 2^-13 |q|_1 (2r <= the box's smallest extent) with 2^-13 E to
@@ -58,9 +58,9 @@
 #include <cmath>
 #include <cstdint>
 
-#include "kernels/bvh_frustum.h"
-#include "kernels/bvh_packet.h"
-#include "kernels/bvh_packet_traversal.h"
+#include "kernels/bvh/bvh_frustum.h"
+#include "kernels/bvh/bvh_packet.h"
+#include "kernels/bvh/bvh_packet_traversal.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
@@ -329,7 +329,8 @@ void beam_gather(const SceneView& s, Beam& beam, std::uint32_t* stack) {
                 stack[sp] = n.child[order[k]], stack_near[sp++] = near[order[k]];
             continue;
         }
-        // A leaf's spheres a register at a time (the arrays are padded: kernels/bvh_build.h).
+        // A leaf's spheres a register at a time (the arrays are padded:
+        // render/prepare/bvh_build.h).
         const std::uint32_t first = leaf_first(ref), leaf = leaf_count(ref);
         for (std::uint32_t at = 0; at < leaf && sp != kFull; at += W) {
             const std::uint32_t i = first + at;

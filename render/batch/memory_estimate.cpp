@@ -1,7 +1,7 @@
-// The memory estimate of render/memory_estimate.h. Every size below names the layout it comes
-// from; when those layouts change, change the constants with them.
+// The memory estimate of render/batch/memory_estimate.h. Every size below names the layout it
+// comes from; when those layouts change, change the constants with them.
 
-#include "render/memory_estimate.h"
+#include "render/batch/memory_estimate.h"
 
 #include <unistd.h>
 
@@ -13,11 +13,11 @@
 #include <system_error>
 #include <thread>
 
-#include "kernels/bvh_node.h"
+#include "kernels/bvh/bvh_node.h"
 #include "render/tile_layout.h"
 #include "scene/scene_error.h"
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
@@ -56,9 +56,9 @@ constexpr std::uint64_t kCompiledMaterialBytes = 16 * 4;  // CompiledMaterials' 
 constexpr std::uint64_t kCompiledLightBytes = 11 * 4;     // CompiledLights' 11 columns
 constexpr std::uint64_t kPadding = 8;
 
-// kernels/bvh_build.cpp build_sphere_bvh, per sphere: one PrimRef array (32 bytes; the
+// render/prepare/bvh_build.cpp build_sphere_bvh, per sphere: one PrimRef array (32 bytes; the
 // partitions work in place) and n - 1 BinaryNodes (28 bytes; inner nodes only) while
-// building (kernels/bvh_sah.h), the 8-wide nodes (224 bytes each; one per 26 spheres
+// building (render/prepare/bvh_sah.h), the 8-wide nodes (224 bytes each; one per 26 spheres
 // measured on random:1000000, counted as one per 4) and the BVH's copy of the spheres
 // (5 columns). Its arrays sit on 2 MiB huge pages: a
 // page of rounding for each of its 8 arrays.
@@ -316,4 +316,18 @@ std::optional<std::uint64_t> parse_memory_size(std::string_view text) {
     return value << shift;
 }
 
-}  // namespace octray
+RenderMemoryParams memory_params(const RenderConfig& config) {
+    RenderMemoryParams p;
+    p.threads = config.threads;
+    p.tile_width = config.tile.width;
+    p.tile_height = config.tile.height;
+    p.packet_path = config.path == RenderPath::simd;
+    p.accel = config.accel;
+    p.aov_depth = config.aovs.depth;
+    p.aov_normal = config.aovs.normal;
+    p.aov_albedo = config.aovs.albedo;
+    p.aov_id = config.aovs.id;
+    return p;
+}
+
+}  // namespace octray::batch

@@ -4,11 +4,11 @@
 // --max-memory`), and the parser for sizes such as "512M" or "4G".
 //
 // The estimate counts what the process really allocates, from the layouts in
-// core/image.h, scene/compile.h, kernels/bvh_build.cpp, render/packet_renderer.cpp (its
+// core/image.h, scene/compile.h, render/prepare/bvh_build.cpp, render/packet_renderer.cpp (its
 // tile scratch: render/tile_layout.h), render/batch/progressive.cpp, render/aov.h,
 // render/image/exr_write.cpp, render/image/png.cpp and render/batch/frame_loop.cpp,
 // plus the process's own fixed footprint and the parse of a scene file; it is meant to be
-// an upper bound of the peak resident set size (tests/tools/memory_estimate_test.cpp
+// an upper bound of the peak resident set size (tests/batch/memory_estimate_test.cpp
 // measures it). It errs on the high side: the packet path's per-thread ray streams are
 // sized as if every generation of a tile held a full chunk of rays at once
 // (tests/render/packet_renderer_test.cpp checks a thread's scratch against it), the BVH's
@@ -20,9 +20,10 @@
 #include <string_view>
 
 #include "render/accel.h"
+#include "render/render_config.h"
 #include "scene/scene.h"
 
-namespace octray {
+namespace octray::batch {
 
 // How the render will run: what the per-thread terms depend on.
 struct RenderMemoryParams {
@@ -36,7 +37,7 @@ struct RenderMemoryParams {
     bool png_preview = false;        // --png
     bool progressive = false;        // --progressive: a pass renders while the last is kept
     // A frame's image and files are written while the next frame renders: two frames'
-    // images and EXR channels at once (batch::BatchSettings::write_behind).
+    // images and EXR channels at once (BatchSettings::write_behind).
     bool write_behind = false;
     // --aov: the buffers of compute_aovs and their EXR channels.
     bool aov_depth = false, aov_normal = false, aov_albedo = false, aov_id = false;
@@ -63,6 +64,11 @@ struct RenderMemoryEstimate {
     // "about 1.2 GiB (framebuffer 0.9 GiB, EXR output 0.5 GiB, ...)".
     std::string describe() const;
 };
+
+// What the estimate takes from a render's description: threads, tiles, the path,
+// acceleration and the AOVs; the caller adds what depends on the outputs (EXR type and
+// codec, PNG, progressive passes, write behind, the scene file's size).
+RenderMemoryParams memory_params(const RenderConfig& config);
 
 RenderMemoryEstimate estimate_render_memory(const Scene& scene,
                                             const RenderMemoryParams& params = {});
@@ -91,4 +97,4 @@ std::uint64_t machine_memory_bytes();
 // insensitive); nullopt for anything else, zero, or a size over UINT64_MAX bytes.
 std::optional<std::uint64_t> parse_memory_size(std::string_view text);
 
-}  // namespace octray
+}  // namespace octray::batch

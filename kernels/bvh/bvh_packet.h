@@ -5,8 +5,8 @@
 // Included ONLY by the per-ISA translation units, under their OCTRAY_KERNEL_NAMESPACE
 // (packet_math.h; kernels/README.md, "the ODR rule").
 //
-// The tree is kernels/bvh_build.h's: 8-wide nodes with their children's boxes in SoA
-// (kernels/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
+// The tree is render/prepare/bvh_build.h's: 8-wide nodes with their children's boxes in SoA
+// (kernels/bvh/bvh_node.h), leaves of up to 8 spheres in SoA. Two traversals share it:
 // - packet traversal (Wald et al. 2001, "Interactive rendering with coherent ray
 //   tracing", widened to 8-wide nodes): the packet as a whole (a frustum, where its
 //   directions' signs agree) is tested against all 8 children at once; the 8-ray packet is
@@ -35,7 +35,7 @@
 // values) and of O - c. (The textbook form used before was far worse: a fuzzy sphere of
 // radius ~sqrt(19u)|O'| around a tiny sphere far away, and a widening of
 // sqrt(r_min^2 + 32u(D^2 + r_max^2)) - r_min, up to half a radius on random:1048576.)
-// The tests (tests/kernels/bvh_test.cpp) check hit for hit against brute force
+// The tests (tests/kernels/bvh_traversal_test.cpp) check hit for hit against brute force
 // on degenerate scenes (radii from 1e-6 to 1e3, coincident spheres, spheres far apart).
 
 #ifndef OCTRAY_KERNEL_NAMESPACE
@@ -69,7 +69,7 @@ static_assert(kTraversalWidth % kPacketWidth == 0 && kTraversalWidth <= 16);
 
 // Entries of a traversal stack: a node pushes at most 8 children (the single-ray
 // traversal writes all 8 slots above the top at once), and the builder keeps the tree
-// below 48 + 28 levels (kernels/bvh_sah.cpp, kMaxSahDepth).
+// below 48 + 28 levels (render/prepare/bvh_sah.cpp, kMaxSahDepth).
 constexpr std::uint32_t kBvhStackSize = 1024;
 // 32u and 64u of the margin above.
 constexpr float kBvhFuzz = 0x1.0p-19f;

@@ -12,10 +12,10 @@
 
 #include <cstdint>
 
-#include "kernels/bvh_frustum.h"
-#include "kernels/bvh_packet.h"
-#include "kernels/bvh_single_ray.h"
-#include "kernels/sphere_test.h"
+#include "kernels/bvh/bvh_frustum.h"
+#include "kernels/bvh/bvh_packet.h"
+#include "kernels/bvh/bvh_single_ray.h"
+#include "kernels/geometry/sphere_test.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 

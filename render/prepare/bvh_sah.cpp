@@ -1,6 +1,6 @@
 // Binned SAH (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies")
 // on a binary tree built in parallel over subtrees: the first half of the sphere BVH
-// builder (kernels/bvh_sah.h; the 8-wide collapse is kernels/bvh_build.cpp).
+// builder (render/prepare/bvh_sah.h; the 8-wide collapse is render/prepare/bvh_build.cpp).
 //
 // Determinism: every decision depends only on the spheres of a subtree and its place in
 // the tree. Binning reduces boxes with min/max and counts with integer sums (both exact,
@@ -10,7 +10,7 @@
 // so no slot depends on which thread got there first. Partitions reorder a node's own range in
 // place, which no other task touches meanwhile.
 
-#include "kernels/bvh_sah.h"
+#include "render/prepare/bvh_sah.h"
 
 #include <immintrin.h>
 #include <tbb/blocked_range.h>

@@ -1,13 +1,13 @@
-// The sphere BVH builder (kernels/bvh_build.h): the binary tree by binned SAH
-// (kernels/bvh_sah.cpp), then collapsed into 8-wide nodes (Wald et al. 2008, "Getting rid
-// of packets"; embree's BVH8 collapse: open the child with the largest surface area until
+// The sphere BVH builder (render/prepare/bvh_build.h): the binary tree by binned SAH
+// (render/prepare/bvh_sah.cpp), then collapsed into 8-wide nodes (Wald et al. 2008, "Getting
+// rid of packets"; embree's BVH8 collapse: open the child with the largest surface area until
 // 8 children) and laid out.
 //
-// Determinism: the binary tree is the same for any thread count (kernels/bvh_sah.cpp); the
-// 8-wide collapse hands large subtrees to tasks, and one pass then writes every node to its
+// Determinism: the binary tree is the same for any thread count (render/prepare/bvh_sah.cpp);
+// the 8-wide collapse hands large subtrees to tasks, and one pass then writes every node to its
 // place in child order, whichever task finished first.
 
-#include "kernels/bvh_build.h"
+#include "render/prepare/bvh_build.h"
 
 #include <emmintrin.h>
 #include <math.h>
@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/bvh_sah.h"
+#include "render/prepare/bvh_sah.h"
 
 namespace octray {
 

@@ -12,11 +12,11 @@
 
 #include <cstdint>
 
-#include "kernels/brute_force.h"
-#include "kernels/bvh_beam.h"
-#include "kernels/bvh_packet.h"
-#include "kernels/bvh_packet_traversal.h"
-#include "kernels/plane_test.h"
+#include "kernels/bvh/bvh_beam.h"
+#include "kernels/bvh/bvh_packet.h"
+#include "kernels/bvh/bvh_packet_traversal.h"
+#include "kernels/geometry/plane_test.h"
+#include "kernels/stream/brute_force.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 

@@ -5,7 +5,7 @@
 // estimate is read through the option itself: with the limit one byte below the measured
 // peak, the same command line must be refused before rendering.
 
-#include "render/memory_estimate.h"
+#include "render/batch/memory_estimate.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -139,13 +139,13 @@ TEST_F(MemoryEstimateTest, FramesWrittenWhileTheNextRendersStayWithinTheEstimate
                       "0-3", "--float", "--png", "w.#.png", "-o", "w.#.exr", "--threads", "2"},
                      dir_);
     ASSERT_EQ(peak.status, 0);
-    octray::RenderMemoryParams params;
+    octray::batch::RenderMemoryParams params;
     params.threads = 2;
     params.float32_output = true;
     params.png_preview = true;
     params.write_behind = true;
     const octray::Scene scene = octray::load_scene("whitted,width=1920,height=1080");
-    EXPECT_LE(peak.bytes, octray::estimate_render_memory(scene, params).total);
+    EXPECT_LE(peak.bytes, octray::batch::estimate_render_memory(scene, params).total);
 }
 
 // An image whose framebuffer alone exceeds this machine's memory (the largest the pixel

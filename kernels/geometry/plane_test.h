@@ -19,7 +19,7 @@ constexpr float kPlaneParallelEpsilon = 1e-12f;
 
 // Planes, for one register of rays: closest hit with ties to the lower file index, and
 // occlusion on (0, t_max). Shared by the brute-force kernels and the BVH traversal
-// (kernels/hit_kernels.h): planes stay outside the BVH.
+// (kernels/stream/hit_kernels.h): planes stay outside the BVH.
 template <class F>
 void closest_planes(const SceneView& s, const V3<F>& o, const V3<F>& d, const F& tmin,
                     F& best_t, F& best_id) {

@@ -12,9 +12,9 @@
 
 #include <cstdint>
 
-#include "kernels/bvh_frustum.h"
-#include "kernels/bvh_packet.h"
-#include "kernels/sphere_test.h"
+#include "kernels/bvh/bvh_frustum.h"
+#include "kernels/bvh/bvh_packet.h"
+#include "kernels/geometry/sphere_test.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 

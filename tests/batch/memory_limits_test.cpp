@@ -1,5 +1,5 @@
-// render/memory_estimate.h: the render memory estimate, the limit check behind --max-memory,
-// and the size parser.
+// render/batch/memory_estimate.h: the render memory estimate, the limit check behind
+// --max-memory, the size parser, and what the estimate takes from a RenderConfig.
 
 #include <gtest/gtest.h>
 
@@ -7,11 +7,11 @@
 #include <limits>
 #include <string>
 
-#include "render/memory_estimate.h"
+#include "render/batch/memory_estimate.h"
 #include "scene/builtin.h"
 #include "scene/scene_error.h"
 
-namespace octray {
+namespace octray::batch {
 namespace {
 
 constexpr std::uint64_t kGiB = std::uint64_t{1} << 30;
@@ -217,5 +217,23 @@ TEST(MemorySize, RefusesEverythingElse) {
     }
 }
 
+TEST(MemoryParams, WhatTheEstimateTakesFromARenderConfig) {
+    RenderConfig c;
+    c.threads = 3;
+    c.tile = {8, 4};
+    c.accel = Accel::bvh;
+    c.aovs.normal = true;
+    const RenderMemoryParams m = memory_params(c);
+    EXPECT_EQ(m.threads, 3);
+    EXPECT_EQ(m.tile_width, 8);
+    EXPECT_EQ(m.tile_height, 4);
+    EXPECT_TRUE(m.packet_path);
+    EXPECT_EQ(m.accel, Accel::bvh);
+    EXPECT_TRUE(m.aov_normal);
+    EXPECT_FALSE(m.aov_depth || m.aov_albedo || m.aov_id);
+    c.path = RenderPath::scalar;
+    EXPECT_FALSE(memory_params(c).packet_path);
+}
+
 }  // namespace
-}  // namespace octray
+}  // namespace octray::batch

@@ -1,7 +1,7 @@
 #pragma once
-// The node layout of the sphere BVH (kernels/bvh_build.h), shared by the builder and the packet
-// kernels. Plain data and constants only: the per-ISA kernel translation units include it
-// (kernels/README.md, "the ODR rule").
+// The node layout of the sphere BVH (render/prepare/bvh_build.h), shared by the builder and the
+// packet kernels. Plain data and constants only: the per-ISA kernel translation units include
+// it (kernels/README.md, "the ODR rule").
 
 #include <cstdint>
 

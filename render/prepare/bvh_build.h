@@ -2,7 +2,7 @@
 // An 8-wide bounding volume hierarchy over a compiled scene's spheres (planes stay outside
 // it: they are unbounded and tested directly). Built by binned SAH on a binary tree, in
 // parallel with TBB over subtrees, then collapsed into 8-wide nodes whose children's boxes
-// are stored in SoA (kernels/bvh_node.h). Leaves hold up to 8 spheres, copied into SoA
+// are stored in SoA (kernels/bvh/bvh_node.h). Leaves hold up to 8 spheres, copied into SoA
 // arrays in leaf order (cx, cy, cz, r2, object: the layout the brute-force kernels read).
 //
 // Deterministic: the tree (every byte of it) does not depend on the number of threads.
@@ -15,7 +15,7 @@
 #include <span>
 
 #include "core/aligned.h"
-#include "kernels/bvh_node.h"
+#include "kernels/bvh/bvh_node.h"
 #include "scene/compile.h"
 
 namespace octray {

@@ -12,7 +12,7 @@
 
 #include <cstdint>
 
-#include "kernels/bvh_packet.h"
+#include "kernels/bvh/bvh_packet.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 

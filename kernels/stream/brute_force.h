@@ -10,10 +10,10 @@
 
 #include <cstdint>
 
-#include "kernels/bvh_packet.h"
+#include "kernels/bvh/bvh_packet.h"
+#include "kernels/geometry/plane_test.h"
+#include "kernels/geometry/sphere_test.h"
 #include "kernels/packet_math.h"
-#include "kernels/plane_test.h"
-#include "kernels/sphere_test.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
@@ -42,7 +42,7 @@ template <class B, class T>
 }
 
 // Closest hit over all spheres and planes, brute force (reference:
-// ReferenceTracer::intersect); closest_hit() in kernels/hit_kernels.h calls it when the
+// ReferenceTracer::intersect); closest_hit() in kernels/stream/hit_kernels.h calls it when the
 // scene has no BVH.
 // Spheres are broadcast one at a time against the packet. An object's candidate is its
 // first root above t_min; the hit is the smallest candidate, ties to the lower file index
@@ -102,7 +102,7 @@ void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t co
 
 // ---------------------------------------------------------------------------------------
 // Any hit for shadow rays on (0, t_max), brute force (reference: ReferenceTracer::occluded);
-// any_hit() in kernels/hit_kernels.h calls it when the scene has no BVH. A packet
+// any_hit() in kernels/stream/hit_kernels.h calls it when the scene has no BVH. A packet
 // stops testing objects once every live lane is occluded. occluded[i] is 1 or 0.
 template <class Arch>
 void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t count,

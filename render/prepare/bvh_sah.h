@@ -1,15 +1,15 @@
 #pragma once
-// The binary half of the sphere BVH builder (kernels/bvh_build.h): the builder's boxes and
-// sphere references in SSE registers, and the binned SAH build of a binary tree over them
-// (kernels/bvh_sah.cpp). kernels/bvh_build.cpp makes the references, collapses the binary
-// tree into 8-wide nodes and lays them out. Internal to those two files.
+// The binary half of the sphere BVH builder (render/prepare/bvh_build.h): the builder's boxes
+// and sphere references in SSE registers, and the binned SAH build of a binary tree over them
+// (render/prepare/bvh_sah.cpp). render/prepare/bvh_build.cpp makes the references, collapses
+// the binary tree into 8-wide nodes and lays them out. Internal to those two files.
 
 #include <emmintrin.h>
 
 #include <cstdint>
 #include <limits>
 
-#include "kernels/bvh_node.h"
+#include "kernels/bvh/bvh_node.h"
 
 namespace octray::bvh_sah {
 

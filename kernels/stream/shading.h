@@ -12,8 +12,8 @@
 
 #include <cstdint>
 
-#include "kernels/compaction.h"
 #include "kernels/packet_math.h"
+#include "kernels/stream/compaction.h"
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
