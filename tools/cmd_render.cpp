@@ -386,13 +386,13 @@ void add_render_command(CLI::App& app, CommandRunner& run) {
         ->type_name("SIZE");
     args->width_option =
         cmd->add_option("--width", args->width,
-                        "RgbImage width in pixels, " + integer_range_text(1, kMaxImageSide) +
+                        "Image width in pixels, " + integer_range_text(1, kMaxImageSide) +
                             " (overrides the scene)")
             ->type_name("W")
             ->transform(decimal_integer(1, kMaxImageSide));
     args->height_option =
         cmd->add_option("--height", args->height,
-                        "RgbImage height in pixels, " + integer_range_text(1, kMaxImageSide) +
+                        "Image height in pixels, " + integer_range_text(1, kMaxImageSide) +
                             " (overrides the scene)")
             ->type_name("H")
             ->transform(decimal_integer(1, kMaxImageSide));

@@ -212,11 +212,11 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
         ->capture_default_str();
     cmd->add_option(
            "--width", args->width,
-           "RgbImage width, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
+           "Image width, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
         ->type_name("W")
         ->transform(decimal_integer(1, kMaxImageSide));
     cmd->add_option("--height", args->height,
-                    "RgbImage height, " + integer_range_text(1, kMaxImageSide) +
+                    "Image height, " + integer_range_text(1, kMaxImageSide) +
                         " (overrides the scene)")
         ->type_name("H")
         ->transform(decimal_integer(1, kMaxImageSide));

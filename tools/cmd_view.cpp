@@ -278,12 +278,12 @@ void add_view_command(CLI::App& app, CommandRunner& run) {
         ->transform(decimal_integer(0, 65535))
         ->capture_default_str();
     cmd->add_option("--width", args->width,
-                    "RgbImage width in pixels, " + integer_range_text(1, kMaxImageSide) +
+                    "Image width in pixels, " + integer_range_text(1, kMaxImageSide) +
                         " (overrides the scene)")
         ->type_name("W")
         ->transform(decimal_integer(1, kMaxImageSide));
     cmd->add_option("--height", args->height,
-                    "RgbImage height in pixels, " + integer_range_text(1, kMaxImageSide) +
+                    "Image height in pixels, " + integer_range_text(1, kMaxImageSide) +
                         " (overrides the scene)")
         ->type_name("H")
         ->transform(decimal_integer(1, kMaxImageSide));

@@ -1,8 +1,8 @@
 #pragma once
-// Writing images: OpenEXR (the product) and 8-bit PNG previews, and the types an OpenEXR
-// image is made of. Every writer goes through write_file_atomically(), so an interrupted
-// run never leaves a partial image behind. Every OpenEXR file octray writes goes through
-// write_exr(path, Image) (exr_write.cpp); every PNG through png.cpp.
+// Writing images: OpenEXR (the product) and 8-bit PNG previews, and a render's framebuffer
+// made an Image (make_image). Every writer goes through write_file_atomically(), so an
+// interrupted run never leaves a partial image behind. Every OpenEXR file octray writes
+// goes through write_exr(path, Image) (exr_write.cpp); every PNG through png.cpp.
 
 #include <array>
 #include <cstddef>
