@@ -30,6 +30,13 @@ TEST_F(CliTest, HelpExplainsCommandsOptionsAndExitCodes) {
          {"--output", "--width", "--height", "--spp", "--threads", "--seed", "--max-depth",
           "--path", "--png", "--float", "--compression", "--tile", "Examples", "Exit codes"})
         EXPECT_TRUE(contains(render.output, option)) << option << "\n" << render.output;
+    // The options' words are the user's, never a type's name (a code rename once reached
+    // "RgbImage width in pixels" here).
+    for (const char* command : {"render", "view", "verify"}) {
+        const std::string help = octray({command, "--help"}).output;
+        EXPECT_TRUE(contains(help, "Image width")) << command << "\n" << help;
+        EXPECT_FALSE(contains(help, "RgbImage")) << command << "\n" << help;
+    }
 }
 
 // Issue 26: `octray help COMMAND` is `octray COMMAND --help`, `-V` is `--version`, and an
