@@ -280,6 +280,14 @@ octray::Scene configured_scene(const Scene& scene, octray::RenderConfig& config)
 
 // The AOV image's channels (render/aov.h) as the API's vectors: Z, N.* and albedo.*
 // interleaved three to a pixel, id.
+// Refuses (SceneError: Error(scene)) a render whose memory estimate exceeds `limit`, or
+// this machine's memory when `limit` is 0, as `octray render` does before it starts.
+void check_memory(const octray::Scene& scene, const batch::RenderMemoryParams& params,
+                  std::uint64_t limit) {
+    if (limit == 0) limit = batch::machine_memory_bytes();  // 0 if unknown: no limit
+    if (limit > 0) batch::check_memory_limit(scene, limit, params);
+}
+
 Aovs from_internal(const octray::Image& a) {
     Aovs out;
     const auto floats = [&](const char* name) {
@@ -500,6 +508,7 @@ struct Renderer::Impl {
 
     Impl(const Scene& scene, const RenderOptions& o)
         : options(o), config(to_config(o)), source(configured_scene(scene, config)) {
+        check_memory(source, batch::memory_params(config), o.max_memory);
         renderer = std::make_unique<octray::FrameRenderer>(source, config.path, config.isa,
                                                            config.accel, config.threads);
     }
@@ -752,6 +761,7 @@ FrameFilesResult render_frames(const Scene& scene, const RenderOptions& options,
         batch::RenderMemoryParams memory = batch::memory_params(config);
         memory.float32_output = files.exr.float32;
         memory.png_preview = !files.png.empty();
+        check_memory(scenes[0].scene, memory, options.max_memory);
         memory.write_behind = true;
         const std::uint64_t machine = batch::machine_memory_bytes();
         settings.write_behind =

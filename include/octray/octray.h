@@ -223,6 +223,11 @@ struct RenderOptions {
     std::optional<Crop> crop = std::nullopt;
     // The AOVs to render alongside the image (RenderResult::aovs); none by default.
     AovSelection aovs{};
+    // A render (or render_frames) whose memory estimate — `octray render`'s, framebuffer,
+    // tile scratch, BVH, AOVs and outputs — exceeds this many bytes is refused before
+    // anything is allocated: Error(scene) with the estimate and its terms, as `octray render
+    // --max-memory` refuses it. 0: this machine's memory (no limit where it is unknown).
+    std::uint64_t max_memory = 0;
 };
 
 // Linear RGB floats, row 0 on top: pixel (x, y) is rgb[3 * (y * width + x) + {0, 1, 2}].

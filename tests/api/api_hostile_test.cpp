@@ -68,8 +68,6 @@ api::Scene small_scene() {
 
 api::Vec3 v3(float x, float y, float z) { return {x, y, z}; }
 
-}  // namespace
-
 // The cases the issue names: each was a crash or a wrong verdict.
 TEST(ApiHostile, TheReportedCrashesAreErrors) {
     const api::Image empty{0, 0, {}};
@@ -389,3 +387,35 @@ TEST(ApiHostile, SpecsAndJsonFromFragments) {
         });
     }
 }
+
+// A render over its memory limit is refused before it starts, with the estimate, as
+// `octray render --max-memory` refuses it: by api::render, a Renderer and render_frames
+// (which then writes nothing). 0, the default, is this machine's memory.
+TEST(ApiHostile, ARenderOverItsMemoryLimitIsRefusedBeforeItStarts) {
+    const api::Scene scene = api::Scene::load("whitted");
+    api::RenderOptions options;
+    options.width = 64;
+    options.height = 48;
+    options.threads = 1;
+    options.max_memory = 1024;  // less than any frame
+    try {
+        (void)api::render(scene, options);
+        ADD_FAILURE() << "a render over its memory limit ran";
+    } catch (const api::Error& e) {
+        EXPECT_EQ(e.kind(), api::ErrorKind::scene);
+        const std::string message = e.what();
+        EXPECT_NE(message.find("64 x 48 image"), std::string::npos) << message;
+        EXPECT_NE(message.find("memory limit"), std::string::npos) << message;
+    }
+    EXPECT_EQ(kind_of([&] { api::Renderer renderer(scene, options); }), api::ErrorKind::scene);
+    api::FrameFilesOptions files;
+    files.output = temp_path("memory") + "/f.exr";
+    std::filesystem::remove_all(temp_path("memory"));
+    EXPECT_EQ(kind_of([&] { (void)api::render_frames(scene, options, files); }),
+              api::ErrorKind::scene);
+    EXPECT_FALSE(std::filesystem::exists(files.output));
+    options.max_memory = 0;
+    EXPECT_EQ(api::render(scene, options).image.width, 64);
+}
+
+}  // namespace
