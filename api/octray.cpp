@@ -136,6 +136,7 @@ Image from_internal(const octray::RgbImage& image) {
 octray::Image to_channels(const Image& image) {
     const octray::RgbImage rgb = to_internal(image);
     octray::Image out(image.width, image.height, {"R", "G", "B"});
+    if (rgb.pixel_count() == 0) return out;  // no pixels: no storage to point into
     const float* values = reinterpret_cast<const float*>(rgb.data());
     for (int c = 0; c < 3; ++c)
         out.channels[static_cast<std::size_t>(c)] = octray::make_channel(
