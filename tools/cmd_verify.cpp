@@ -215,9 +215,9 @@ void add_verify_command(CLI::App& app, CommandRunner& run) {
            "Image width, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
         ->type_name("W")
         ->transform(decimal_integer(1, kMaxImageSide));
-    cmd->add_option("--height", args->height,
-                    "Image height, " + integer_range_text(1, kMaxImageSide) +
-                        " (overrides the scene)")
+    cmd->add_option(
+           "--height", args->height,
+           "Image height, " + integer_range_text(1, kMaxImageSide) + " (overrides the scene)")
         ->type_name("H")
         ->transform(decimal_integer(1, kMaxImageSide));
     cmd->add_option("--spp", args->spp,
