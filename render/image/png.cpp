@@ -59,12 +59,13 @@ void on_png_warning(png_structp, png_const_charp) {}
 // ---- Writing -----------------------------------------------------------------------------
 // octray encodes the PNGs it writes itself: a PNG octray writes is wanted soon rather than
 // small. Every row is filtered with one filter (each byte minus its left neighbour's,
-// SUB) and the rows are compressed as one zlib stream by libdeflate at its fastest level,
-// which compresses the pixels about 1.5 times as fast as zlib's fastest level did through
-// libpng, into a smaller file (render/image/README.md, "Compression").
+// SUB) and the rows are compressed as one zlib stream by libdeflate at level 2, which
+// compresses previews faster than zlib's fastest level did through libpng, and most of
+// them faster than libdeflate's level 1, into smaller files (render/image/README.md,
+// "Compression").
 // libpng reads them back in the tests.
 
-constexpr int kPngLevel = 1;
+constexpr int kPngLevel = 2;
 
 // How the file says its pixels are sRGB: the sRGB chunk alone (the heatmap), or with the
 // gAMA and cHRM chunks that stand in for it in older viewers (the render preview).
