@@ -105,43 +105,38 @@ Isa from_internal(octray::Isa isa) {
     return Isa::automatic;
 }
 
-octray::RgbImage to_internal(const Image& image) {
+// The API's interleaved RGB image as octray's: float32 planes R, G, B (a render's image,
+// render/image/image.h), its data window its display window.
+octray::Image image_to_internal(const Image& image) {
     if (image.width < 0 || image.height < 0 ||
         image.rgb.size() != 3 * static_cast<std::size_t>(image.width) *
                                 static_cast<std::size_t>(image.height)) {
         throw Error(ErrorKind::invalid_argument,
                     "image: rgb must hold 3 floats for each of width x height pixels");
     }
-    octray::RgbImage out(image.width, image.height);
-    for (std::size_t k = 0; k < out.pixel_count(); ++k) {
-        out.data()[k] = {image.rgb[3 * k], image.rgb[3 * k + 1], image.rgb[3 * k + 2]};
+    const octray::PixelRect window{0, 0, image.width, image.height};
+    octray::Image out = octray::make_rgb_image(window, window);
+    const std::size_t n = out.pixel_count();
+    for (int c = 0; c < 3; ++c) {
+        float* plane = out.plane(c);
+        for (std::size_t k = 0; k < n; ++k)
+            plane[k] = image.rgb[3 * k + static_cast<std::size_t>(c)];
     }
     return out;
 }
 
-Image from_internal(const octray::RgbImage& image) {
+// A render's image (float32 R, G, B planes) as the API's interleaved RGB.
+Image image_from_internal(const octray::Image& image) {
     Image out;
     out.width = image.width();
     out.height = image.height();
-    out.rgb.resize(3 * image.pixel_count());
-    for (std::size_t k = 0; k < image.pixel_count(); ++k) {
-        out.rgb[3 * k] = image.data()[k].r;
-        out.rgb[3 * k + 1] = image.data()[k].g;
-        out.rgb[3 * k + 2] = image.data()[k].b;
+    const std::size_t n = image.pixel_count();
+    out.rgb.resize(3 * n);
+    for (int c = 0; c < 3; ++c) {
+        const float* plane = image.plane(c);
+        for (std::size_t k = 0; k < n; ++k)
+            out.rgb[3 * k + static_cast<std::size_t>(c)] = plane[k];
     }
-    return out;
-}
-
-// The API's plain RGB image as octray's image: float32 channels R, G, B.
-octray::Image to_channels(const Image& image) {
-    const octray::RgbImage rgb = to_internal(image);
-    octray::Image out(image.width, image.height, {"R", "G", "B"});
-    if (rgb.pixel_count() == 0) return out;  // no pixels: no storage to point into
-    const float* values = reinterpret_cast<const float*>(rgb.data());
-    for (int c = 0; c < 3; ++c)
-        out.channels[static_cast<std::size_t>(c)] = octray::make_channel(
-            out.channels[static_cast<std::size_t>(c)].name, octray::PixelFormat::float32,
-            values + c, rgb.pixel_count(), 3);
     return out;
 }
 
@@ -548,14 +543,15 @@ struct Renderer::Impl {
         }
         RenderResult out;
         out.path = config.path_label();
-        out.image = from_internal(r.result.image);
+        out.image = image_from_internal(r.result.image);
         out.rays = {r.result.rays.primary, r.result.rays.shadow, r.result.rays.reflected,
                     r.result.rays.refracted};
         out.seconds = r.result.seconds;
         if (config.aovs.any()) out.aovs = from_internal(r.aovs);
-        out.window = {r.result.rect.x0, r.result.rect.y0, r.result.rect.x1, r.result.rect.y1};
-        out.full_width = r.result.full_width;
-        out.full_height = r.result.full_height;
+        const octray::PixelRect& window = r.result.image.data_window;
+        out.window = {window.x0, window.y0, window.x1, window.y1};
+        out.full_width = r.result.image.display_window.width();
+        out.full_height = r.result.image.display_window.height();
         return out;
     }
 };
@@ -593,7 +589,7 @@ void write_exr(const std::string& path, const Image& image, const ExrOptions& op
         o.float32 = options.float32;
         ExrAttributes attributes;
         attributes.strings.emplace_back("software", std::string("octray ") + version());
-        octray::write_exr(path, to_internal(image), o, attributes);
+        octray::write_exr(path, image_to_internal(image), o, attributes);
     });
 }
 
@@ -622,7 +618,7 @@ Image read_image(const std::string& path) {
 
 CompareResult compare(const Image& a, const Image& b, const CompareOptions& options) {
     return translate_errors(
-        [&] { return compare_channels(to_channels(a), to_channels(b), options); });
+        [&] { return compare_channels(image_to_internal(a), image_to_internal(b), options); });
 }
 
 CompareResult compare_files(const std::string& a, const std::string& b,

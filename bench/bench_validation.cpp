@@ -99,12 +99,13 @@ std::string validate_render(const std::string& spec, const BenchOptions& o, Isa 
     const RenderResult simd =
         prepared ? render_packet(PreparedScene(small, accel, o.threads), ro, isa)
                  : render_packet(small, ro, isa);
-    valid = ref.image == simd.image && ref.rays.total() == simd.rays.total();
+    valid = same_pixels(ref.image, simd.image) && ref.rays.total() == simd.rays.total();
     return std::string(valid ? "valid" : "INVALID") + ": " +
            (prepared ? "prepared-scene" : "packet") + " image " +
-           (ref.image == simd.image ? "equals" : "differs from") + " the reference image at " +
-           std::to_string(small.image.width) + "x" + std::to_string(small.image.height) +
-           ", ray counts " + (ref.rays.total() == simd.rays.total() ? "equal" : "differ");
+           (same_pixels(ref.image, simd.image) ? "equals" : "differs from") +
+           " the reference image at " + std::to_string(small.image.width) + "x" +
+           std::to_string(small.image.height) + ", ray counts " +
+           (ref.rays.total() == simd.rays.total() ? "equal" : "differ");
 }
 
 #if OCTRAY_HAVE_EMBREE
@@ -126,7 +127,8 @@ std::string validate_embree_render(const Scene& small, const EmbreeFrames& frame
     std::size_t off = 0;
     const std::size_t n = ref.image.pixel_count();
     for (std::size_t k = 0; k < n; ++k) {
-        const Rgb a = ref.image.data()[k], b = e.image.data()[k];
+        const Rgb a(ref.image.plane(0)[k], ref.image.plane(1)[k], ref.image.plane(2)[k]);
+        const Rgb b(e.image.plane(0)[k], e.image.plane(1)[k], e.image.plane(2)[k]);
         const double d[3] = {double(a.r) - b.r, double(a.g) - b.g, double(a.b) - b.b};
         squared += d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         peak = std::max({peak, double(a.r), double(a.g), double(a.b)});

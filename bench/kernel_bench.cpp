@@ -254,14 +254,14 @@ void tile_end_to_end(benchmark::State& state, bool simd, Isa isa) {
     RenderOptions options;
     options.threads = 1;
     const RenderResult ref = render_reference(scene, options);
-    if (simd && !(render_packet(compiled, options, isa).image == ref.image)) {
+    if (simd && !(same_pixels(render_packet(compiled, options, isa).image, ref.image))) {
         state.SkipWithError("packet tile differs from the reference tile");
         return;
     }
     for (auto _ : state) {
         const RenderResult r =
             simd ? render_packet(compiled, options, isa) : render_reference(scene, options);
-        benchmark::DoNotOptimize(r.image.data());
+        benchmark::DoNotOptimize(r.image.plane(0));
     }
     set_rate(state, ref.rays.total());
     set_rate(state, 256, "pixels/s");

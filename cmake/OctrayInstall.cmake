@@ -27,7 +27,7 @@ install(FILES ${OCTRAY_SHARE_DIR}/bash-completion/completions/octray
 install(FILES ${OCTRAY_SHARE_DIR}/zsh/vendor-completions/_octray
         DESTINATION ${CMAKE_INSTALL_DATADIR}/zsh/vendor-completions)
 install(TARGETS octray_api octray_batch octray_frames octray_aov octray_core octray_scene octray_kernels octray_prepare octray_render
-                octray_reference octray_image
+                octray_reference octray_image octray_image_model
                 octray_warnings octray_fp_model octray_optimize
         EXPORT octrayTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/image/image.h"
 #include "render/render_options.h"
 
 namespace octray {
@@ -43,8 +44,11 @@ inline PixelRect render_rect(const RenderOptions& options, int width, int height
 // (render_packet_blocks, render_reference_blocks): each block non-empty and inside it, and
 // neither a crop nor a sample range (a block render traces every sample of its pixels).
 // Throws std::invalid_argument.
-inline void check_block_render(std::span<const PixelRect> blocks, const RgbImage& target,
+inline void check_block_render(std::span<const PixelRect> blocks, const Image& target,
                                int width, int height, const RenderOptions& options) {
+    if (!is_rgb_image(target))
+        throw std::invalid_argument(
+            "a block render writes into a render's image (float32 channels R, G and B)");
     if (target.width() != width || target.height() != height)
         throw std::invalid_argument("a block render writes into the whole " +
                                     std::to_string(width) + "x" + std::to_string(height) +
@@ -75,12 +79,13 @@ inline SampleRange render_sample_range(const RenderOptions& options, int spp,
         message += ")";
         throw std::invalid_argument(message);
     }
-    if (r.begin > 0 &&
-        (options.sample_sums == nullptr || options.sample_sums->width() != rect.width() ||
-         options.sample_sums->height() != rect.height()))
+    if (r.begin > 0 && (options.sample_sums == nullptr || !is_rgb_image(*options.sample_sums) ||
+                        options.sample_sums->width() != rect.width() ||
+                        options.sample_sums->height() != rect.height()))
         throw std::invalid_argument(
             "a sample range that starts after sample 0 needs the previous pass's sums "
-            "(RenderOptions::sample_sums) at the size of the rendered rectangle");
+            "(RenderOptions::sample_sums: float32 R, G, B) at the size of the rendered "
+            "rectangle");
     return r;
 }
 

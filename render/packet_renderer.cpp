@@ -201,16 +201,23 @@ TileScratch& scratch_for_thread() {
 // took 7-10 ms this way against 10-14 ms of faults (docs/performance-log.md, "Division-free
 // rejection in the BVH leaves, render_tile's loops, the first frame"). Advice only: a kernel
 // before Linux 5.14 refuses it, and the tiles' first touch maps the pages as before.
-void populate_frame(RgbImage& image) {
+void populate_frame(Image& image) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     constexpr std::size_t kPage = 4096, kChunk = std::size_t{2} << 20;
-    const auto at = reinterpret_cast<std::uintptr_t>(image.data());
-    const std::uintptr_t begin = (at + kPage - 1) & ~(kPage - 1);
-    const std::uintptr_t end = (at + image.pixel_count() * sizeof(Rgb)) & ~(kPage - 1);
-    if (end <= begin) return;
-    tbb::parallel_for(std::size_t{0}, (end - begin + kChunk - 1) / kChunk, [&](std::size_t c) {
-        const std::uintptr_t b = begin + c * kChunk, e = std::min(end, b + kChunk);
-        (void)madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_WRITE);
+    struct Range {
+        std::uintptr_t begin, end;
+    };
+    std::vector<Range> chunks;
+    for (ImageChannel& channel : image.channels) {
+        const auto at = reinterpret_cast<std::uintptr_t>(channel.samples.data());
+        const std::uintptr_t begin = (at + kPage - 1) & ~(kPage - 1);
+        const std::uintptr_t end = (at + channel.samples.size()) & ~(kPage - 1);
+        for (std::uintptr_t b = begin; b < end; b += kChunk)
+            chunks.push_back({b, std::min(end, b + kChunk)});
+    }
+    tbb::parallel_for(std::size_t{0}, chunks.size(), [&](std::size_t c) {
+        (void)madvise(reinterpret_cast<void*>(chunks[c].begin), chunks[c].end - chunks[c].begin,
+                      MADV_POPULATE_WRITE);
     });
 #else
     (void)image;
@@ -319,11 +326,11 @@ struct TileGrid {
 // Where a render's tiles go: the crop-sized image (and, for a progressive pass, the sums),
 // and which samples of each pixel to trace (render/crop.h).
 struct RenderTarget {
-    RgbImage& image;
-    PixelRect rect;                        // the pixels `image` holds; tiles lie inside it
-    SampleRange samples;                   // [0, spp) for a plain render
-    const RgbImage* start_sums = nullptr;  // sums of samples [0, samples.begin) or nullptr
-    RgbImage* sums = nullptr;              // a progressive pass: where the new sums go
+    Image& image;                       // R, G, B float32 planes (make_rgb_image)
+    PixelRect rect;                     // the pixels `image` holds; tiles lie inside it
+    SampleRange samples;                // [0, spp) for a plain render
+    const Image* start_sums = nullptr;  // sums of samples [0, samples.begin) or nullptr
+    Image* sums = nullptr;              // a progressive pass: where the new sums go
 };
 
 // Pixel blocks of 4 x 2 inside a tile: eight neighbouring pixels fill one packet at one
@@ -362,15 +369,16 @@ class PacketTracer {
         // A progressive pass adds its samples onto the previous passes' sums, so each pixel
         // still sums its samples one after the other in sample order.
         const int ox = tile.x0 - target.rect.x0, oy = tile.y0 - target.rect.y0;
-        if (target.start_sums != nullptr)
-            for (int y = 0; y < tile.height; ++y)
-                for (int x = 0; x < tile.width; ++x) {
-                    const std::size_t p = static_cast<std::size_t>(y) * tile.width + x;
-                    const Rgb start = target.start_sums->at(ox + x, oy + y);
-                    s.acc_r[p] = start.r;
-                    s.acc_g[p] = start.g;
-                    s.acc_b[p] = start.b;
-                }
+        if (target.start_sums != nullptr) {
+            float* const acc[3] = {s.acc_r.data(), s.acc_g.data(), s.acc_b.data()};
+            for (int c = 0; c < 3; ++c)
+                for (int y = 0; y < tile.height; ++y)
+                    std::copy_n(target.start_sums->plane(c) +
+                                    static_cast<std::size_t>(oy + y) *
+                                        static_cast<std::size_t>(target.rect.width()) +
+                                    static_cast<std::size_t>(ox),
+                                tile.width, acc[c] + static_cast<std::size_t>(y) * tile.width);
+        }
         if (s.levels.size() < static_cast<std::size_t>(scene_.max_depth) + 1)
             s.levels.resize(static_cast<std::size_t>(scene_.max_depth) + 1);
 
@@ -400,16 +408,14 @@ class PacketTracer {
         if (!control.proceed()) return false;  // stopped inside the last chunk's trees
         // The mean of the samples so far: all spp of them, unless a progressive pass.
         const auto samples_so_far = static_cast<float>(end_sample);
-        for (int y = 0; y < tile.height; ++y) {
-            const std::size_t row = static_cast<std::size_t>(y) * tile.width;
-            const float *r = s.acc_r.data() + row, *g = s.acc_g.data() + row,
-                        *b = s.acc_b.data() + row;
-            if (target.sums != nullptr) {
-                Rgb* sums = &target.sums->at(ox, oy + y);
-                for (int x = 0; x < tile.width; ++x) sums[x] = Rgb(r[x], g[x], b[x]);
+        const float* const acc[3] = {s.acc_r.data(), s.acc_g.data(), s.acc_b.data()};
+        for (int c = 0; c < 3; ++c)
+            for (int y = 0; y < tile.height; ++y) {
+                const float* sums = acc[c] + static_cast<std::size_t>(y) * tile.width;
+                if (target.sums != nullptr)
+                    std::copy_n(sums, tile.width, &target.sums->at(c, ox, oy + y));
+                stream_row(&target.image.at(c, ox, oy + y), sums, tile.width, samples_so_far);
             }
-            stream_row(&target.image.at(ox, oy + y), r, g, b, tile.width, samples_so_far);
-        }
         finish_streaming();
         return true;
     }
@@ -634,20 +640,17 @@ RenderResult render_frame(const CompiledScene& scene, FrameTree tree,
     // laid from the crop's corner; a pixel's value depends on neither.
     const PixelRect rect = render_rect(options, scene.width, scene.height);
     const SampleRange sample_range = render_sample_range(options, scene.spp, rect);
-    result.rect = rect;
-    result.full_width = scene.width;
-    result.full_height = scene.height;
     // Every pixel of the rectangle is written by its tile.
     // A frame in fresh storage (not a spare of the right size) has its pages mapped first.
-    const bool fresh_frame = options.spare_image == nullptr ||
-                             !options.spare_image->fits(rect.width(), rect.height());
-    result.image =
-        options.spare_image != nullptr
-            ? RgbImage::reuse(std::move(*options.spare_image), rect.width(), rect.height())
-            : RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
+    const PixelRect full{0, 0, scene.width, scene.height};
+    const bool fresh_frame =
+        options.spare_image == nullptr || !fits_rgb_storage(*options.spare_image, rect);
+    result.image = make_rgb_image(
+        rect, full, options.spare_image != nullptr ? std::move(*options.spare_image) : Image());
+    if (options.spare_image != nullptr) *options.spare_image = Image();
     RenderTarget target{result.image, rect, sample_range};
     if (options.samples) {
-        result.sample_sums = RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
+        result.sample_sums = make_rgb_image(rect, full);
         target.start_sums = sample_range.begin > 0 ? options.sample_sums : nullptr;
         target.sums = &result.sample_sums;
     }
@@ -777,15 +780,14 @@ PreparedScene::Update PreparedScene::update(const Scene& posed) {
 }
 
 RenderResult render_packet_blocks(const PreparedScene& prepared,
-                                  std::span<const PixelRect> blocks, RgbImage& target,
+                                  std::span<const PixelRect> blocks, Image& target,
                                   const RenderOptions& options, Isa isa) {
     const auto start = std::chrono::steady_clock::now();
     const CompiledScene& scene = prepared.compiled();
     check_block_render(blocks, target, scene.width, scene.height, options);
     const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
     RenderResult result;
-    result.full_width = scene.width;
-    result.full_height = scene.height;
+    result.image.display_window = PixelRect{0, 0, scene.width, scene.height};
     const RenderTarget out{target, PixelRect{0, 0, scene.width, scene.height},
                            SampleRange{0, scene.spp}};
     TileTallies tallies;

@@ -119,7 +119,7 @@ FirstHits trace_first_hits(const PreparedScene& scene, const RenderOptions& opti
 // sample range; std::runtime_error for a forced ISA the CPU lacks. The result carries the
 // rays and seconds; its image is empty (the pixels are in `target`).
 RenderResult render_packet_blocks(const PreparedScene& scene, std::span<const PixelRect> blocks,
-                                  RgbImage& target, const RenderOptions& options = {},
+                                  Image& target, const RenderOptions& options = {},
                                   Isa isa = Isa::automatic);
 
 }  // namespace octray

@@ -348,16 +348,12 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
     const PixelRect rect = render_rect(options, scene.image.width, scene.image.height);
     const SampleRange samples = render_sample_range(options, scene.image.spp, rect);
     const bool partial_samples = options.samples.has_value();
-    result.rect = rect;
-    result.full_width = scene.image.width;
-    result.full_height = scene.image.height;
     // Every pixel of the rectangle is written by its tile.
-    result.image =
-        options.spare_image != nullptr
-            ? RgbImage::reuse(std::move(*options.spare_image), rect.width(), rect.height())
-            : RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
-    if (partial_samples)
-        result.sample_sums = RgbImage(rect.width(), rect.height(), RgbImage::Uninitialized{});
+    const PixelRect full{0, 0, scene.image.width, scene.image.height};
+    result.image = make_rgb_image(
+        rect, full, options.spare_image != nullptr ? std::move(*options.spare_image) : Image());
+    if (options.spare_image != nullptr) *options.spare_image = Image();
+    if (partial_samples) result.sample_sums = make_rgb_image(rect, full);
     tbb::combinable<RayCounts> counts;
     TileControl control(options);
 
@@ -375,16 +371,16 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
                         if (!control.proceed()) return;
                         const int x = i - rect.x0, y = j - rect.y0;
                         if (!partial_samples) {
-                            result.image.at(x, y) =
-                                tracer.render_pixel(i, j, options.frame, local);
+                            set_rgb(result.image, x, y,
+                                    tracer.render_pixel(i, j, options.frame, local));
                             continue;
                         }
                         const Rgb start =
-                            samples.begin > 0 ? options.sample_sums->at(x, y) : Rgb();
+                            samples.begin > 0 ? rgb_at(*options.sample_sums, x, y) : Rgb();
                         const Rgb sum =
                             tracer.sum_samples(i, j, options.frame, samples, start, local);
-                        result.sample_sums.at(x, y) = sum;
-                        result.image.at(x, y) = sum / static_cast<float>(samples.end);
+                        set_rgb(result.sample_sums, x, y, sum);
+                        set_rgb(result.image, x, y, sum / static_cast<float>(samples.end));
                     }
                 control.done(static_cast<std::uint64_t>(tile.rows().size()) *
                              tile.cols().size());
@@ -400,13 +396,12 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options) 
 }
 
 RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRect> blocks,
-                                     RgbImage& target, const RenderOptions& options) {
+                                     Image& target, const RenderOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     check_block_render(blocks, target, scene.image.width, scene.image.height, options);
     const ReferenceTracer tracer(scene, reference_accel(options.accel), options.cancel);
     RenderResult result;
-    result.full_width = scene.image.width;
-    result.full_height = scene.image.height;
+    result.image.display_window = PixelRect{0, 0, scene.image.width, scene.image.height};
     tbb::combinable<RayCounts> counts;
     TileControl control(options);
     run_with_threads(options.threads, [&] {
@@ -423,7 +418,7 @@ RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRe
                             // A pixel the cancel flag cut short never reaches the caller's
                             // image.
                             if (!control.proceed()) return;
-                            target.at(i, j) = value;
+                            set_rgb(target, i, j, value);
                         }
                     control.done(static_cast<std::uint64_t>(r.width()) *
                                  static_cast<std::uint64_t>(r.height()));

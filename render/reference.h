@@ -105,6 +105,6 @@ RenderResult render_reference(const Scene& scene, const RenderOptions& options =
 // render_packet_blocks (render/packet_renderer.h) does, with its checks; each pixel is
 // the same pixel of render_reference's image. One tracer serves every block.
 RenderResult render_reference_blocks(const Scene& scene, std::span<const PixelRect> blocks,
-                                     RgbImage& target, const RenderOptions& options = {});
+                                     Image& target, const RenderOptions& options = {});
 
 }  // namespace octray

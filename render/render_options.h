@@ -11,12 +11,13 @@
 #include <string_view>
 #include <vector>
 
-#include "core/image.h"
 #include "core/pixel_rect.h"
 #include "render/accel.h"
 #include "scene/json_rules.h"
 
 namespace octray {
+
+struct Image;  // render/image/image.h
 
 // Which renderer traces a frame: the SIMD packet path (render/packet_renderer.h) or the
 // scalar reference (render/reference.h). `--path simd|scalar` of `render` and `bench`.
@@ -73,10 +74,10 @@ struct RenderOptions {
     // finished tile's pixel count to *pixels_done (progress).
     const std::atomic<bool>* cancel = nullptr;
     std::atomic<std::uint64_t>* pixels_done = nullptr;
-    // A spent image whose storage the render may take for its own (RgbImage::reuse: when
-    // the pixel counts agree; it is left empty then). The frame loop hands back each frame
-    // it has written, so a batch maps its frame's pages once, not once per frame.
-    RgbImage* spare_image = nullptr;
+    // A spent image whose storage the render may take for its own (make_rgb_image's
+    // `spare`: when the pixel counts agree); it is left empty. The frame loop hands back
+    // each frame it has written, so a batch maps its frame's pages once, not once per frame.
+    Image* spare_image = nullptr;
     // Render only these pixels of the full image (render/README.md, "Crops"): the result
     // image is crop-sized and each pixel equals the same pixel of the full render bit for
     // bit. Must be non-empty and inside the image (else std::invalid_argument).
@@ -86,7 +87,7 @@ struct RenderOptions {
     // [0, begin), crop-sized; nullptr when begin == 0). The result then also carries the
     // new sums; its image is sums / end. Unset: every sample, as a plain render.
     std::optional<SampleRange> samples;
-    const RgbImage* sample_sums = nullptr;
+    const Image* sample_sums = nullptr;
     // The SIMD path's acceleration structure for spheres (`--accel`, render/accel.h): auto
     // builds a BVH from kBvhAutoMinSpheres spheres on. The image is the same either way;
     // the scalar reference ignores it (brute force always).

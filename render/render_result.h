@@ -1,12 +1,12 @@
 #pragma once
-// What a render gives back: its pixels and window (RenderResult), and the first hits the
+// What a render gives back: its pixels and windows (RenderResult), and the first hits the
 // AOVs are made from (FirstHits). What it is asked: render/render_options.h.
 
 #include <cstdint>
 #include <vector>
 
-#include "core/image.h"
 #include "core/pixel_rect.h"
+#include "render/image/image.h"
 #include "render/render_options.h"
 
 namespace octray {
@@ -22,16 +22,15 @@ struct FirstHits {
 };
 
 struct RenderResult {
-    RgbImage image;  // the pixels of `rect` (crop-sized); (0, 0) is pixel (rect.x0, rect.y0)
-    // Which pixels of the full_width x full_height image `image` holds: the crop, or the
-    // whole image. An EXR writer makes `rect` the data window and the full image the
-    // display window (render/image/image_io.h, make_image).
-    PixelRect rect;
-    int full_width = 0;
-    int full_height = 0;
+    // The pixels: float32 channels R, G, B (make_rgb_image, render/image/image.h) of the
+    // pixels the render covered, its data window (the crop, or the whole image), inside a
+    // display window of the whole image; pixel (0, 0) of the planes is the data window's
+    // corner. A block render (render_packet_blocks) writes into its target instead and
+    // leaves this without channels, its display window the whole image.
+    Image image;
     // With RenderOptions::samples: the per-pixel sums of samples [0, samples->end), to pass
-    // on as the next pass's sample_sums. Empty otherwise.
-    RgbImage sample_sums;
+    // on as the next pass's sample_sums (an image like `image`). Empty otherwise.
+    Image sample_sums;
     RayCounts rays;
     double seconds = 0.0;  // wall-clock time of the render itself
     // The parts of `seconds` spent compiling the scene and building its BVH (0 where the

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "core/image.h"
 #include "render/batch/assemble.h"
+#include "render/image/image.h"
 #include "render/image/image_io.h"
 #include "render/image/image_read.h"
 #include "tools/cli_checks.h"
@@ -35,15 +35,11 @@ batch::AssembleSummary assemble_png(const std::vector<std::string>& part_paths,
         throw UsageError("-o " + output +
                          ": a PNG holds R, G, B, and the parts have no R, G and B channels; "
                          "write an OpenEXR (.exr) instead");
-    const int width = full.data_window.width(), height = full.data_window.height();
-    RgbImage image(width, height);
-    for (int y = 0; y < height; ++y) {
-        for (int x = 0; x < width; ++x) {
-            const std::size_t k =
-                static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                static_cast<std::size_t>(x);
-            image.at(x, y) = Rgb{rgb[0]->value(k), rgb[1]->value(k), rgb[2]->value(k)};
-        }
+    // R, G, B as float32, in that order: the picture a render hands to its preview.
+    Image image = make_rgb_image(full.data_window, full.display_window);
+    for (int c = 0; c < 3; ++c) {
+        float* plane = image.plane(c);
+        for (std::size_t k = 0; k < image.pixel_count(); ++k) plane[k] = rgb[c]->value(k);
     }
     write_png_preview(output, image);
     batch::AssembleSummary summary;

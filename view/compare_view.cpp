@@ -1,5 +1,6 @@
 #include "view/compare_view.h"
 
+#include <algorithm>
 #include <array>
 #include <set>
 #include <stdexcept>
@@ -10,19 +11,18 @@ namespace octray::view {
 namespace {
 
 // Channels `source` (red, green, blue) of `image` as a picture; black without channels.
-RgbImage picture_of(const Image& image, const std::array<int, 3>& source) {
-    RgbImage rgb(image.width(), image.height());
+Image picture_of(const Image& image, const std::array<int, 3>& source) {
+    Image rgb(image.width(), image.height(), {"R", "G", "B"});
     if (source[0] < 0) return rgb;
-    for (int y = 0; y < image.height(); ++y)
-        for (int x = 0; x < image.width(); ++x)
-            rgb.at(x, y) = Rgb{image.at(source[0], x, y), image.at(source[1], x, y),
-                               image.at(source[2], x, y)};
+    for (int c = 0; c < 3; ++c)
+        std::copy_n(image.plane(source[static_cast<std::size_t>(c)]), image.pixel_count(),
+                    rgb.plane(c));
     return rgb;
 }
 
 }  // namespace
 
-RgbImage display_rgb(const Image& image) {
+Image display_rgb(const Image& image) {
     std::array<int, 3> source{image.channel_index("R"), image.channel_index("G"),
                               image.channel_index("B")};
     if (source[0] < 0 || source[1] < 0 || source[2] < 0) {
@@ -47,7 +47,7 @@ std::vector<std::string> display_layers(const Image& image) {
     return layers;
 }
 
-RgbImage display_rgb(const Image& image, const std::string& layer) {
+Image display_rgb(const Image& image, const std::string& layer) {
     if (layer.empty()) return display_rgb(image);
     const auto find = [&](const char* suffix) {
         return image.channel_index(layer + "." + suffix);

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "core/image.h"
 #include "render/image/error_heatmap.h"
+#include "render/image/image.h"
 #include "render/image/image_compare.h"
 #include "render/image/image_read.h"
 
@@ -24,7 +24,7 @@ struct CompareView {
     CompareOptions options;
     CompareResult result;
     std::string figures_json;  // format_compare_json(): the figures of `octray compare --json`
-    RgbImage rgb_a, rgb_b, rgb_diff;
+    Image rgb_a, rgb_b, rgb_diff;  // float32 R, G, B planes
     ErrorHeatmap heatmap;  // render_error_heatmap() with compare's defaults (8-bit sRGB)
     // The layers the page can show (display_layers of A; B has the same channels): "" the
     // colour, then each AOV ("N", "albedo", "depth", "id", ...).
@@ -39,7 +39,7 @@ std::vector<std::string> display_layers(const Image& image);
 // The displayed RGB of `layer` of a channel image: its channels R, G, B or X, Y, Z as
 // colour, else its first channel as gray (an unprefixed layer: that channel). Throws
 // std::invalid_argument for a layer the image does not have.
-RgbImage display_rgb(const Image& image, const std::string& layer);
+Image display_rgb(const Image& image, const std::string& layer);
 
 // Reads and compares the two files. Throws IoError (unreadable, not an image: `octray
 // compare`'s exit 4) or ImageMismatch (sizes or channels differ: its exit 3), as compare.
@@ -47,6 +47,6 @@ CompareView load_compare_view(const std::string& path_a, const std::string& path
                               const CompareOptions& options = {});
 
 // The displayed RGB of a channel image (see CompareView).
-RgbImage display_rgb(const Image& image);
+Image display_rgb(const Image& image);
 
 }  // namespace octray::view

@@ -1,17 +1,19 @@
 #include "view/tone_map.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "render/image/image_io.h"
 #include "view/jpeg.h"
 
 namespace octray::view {
 
-std::vector<std::uint8_t> tone_map_srgb8(const RgbImage& image, float exposure) {
-    static_assert(sizeof(Rgb) == 3 * sizeof(float));
+std::vector<std::uint8_t> tone_map_srgb8(const Image& image, float exposure) {
+    if (!is_rgb_image(image))
+        throw std::invalid_argument("tone_map_srgb8: a picture is float32 R, G, B planes");
     std::vector<std::uint8_t> rgb(3 * image.pixel_count());
-    srgb8_scaled(reinterpret_cast<const float*>(image.data()), rgb.size(), std::exp2(exposure),
-                 rgb.data());
+    srgb8_interleaved(image.plane(0), image.plane(1), image.plane(2), image.pixel_count(),
+                      std::exp2(exposure), rgb.data());
     return rgb;
 }
 

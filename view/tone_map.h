@@ -7,14 +7,16 @@
 #include <string>
 #include <vector>
 
-#include "core/image.h"
+#include "render/image/image.h"
 #include "view/view_session.h"
 
 namespace octray::view {
 
 // RGB bytes, row 0 on top: each channel min(max(v * 2^exposure, 0), 1) through the sRGB
 // OETF (IEC 61966-2-1), rounded to nearest. NaN maps to 0.
-std::vector<std::uint8_t> tone_map_srgb8(const RgbImage& image, float exposure);
+// `image`: a render's picture (float32 R, G, B planes, render/image/image.h); else throws
+// std::invalid_argument.
+std::vector<std::uint8_t> tone_map_srgb8(const Image& image, float exposure);
 
 // A picture as the page's picture stream sends it (README, "Transport"): tone-mapped at
 // `exposure`; the refined picture (not a preview, the last pass, all of it rendered with

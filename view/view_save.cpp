@@ -155,17 +155,12 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
     }
     RenderResult result;
     result.image = frame->image;
-    result.rect = PixelRect{0, 0, frame->image.width(), frame->image.height()};
-    result.full_width = frame->image.width();
-    result.full_height = frame->image.height();
     result.rays = frame->rays;
     result.seconds = frame->render_seconds;
     const ExrAttributes attributes = batch::render_exr_attributes(
         identity, posed, animation_frame, result, path_label(frame->path, frame->isa),
         posed.image.spp, std::string());
-    write_exr((directory / name).string(),
-              make_image(result.image, result.rect, result.full_width, result.full_height,
-                         ExrWriteOptions{}, attributes));
+    write_exr((directory / name).string(), result.image, ExrWriteOptions{}, attributes);
 
     std::string command = "octray render " + shell_word(identity.spec) + " --width " +
                           std::to_string(posed.image.width) + " --height " +

@@ -156,10 +156,10 @@ float exposure_param(const httplib::Request& req) {
 
 // {"x": X, "y": Y, "width": W, "height": H, "rgb": [r, g, b]}: the linear value of pixel
 // (x, y) of `image` (non-finite values as the strings "nan", "inf", "-inf").
-json pixel_json(const httplib::Request& req, const RgbImage& image) {
+json pixel_json(const httplib::Request& req, const Image& image) {
     const int x = integer_param(req, "x", 0, image.width() - 1);
     const int y = integer_param(req, "y", 0, image.height() - 1);
-    const Rgb& p = image.at(x, y);
+    const Rgb p = rgb_at(image, x, y);
     const auto value = [](float v) -> json {
         if (std::isnan(v)) return "nan";
         if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
@@ -172,10 +172,15 @@ json pixel_json(const httplib::Request& req, const RgbImage& image) {
                 {"rgb", json::array({value(p.r), value(p.g), value(p.b)})}};
 }
 
-std::string float_bytes(const RgbImage& image) {
-    static_assert(sizeof(Rgb) == 3 * sizeof(float));
-    return std::string(reinterpret_cast<const char*>(image.data()),
-                       image.pixel_count() * sizeof(Rgb));
+// The picture's floats interleaved, r g b per pixel, row 0 first (what the page reads).
+std::string float_bytes(const Image& image) {
+    const std::size_t n = image.pixel_count();
+    std::vector<float> rgb(3 * n);
+    for (int c = 0; c < 3; ++c) {
+        const float* plane = image.plane(c);
+        for (std::size_t i = 0; i < n; ++i) rgb[3 * i + static_cast<std::size_t>(c)] = plane[i];
+    }
+    return std::string(reinterpret_cast<const char*>(rgb.data()), rgb.size() * sizeof(float));
 }
 
 // One message of /api/pictures: "OCTP", the lengths of `header` and `picture` (uint32,
@@ -221,7 +226,7 @@ struct ViewServer::Impl {
     // `octray view A B`: the pictures of layers other than the colour, by (picture, layer),
     // made when first asked for (std::map: references to them stay valid).
     std::mutex layer_mutex;
-    std::map<std::pair<std::string, std::string>, RgbImage> layer_pictures;
+    std::map<std::pair<std::string, std::string>, Image> layer_pictures;
     std::mutex stop_mutex;
 
     Impl(ViewSession* s, const CompareView* c, ServerOptions o)
@@ -488,7 +493,7 @@ void ViewServer::Impl::compare_routes() {
     });
     // picture=a (default), b or diff: the linear RGB picture; layer= one of the status's
     // layers (default "": the colour), each made once when first asked for.
-    const auto picture = [this, &view](const httplib::Request& req) -> const RgbImage& {
+    const auto picture = [this, &view](const httplib::Request& req) -> const Image& {
         const std::string name =
             req.has_param("picture") ? req.get_param_value("picture") : "a";
         const std::string layer = req.has_param("layer") ? req.get_param_value("layer") : "";
@@ -526,14 +531,14 @@ void ViewServer::Impl::compare_routes() {
             res.set_content(encode_png(view.heatmap.image), "image/png");
             return;
         }
-        const RgbImage& image = picture(req);
+        const Image& image = picture(req);
         res.set_content(
             encode_png_rgb8(image.width(), image.height(), tone_map_srgb8(image, exposure)),
             "image/png");
     });
     server.Get("/api/image.f32",
                [picture](const httplib::Request& req, httplib::Response& res) {
-                   const RgbImage& image = picture(req);
+                   const Image& image = picture(req);
                    res.set_header("X-Octray-Width", std::to_string(image.width()));
                    res.set_header("X-Octray-Height", std::to_string(image.height()));
                    res.set_content(float_bytes(image), "application/octet-stream");

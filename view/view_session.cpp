@@ -288,7 +288,7 @@ void ViewSession::run_frameless() {
         frameless_blocks(width, height, std::max(1, settings_.frameless_block));
     // About 16 pictures a sweep, of at least 16 blocks each (enough work for the threads).
     const std::size_t batch_size = std::max<std::size_t>(16, blocks.size() / 16);
-    RgbImage framebuffer(width, height);
+    Image framebuffer(width, height, {"R", "G", "B"});  // black until rendered
     std::vector<PixelRect> batch;
     std::size_t cursor = 0;             // next block of the permutation
     std::size_t fresh = blocks.size();  // blocks rendered with the current camera

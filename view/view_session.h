@@ -14,8 +14,8 @@
 #include <string>
 #include <thread>
 
-#include "core/image.h"
 #include "kernels/isa.h"
+#include "render/image/image.h"
 #include "render/packet_renderer.h"
 #include "render/render_config.h"
 #include "render/render_options.h"
@@ -61,7 +61,7 @@ std::optional<PixelOrder> parse_pixel_order(const std::string& name);
 
 // One published picture and how it was made.
 struct ViewFrame {
-    RgbImage image;                    // linear RGB, row 0 on top
+    Image image;  // linear float32 R, G, B planes (make_rgb_image), row 0 on top
     std::uint64_t generation = 0;      // 1, 2, 3, ... in publishing order
     std::uint64_t camera_version = 0;  // which set_camera() call it shows (1: the scene's)
     Camera camera;

@@ -132,8 +132,8 @@ Image assemble_parts(const std::vector<Image>& parts, const std::vector<std::str
     out.compression = first.compression;
     out.attributes = first.attributes;
     for (const ImageChannel& c : first.channels)
-        out.channels.push_back(ImageChannel{
-            c.name, c.format, std::vector<unsigned char>(pixels * sample_size(c.format))});
+        out.channels.push_back(
+            ImageChannel{c.name, c.format, SampleBytes(pixels * sample_size(c.format), 0)});
     const std::size_t width = static_cast<std::size_t>(display.width());
     for (const Image& p : parts) {
         const PixelRect& r = p.data_window;

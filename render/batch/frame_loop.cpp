@@ -91,7 +91,7 @@ struct FrameFiles {
 
     // Both are written atomically, each on its own; the frame counts as finished only
     // when both are (resume.h).
-    void write(const RgbImage& pixels) const {
+    void write(const Image& pixels) const {
         if (exr_path.empty()) {
             write_png_preview(png_path, pixels);
         } else if (png_path.empty()) {
@@ -112,7 +112,7 @@ struct PendingWrite {
     std::string claimed;  // its placeholder, released if the write fails
     Clock::time_point started;
     FrameFiles files;
-    RgbImage pixels;
+    Image pixels;  // the render's R, G, B (the preview's source)
     double seconds = 0.0;
     std::exception_ptr report_error;  // what reporting it threw, rethrown when joined
     std::thread writer;
@@ -161,9 +161,9 @@ class BatchRunner {
     std::string owner_;  // octray.owner of this run's unfinished passes
     // The last frame written: the next frame renders into its storage (RenderOptions::
     // spare_image), so only a run's first frame maps fresh pages for its pixels.
-    RgbImage spare_frame_;
+    Image spare_frame_;
     // The channels of the last EXR written, converted into again by the next (the same
-    // reason: make_image's `spare`).
+    // reason: make_exr_image's `spare`).
     std::vector<ImageChannel> spare_channels_;
     // The frames of scene renderer_index_, posed and prepared once (FrameRenderer).
     // (A pointer: g++ 12 takes an optional holding an optional for maybe-uninitialized.)
@@ -235,10 +235,9 @@ FrameFiles BatchRunner::files(const BatchScene& scene, const BatchJob& job, cons
     }
     f.exr_path = job.output;
     f.png_path = job.png;
-    f.exr =
-        make_image(result.image, result.rect, result.full_width, result.full_height,
-                   settings_.exr, attributes(scene, posed, job.frame, result, samples_so_far),
-                   std::move(spare_channels_));
+    f.exr = make_exr_image(result.image, settings_.exr,
+                           attributes(scene, posed, job.frame, result, samples_so_far),
+                           std::move(spare_channels_));
     if (!aovs.channels.empty())
         append_aov_channels(f.exr, aovs,
                             settings_.exr.float32 ? PixelFormat::float32 : PixelFormat::half);
@@ -403,7 +402,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
                                          : static_cast<std::uint64_t>(posed.image.width) *
                                                static_cast<std::uint64_t>(posed.image.height);
         if (spare_frame_.pixel_count() != pixels) {
-            spare_frame_ = RgbImage();
+            spare_frame_ = Image();
             spare_channels_.clear();
         }
         options.spare_image = &spare_frame_;

@@ -29,12 +29,12 @@ std::uint64_t sat_mul(std::uint64_t a, std::uint64_t b) {
 }
 std::uint64_t u64(int v) { return v > 0 ? static_cast<std::uint64_t>(v) : 0; }
 
-// core/image.h: one Rgb (three floats) per pixel.
+// render/image/image.h make_rgb_image: a render's image, three float32 planes.
 constexpr std::uint64_t kFramebufferBytesPerPixel = 12;
 // render/batch/progressive.cpp: while a pass renders, the last pass's image and sample sums are
 // kept, and the pass makes its own: four images.
 constexpr std::uint64_t kProgressiveImages = 4;
-// render/image/exr_write.cpp make_image and render/aov.cpp append_aov_channels: every
+// render/image/exr_write.cpp make_exr_image and render/aov.cpp append_aov_channels: every
 // channel is copied into the EXR image, as half (2 bytes) or float (4); the id AOV is
 // UINT (4).
 constexpr std::uint64_t kColorChannels = 3;

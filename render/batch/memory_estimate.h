@@ -4,15 +4,15 @@
 // --max-memory`), and the parser for sizes such as "512M" or "4G".
 //
 // The estimate counts what the process really allocates, from the layouts in
-// core/image.h, scene/compile.h, render/prepare/bvh_build.cpp, render/packet_renderer.cpp (its
-// tile scratch: render/tile_layout.h), render/batch/progressive.cpp, render/aov.h,
-// render/image/exr_write.cpp, render/image/png.cpp and render/batch/frame_loop.cpp,
-// plus the process's own fixed footprint and the parse of a scene file; it is meant to be
-// an upper bound of the peak resident set size (tests/batch/memory_estimate_test.cpp
-// measures it). It errs on the high side: the packet path's per-thread ray streams are
-// sized as if every generation of a tile held a full chunk of rays at once
-// (tests/render/packet_renderer_test.cpp checks a thread's scratch against it), the BVH's
-// build buffers as if they lived through the render.
+// render/image/image.h, scene/compile.h, render/prepare/bvh_build.cpp,
+// render/packet_renderer.cpp (its tile scratch: render/tile_layout.h),
+// render/batch/progressive.cpp, render/aov.h, render/image/exr_write.cpp, render/image/png.cpp
+// and render/batch/frame_loop.cpp, plus the process's own fixed footprint and the parse of a
+// scene file; it is meant to be an upper bound of the peak resident set size
+// (tests/batch/memory_estimate_test.cpp measures it). It errs on the high side: the packet
+// path's per-thread ray streams are sized as if every generation of a tile held a full chunk of
+// rays at once (tests/render/packet_renderer_test.cpp checks a thread's scratch against it),
+// the BVH's build buffers as if they lived through the render.
 
 #include <cstdint>
 #include <optional>

@@ -43,7 +43,7 @@ RenderResult render_progressive(const PassRenderer& render, int spp,
     result.seconds = seconds;
     result.compile_seconds = compile_seconds;
     result.bvh_seconds = bvh_seconds;
-    result.sample_sums = RgbImage();
+    result.sample_sums = Image();
     return result;
 }
 

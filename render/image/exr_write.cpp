@@ -472,7 +472,10 @@ void write_exr_file(const std::string& path, const Image& image) {
         write_exr_with_openexr(path, image, header);
 }
 
-void require_image(const RgbImage& image) {
+void require_render_image(const Image& image) {
+    if (!is_rgb_image(image))
+        throw std::invalid_argument(
+            "the image is not a render's (float32 channels R, G and B, one sample a pixel)");
     if (image.width() <= 0 || image.height() <= 0)
         throw std::invalid_argument("the image is empty (" + std::to_string(image.width()) +
                                     "x" + std::to_string(image.height()) + ")");
@@ -529,28 +532,24 @@ ExrRational exr_rational(double value) {
     return {r.n, r.d};
 }
 
-Image make_image(const RgbImage& image, PixelRect data_window, int full_width, int full_height,
-                 const ExrWriteOptions& options, const ExrAttributes& attributes,
-                 std::vector<ImageChannel> spare) {
-    if (image.width() != data_window.width() || image.height() != data_window.height())
-        throw std::invalid_argument("make_image: a " + std::to_string(image.width()) + "x" +
-                                    std::to_string(image.height()) +
-                                    " image cannot fill the data window " +
-                                    window_text(data_window));
+Image make_exr_image(const Image& render, const ExrWriteOptions& options,
+                     const ExrAttributes& attributes, std::vector<ImageChannel> spare) {
     Image exr;
-    exr.display_window = PixelRect{0, 0, full_width, full_height};
-    exr.data_window = data_window;
+    exr.display_window = render.display_window;
+    exr.data_window = render.data_window;
     exr.compression = options.compression;
     exr.attributes = attributes;
     const PixelFormat type = options.float32 ? PixelFormat::float32 : PixelFormat::half;
-    const float* rgb = reinterpret_cast<const float*>(image.data());
-    const std::size_t n = image.pixel_count();
-    const auto storage = [&spare](std::size_t k) {
-        return k < spare.size() ? std::move(spare[k].samples) : std::vector<unsigned char>();
-    };
-    exr.channels.push_back(make_channel("R", type, rgb + 0, n, 3, storage(0)));
-    exr.channels.push_back(make_channel("G", type, rgb + 1, n, 3, storage(1)));
-    exr.channels.push_back(make_channel("B", type, rgb + 2, n, 3, storage(2)));
+    for (std::size_t k = 0; k < render.channels.size(); ++k) {
+        const ImageChannel& c = render.channels[k];
+        if (c.format != PixelFormat::float32)
+            throw std::invalid_argument("make_exr_image: channel " + c.name + " is " +
+                                        std::string(to_string(c.format)) +
+                                        ", not a render's float32");
+        SampleBytes storage = k < spare.size() ? std::move(spare[k].samples) : SampleBytes();
+        exr.channels.push_back(
+            make_channel(c.name, type, c.floats(), c.size(), 1, std::move(storage)));
+    }
     return exr;
 }
 
@@ -563,15 +562,14 @@ void write_exr(const std::string& path, const Image& image) {
     write_file_atomically(path, [&](const std::string& tmp) { write_exr_file(tmp, image); });
 }
 
-void write_exr(const std::string& path, const RgbImage& image, const ExrWriteOptions& options,
+void write_exr(const std::string& path, const Image& render, const ExrWriteOptions& options,
                const ExrAttributes& attributes) {
     try {
-        require_image(image);
+        require_render_image(render);
     } catch (const std::exception& e) {
         throw IoError("cannot write " + path + ": " + e.what());
     }
-    write_exr(path, make_image(image, PixelRect{0, 0, image.width(), image.height()},
-                               image.width(), image.height(), options, attributes));
+    write_exr(path, make_exr_image(render, options, attributes));
 }
 
 void set_exr_thread_count(int threads) { Imf::setGlobalThreadCount(threads); }

@@ -79,8 +79,7 @@ std::uint32_t ImageChannel::uint_value(std::size_t k) const {
 }
 
 ImageChannel make_channel(std::string name, PixelFormat format, const float* values,
-                          std::size_t count, std::size_t stride,
-                          std::vector<unsigned char> storage) {
+                          std::size_t count, std::size_t stride, SampleBytes storage) {
     if (format != PixelFormat::half && format != PixelFormat::float32)
         throw std::invalid_argument("make_channel: floats make half or float channels");
     // Storage of another size is not kept: its capacity would outlast this channel.
@@ -102,22 +101,60 @@ ImageChannel make_channel(std::string name, PixelFormat format, const float* val
 
 ImageChannel make_channel(std::string name, const std::vector<std::uint32_t>& values) {
     ImageChannel c{std::move(name), PixelFormat::uint32,
-                   std::vector<unsigned char>(values.size() * sizeof(std::uint32_t))};
+                   SampleBytes(values.size() * sizeof(std::uint32_t))};  // written below
     if (!values.empty()) std::memcpy(c.samples.data(), values.data(), c.samples.size());
     return c;
 }
 
 ImageChannel make_channel(std::string name, const std::vector<std::uint8_t>& values) {
     return ImageChannel{std::move(name), PixelFormat::uint8,
-                        std::vector<unsigned char>(values.begin(), values.end())};
+                        SampleBytes(values.begin(), values.end())};
 }
 
 Image::Image(int width, int height, const std::vector<std::string>& names) {
     display_window = data_window = PixelRect{0, 0, width, height};
     const std::size_t bytes = pixel_count() * sizeof(float);
     for (const std::string& name : names)
-        channels.push_back(
-            ImageChannel{name, PixelFormat::float32, std::vector<unsigned char>(bytes)});
+        channels.push_back(ImageChannel{name, PixelFormat::float32, SampleBytes(bytes, 0)});
+}
+
+Image make_rgb_image(PixelRect data_window, PixelRect display_window, Image spare) {
+    Image image;
+    image.data_window = data_window;
+    image.display_window = display_window;
+    const std::size_t bytes = data_window.pixel_count() * sizeof(float);
+    const char* const names[3] = {"R", "G", "B"};
+    for (std::size_t c = 0; c < 3; ++c) {
+        SampleBytes samples;
+        if (c < spare.channels.size() && spare.channels[c].samples.size() == bytes)
+            samples = std::move(spare.channels[c].samples);
+        image.channels.push_back(ImageChannel{names[c], PixelFormat::float32, {}});
+        image.channels.back().samples = std::move(samples);
+    }
+    spare = Image();  // whatever was not taken is freed before the new storage is mapped
+    for (ImageChannel& c : image.channels)
+        if (c.samples.size() != bytes) c.samples.resize(bytes);  // unwritten
+    return image;
+}
+
+bool fits_rgb_storage(const Image& spare, PixelRect data_window) {
+    const std::size_t bytes = data_window.pixel_count() * sizeof(float);
+    if (spare.channels.size() < 3) return false;
+    for (std::size_t c = 0; c < 3; ++c)
+        if (spare.channels[c].samples.size() != bytes) return false;
+    return true;
+}
+
+bool is_rgb_image(const Image& image) {
+    if (image.channels.size() != 3) return false;
+    const char* const names[3] = {"R", "G", "B"};
+    for (std::size_t c = 0; c < 3; ++c) {
+        const ImageChannel& channel = image.channels[c];
+        if (channel.name != names[c] || channel.format != PixelFormat::float32 ||
+            channel.size() != image.pixel_count())
+            return false;
+    }
+    return true;
 }
 
 const ImageChannel* Image::find_channel(std::string_view name) const {
@@ -144,6 +181,18 @@ bool Image::all_float32() const {
     return true;
 }
 
+std::vector<Rgb> rgb_pixels(const Image& image) {
+    std::vector<Rgb> out(image.pixel_count());
+    for (std::size_t k = 0; k < out.size(); ++k)
+        out[k] = Rgb(image.plane(0)[k], image.plane(1)[k], image.plane(2)[k]);
+    return out;
+}
+
+bool same_pixels(const Image& a, const Image& b) {
+    return a.data_window == b.data_window && a.display_window == b.display_window &&
+           a.channels == b.channels;
+}
+
 Image to_float32(const Image& image) {
     Image out;
     out.display_window = image.display_window;
@@ -156,8 +205,7 @@ Image to_float32(const Image& image) {
             out.channels.push_back(c);
             continue;
         }
-        ImageChannel f{c.name, PixelFormat::float32,
-                       std::vector<unsigned char>(c.size() * sizeof(float))};
+        ImageChannel f{c.name, PixelFormat::float32, SampleBytes(c.size() * sizeof(float))};
         float* values = f.floats();
         for (std::size_t k = 0; k < c.size(); ++k) values[k] = c.value(k);
         out.channels.push_back(std::move(f));

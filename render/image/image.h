@@ -2,10 +2,10 @@
 // octray's image: named channels, each in its own pixel format and stored planar, a data
 // window inside a display window, and the metadata a file carries (compression and header
 // attributes). Every image octray reads, writes, compares or shows is one: a render on its
-// way to a file (make_image, image_io.h), its AOVs (render/aov.h), a file read back
+// way to a file (make_exr_image, image_io.h), its AOVs (render/aov.h), a file read back
 // (read_image, image_read.h), a difference image, the error heatmap (8-bit channels), a
-// part of `octray assemble`, the viewer's pictures. The renderers themselves fill an
-// RgbImage (core/image.h), their interleaved float framebuffer, and hand it on as one.
+// part of `octray assemble`, the viewer's pictures. The renderers fill one: a render's
+// result is an Image of float32 R, G, B channels (render/render_result.h).
 //
 // Reading and writing: image_io.h (write_exr, write_png) and image_read.h (read_image,
 // read_exr_image); comparing: image_compare.h (compare_images, difference_image).
@@ -19,6 +19,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/aligned.h"
+#include "core/color.h"
 #include "core/pixel_rect.h"
 
 namespace octray {
@@ -29,12 +31,17 @@ enum class PixelFormat { uint8, half, float32, uint32 };
 std::string_view to_string(PixelFormat format);  // "uint8", "half", "float", "uint"
 std::size_t sample_size(PixelFormat format);     // 1, 2, 4, 4 bytes
 
+// A channel's bytes: 64-byte aligned, and resize() leaves new bytes unwritten, so that a
+// renderer sizes a frame without zeroing it and its pages are first touched by the
+// threads that fill them (core/aligned.h). SampleBytes(n, 0) is n zero bytes.
+using SampleBytes = UninitializedVector<unsigned char>;
+
 // One channel: a sample per pixel of the data window, row by row (top row first), each in
 // the channel's own format and native byte order (half: the 16 bits of an IEEE binary16).
 struct ImageChannel {
     std::string name;
     PixelFormat format = PixelFormat::half;
-    std::vector<unsigned char> samples;
+    SampleBytes samples;
 
     std::size_t size() const { return samples.size() / sample_size(format); }
     // Sample k as a float (a uint32 is converted and may round above 2^24; a uint8 is
@@ -45,7 +52,7 @@ struct ImageChannel {
     // Same name, format and bytes (a NaN equals the same NaN; -0 differs from +0).
     friend bool operator==(const ImageChannel&, const ImageChannel&) = default;
 
-    // The samples of a float32 channel (std::vector's storage is aligned for any scalar).
+    // The samples of a float32 channel (the storage is aligned for any scalar).
     float* floats() { return reinterpret_cast<float*>(samples.data()); }
     const float* floats() const { return reinterpret_cast<const float*>(samples.data()); }
 };
@@ -56,8 +63,7 @@ struct ImageChannel {
 // zeroed nor mapped afresh; storage of another size is freed first. Throws
 // std::invalid_argument for another format.
 ImageChannel make_channel(std::string name, PixelFormat format, const float* values,
-                          std::size_t count, std::size_t stride = 1,
-                          std::vector<unsigned char> storage = {});
+                          std::size_t count, std::size_t stride = 1, SampleBytes storage = {});
 // A uint32 channel, and a uint8 one.
 ImageChannel make_channel(std::string name, const std::vector<std::uint32_t>& values);
 ImageChannel make_channel(std::string name, const std::vector<std::uint8_t>& values);
@@ -160,6 +166,37 @@ struct Image {
                static_cast<std::size_t>(x);
     }
 };
+
+// ---- A render's pixels -----------------------------------------------------------------
+
+// What a renderer hands back: float32 channels "R", "G", "B" (channels 0, 1, 2) of the
+// pixels of `data_window` (a crop, or the whole image) inside `display_window` (the whole
+// image). The samples are unwritten: the renderer writes every one. Each channel takes
+// the storage of `spare`'s channel of its index where that holds exactly its bytes (a
+// frame loop hands back the frame it has written, and the next frame then maps no fresh
+// pages); `spare` is freed first otherwise, so two frames are never held at once.
+Image make_rgb_image(PixelRect data_window, PixelRect display_window, Image spare = {});
+// Whether make_rgb_image(data_window, ..., spare) takes all of its storage from `spare`.
+bool fits_rgb_storage(const Image& spare, PixelRect data_window);
+// Whether `image` is one: channels R, G, B, float32, sized to its data window.
+bool is_rgb_image(const Image& image);
+// Pixel (x, y) of its data window (0, 0 its first pixel), and setting it.
+inline Rgb rgb_at(const Image& image, int x, int y) {
+    return Rgb(image.at(0, x, y), image.at(1, x, y), image.at(2, x, y));
+}
+inline void set_rgb(Image& image, int x, int y, const Rgb& value) {
+    image.at(0, x, y) = value.r, image.at(1, x, y) = value.g, image.at(2, x, y) = value.b;
+}
+// Pixel k of the planes (k = y * width() + x).
+inline Rgb rgb_at(const Image& image, std::size_t k) {
+    return Rgb(image.plane(0)[k], image.plane(1)[k], image.plane(2)[k]);
+}
+// Every pixel as an Rgb, row by row from the top (a copy).
+std::vector<Rgb> rgb_pixels(const Image& image);
+
+// Whether `a` and `b` hold the same pixels: the same windows and channels (names, formats
+// and bytes, in order; a NaN equals the same NaN). Metadata is not compared.
+bool same_pixels(const Image& a, const Image& b);
 
 // `image` with every channel converted to float32 (values as ImageChannel::value gives
 // them); windows, metadata and names kept.

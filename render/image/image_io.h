@@ -1,7 +1,7 @@
 #pragma once
-// Writing images: OpenEXR (the product) and 8-bit PNG previews, and a render's framebuffer
-// made an Image (make_image). Every writer goes through write_file_atomically(), so an
-// interrupted run never leaves a partial image behind. Every OpenEXR file octray writes
+// Writing images: OpenEXR (the product) and 8-bit PNG previews, and a render's image made
+// the Image a file stores (make_exr_image). Every writer goes through write_file_atomically(),
+// so an interrupted run never leaves a partial image behind. Every OpenEXR file octray writes
 // goes through write_exr(path, Image) (exr_write.cpp); every PNG through png.cpp.
 
 #include <array>
@@ -15,7 +15,6 @@
 #include <utility>
 #include <vector>
 
-#include "core/image.h"
 #include "core/pixel_rect.h"
 #include "render/image/image.h"
 
@@ -56,27 +55,29 @@ struct ExrWriteOptions {
 
 // ---- From a render to a file ----------------------------------------------------------
 
-// R, G, B channels (half, or float32 with options.float32) of `image`; the data window is
-// `data_window` (the image's size) inside a display window of (0, 0)-(full_width,
-// full_height). Throws std::invalid_argument if the sizes disagree.
-// `spare`: channels of an image already written, whose storage R, G and B take in turn
+// A render's image (render/render_result.h: float32 channels R, G, B) as a file stores it:
+// each channel half, or float32 with options.float32, in the render's order; the windows
+// kept; the compression and `attributes` set. Throws std::invalid_argument for a channel
+// that is not float32.
+// `spare`: channels of an image already written, whose storage the channels take in turn
 // (make_channel), so that a frame loop converts each frame into the same memory.
-Image make_image(const RgbImage& image, PixelRect data_window, int full_width, int full_height,
-                 const ExrWriteOptions& options, const ExrAttributes& attributes = {},
-                 std::vector<ImageChannel> spare = {});
+Image make_exr_image(const Image& render, const ExrWriteOptions& options,
+                     const ExrAttributes& attributes = {},
+                     std::vector<ImageChannel> spare = {});
 
 // Writes `image` as a scanline OpenEXR file, atomically. Throws IoError naming the path
 // and the reason (an empty window, a channel whose sample count is not the data window's,
 // two channels or attributes of one name, ...).
 void write_exr(const std::string& path, const Image& image);
 
-// Writes R, G, B channels (row 0 on top); data window = display window = the image.
-// Throws IoError.
-void write_exr(const std::string& path, const RgbImage& image, const ExrWriteOptions& options,
+// Writes a render's image (float32 R, G, B; row 0 on top) as make_exr_image makes it.
+// Throws IoError, also for an image that is not a render's.
+void write_exr(const std::string& path, const Image& render, const ExrWriteOptions& options,
                const ExrAttributes& attributes = {});
 
-// An 8-bit sRGB preview: linear values clamped to [0, 1], sRGB-encoded. Throws IoError.
-void write_png_preview(const std::string& path, const RgbImage& image);
+// An 8-bit sRGB preview of a render's image (float32 R, G, B): linear values clamped to
+// [0, 1], sRGB-encoded. Throws IoError, also for an image that is not a render's.
+void write_png_preview(const std::string& path, const Image& render);
 
 // A linear value clamped to [0, 1] (NaN and negatives to 0) through the sRGB OETF
 // (IEC 61966-2-1), rounded to 8 bits: what the PNG preview stores. Found in a table of the
@@ -87,6 +88,10 @@ std::uint8_t srgb8_by_formula(float linear);
 // srgb8(linear[i] * scale) for i < count, into out[i]: the same bytes, the table looked up
 // once for the whole run (`octray view` tone-maps a 1280x720 picture per camera move).
 void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint8_t* out);
+// The same bytes of three planes, interleaved: out[3 i + c] = srgb8(plane c's [i] * scale)
+// for r, g, b: a render's rows (planar float32) as a PNG or JPEG row.
+void srgb8_interleaved(const float* r, const float* g, const float* b, std::size_t count,
+                       float scale, std::uint8_t* out);
 
 // An 8-bit RGB PNG of `rgb` (3 * width * height bytes, row 0 on top) with an sRGB chunk,
 // in memory (`octray view` sends it to the browser): zlib's fastest level, since it is

@@ -483,7 +483,7 @@ Image read_exr_image_file(const std::string& path) {
             const PixelFormat type = from_imf(t);
             const std::size_t element = sample_size(type);
             image.channels.push_back(
-                ImageChannel{it.name(), type, std::vector<unsigned char>(pixels * element)});
+                ImageChannel{it.name(), type, SampleBytes(pixels * element, 0)});
             frame_buffer.insert(
                 it.name(), Imf::Slice::Make(t, image.channels.back().samples.data(), window,
                                             element, element * static_cast<std::size_t>(w)));

@@ -265,6 +265,16 @@ void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint
     for (std::size_t i = 0; i < count; ++i) out[i] = srgb8_in(table, linear[i] * scale);
 }
 
+void srgb8_interleaved(const float* r, const float* g, const float* b, std::size_t count,
+                       float scale, std::uint8_t* out) {
+    const SrgbTable& table = srgb_table();
+    for (std::size_t i = 0; i < count; ++i) {
+        out[3 * i] = srgb8_in(table, r[i] * scale);
+        out[3 * i + 1] = srgb8_in(table, g[i] * scale);
+        out[3 * i + 2] = srgb8_in(table, b[i] * scale);
+    }
+}
+
 namespace {
 
 // ---- Reading -----------------------------------------------------------------------------
@@ -336,7 +346,10 @@ class PngReadHandle {
     png_infop info_ = nullptr;
 };
 
-void require_image(const std::string& path, const RgbImage& image) {
+void require_render_image(const std::string& path, const Image& image) {
+    if (!is_rgb_image(image))
+        throw IoError("cannot write " + path +
+                      ": the image is not a render's (float32 channels R, G and B)");
     if (image.width() <= 0 || image.height() <= 0)
         throw IoError("cannot write " + path + ": the image is empty (" +
                       std::to_string(image.width()) + "x" + std::to_string(image.height()) +
@@ -345,14 +358,15 @@ void require_image(const std::string& path, const RgbImage& image) {
 
 }  // namespace
 
-void write_png_preview(const std::string& path, const RgbImage& image) {
-    require_image(path, image);
+void write_png_preview(const std::string& path, const Image& render) {
+    require_render_image(path, render);
+    const std::size_t width = static_cast<std::size_t>(render.width());
     const std::string bytes = encode_png(
-        image.width(), image.height(),
+        render.width(), render.height(),
         [&](std::size_t y, std::uint8_t* scratch) {
-            const std::size_t values = 3 * static_cast<std::size_t>(image.width());
-            srgb8_scaled(reinterpret_cast<const float*>(image.data()) + y * values, values,
-                         1.0f, scratch);
+            const std::size_t row = y * width;
+            srgb8_interleaved(render.plane(0) + row, render.plane(1) + row,
+                              render.plane(2) + row, width, 1.0f, scratch);
             return static_cast<const std::uint8_t*>(scratch);
         },
         SrgbChunks::srgb_gama_chrm);

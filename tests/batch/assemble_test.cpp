@@ -30,8 +30,8 @@ Image render_part(const Scene& scene, std::optional<PixelRect> crop, bool float3
     attributes.strings.emplace_back("software", "octray test");
     attributes.rationals.emplace_back("framesPerSecond", ExrRational{24, 1});
     add_camera_attributes(attributes, scene);
-    Image exr = make_image(result.image, result.rect, result.full_width, result.full_height,
-                           ExrWriteOptions{float32, ExrCompression::zip}, attributes);
+    Image exr =
+        make_exr_image(result.image, ExrWriteOptions{float32, ExrCompression::zip}, attributes);
     append_aov_channels(exr, compute_aovs(scene, options, AovSet{true, true, true, true}),
                         float32 ? PixelFormat::float32 : PixelFormat::half);
     return exr;
@@ -118,9 +118,10 @@ std::string assemble_error(const std::vector<Image>& parts) {
 }
 
 Image blank(PixelRect data, PixelRect display = {0, 0, 8, 6}, bool float32 = false) {
-    RgbImage image(data.width(), data.height());
-    Image exr = make_image(image, data, display.x1, display.y1,
-                           ExrWriteOptions{float32, ExrCompression::zip});
+    Image image(data.width(), data.height(), {"R", "G", "B"});
+    image.data_window = data;
+    image.display_window = PixelRect{0, 0, display.x1, display.y1};
+    Image exr = make_exr_image(image, ExrWriteOptions{float32, ExrCompression::zip});
     return exr;
 }
 

@@ -347,7 +347,7 @@ std::size_t pixels_unlike_alone(const Scene& scene, int frame, const fs::path& f
     const float* b = image.plane(image.channel_index("B"));
     std::size_t differ = 0;
     for (std::size_t k = 0; k < alone.image.pixel_count(); ++k) {
-        const Rgb c = alone.image.data()[k];
+        const Rgb c = rgb_at(alone.image, k);
         differ += r[k] != c.r || g[k] != c.g || b[k] != c.b;
     }
     return differ;

@@ -49,16 +49,16 @@ TEST(Progressive, FinalImageEqualsThePlainRenderOnBothPaths) {
                         spp, options,
                         [&](const RenderResult& so_far, int samples) {
                             seen.push_back(samples);
-                            EXPECT_EQ(so_far.rect, plain.rect);
+                            EXPECT_EQ(so_far.image.data_window, plain.image.data_window);
                             EXPECT_EQ(so_far.image.width(), plain.image.width());
                             // The mean so far is the sums divided by the samples so far.
-                            const Rgb sum = so_far.sample_sums.at(1, 1);
-                            const Rgb mean = so_far.image.at(1, 1);
+                            const Rgb sum = rgb_at(so_far.sample_sums, 1, 1);
+                            const Rgb mean = rgb_at(so_far.image, 1, 1);
                             EXPECT_EQ(mean.r, sum.r / static_cast<float>(samples));
                         });
                     EXPECT_EQ(seen, progressive_schedule(spp));
                     EXPECT_TRUE(same_bits(progressive.image, plain.image));
-                    EXPECT_EQ(progressive.rect, plain.rect);
+                    EXPECT_EQ(progressive.image.data_window, plain.image.data_window);
                     EXPECT_EQ(progressive.rays.primary, plain.rays.primary);
                     EXPECT_EQ(progressive.rays.total(), plain.rays.total());
                     EXPECT_EQ(progressive.sample_sums.pixel_count(), 0u);
@@ -88,7 +88,7 @@ TEST(Progressive, PassesAgreeBetweenPaths) {
 
 TEST(Progressive, BadSampleRangesAreRefused) {
     const Scene scene = golden_scene("pinhole_checker", 8, 8, 4);
-    const RgbImage sums(8, 8), wrong(4, 8);
+    const Image sums(8, 8, {"R", "G", "B"}), wrong(4, 8, {"R", "G", "B"});
     for (Path path : {Path::reference, Path::packet}) {
         SCOPED_TRACE(path_name(path));
         RenderOptions o;

@@ -67,43 +67,44 @@ class ImageIoTest : public ::testing::Test {
 
 // A smooth HDR image (lossy codecs are built for such content) whose rows and columns are
 // all distinguishable: red grows to the right, green downwards, blue goes above 1.
-RgbImage gradient_image(int width, int height, float scale = 1.0f) {
-    RgbImage image(width, height);
+Image gradient_image(int width, int height, float scale = 1.0f) {
+    Image image(width, height, {"R", "G", "B"});
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
-            image.at(x, y) =
-                Rgb(scale * (0.05f + 0.9f * static_cast<float>(x) / width),
-                    scale * (0.05f + 0.9f * static_cast<float>(y) / height),
-                    scale * (1.0f + 3.0f * static_cast<float>(x + y) / (width + height)));
+            set_rgb(image, x, y,
+                    Rgb(scale * (0.05f + 0.9f * static_cast<float>(x) / width),
+                        scale * (0.05f + 0.9f * static_cast<float>(y) / height),
+                        scale * (1.0f + 3.0f * static_cast<float>(x + y) / (width + height))));
     return image;
 }
 
 struct ReadExr {
-    RgbImage image;
+    Image image;  // float32 R, G, B planes
     Imf::Header header;
     std::vector<Imf::PixelType> channel_types;
 };
 
 ReadExr read_exr(const std::string& path) {
     Imf::InputFile file(path.c_str());
-    ReadExr out{RgbImage(), file.header(), {}};
+    ReadExr out{Image(), file.header(), {}};
     const Imath::Box2i window = file.header().dataWindow();
     const int width = window.max.x - window.min.x + 1;
     const int height = window.max.y - window.min.y + 1;
-    out.image = RgbImage(width, height);
+    out.image = Image(width, height, {"R", "G", "B"});
     for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it)
         out.channel_types.push_back(it.channel().type);
 
-    // Address the buffer so that data-window row min.y lands in image row 0.
-    char* base = reinterpret_cast<char*>(out.image.data()) -
-                 (static_cast<std::ptrdiff_t>(window.min.x) +
-                  static_cast<std::ptrdiff_t>(window.min.y) * width) *
-                     static_cast<std::ptrdiff_t>(sizeof(Rgb));
+    // Address each plane so that data-window row min.y lands in image row 0.
     Imf::FrameBuffer fb;
-    const std::size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * static_cast<std::size_t>(width);
-    fb.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xs, ys));
-    fb.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xs, ys));
-    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    const std::size_t xs = sizeof(float), ys = sizeof(float) * static_cast<std::size_t>(width);
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+        char* base = reinterpret_cast<char*>(out.image.plane(c)) -
+                     (static_cast<std::ptrdiff_t>(window.min.x) +
+                      static_cast<std::ptrdiff_t>(window.min.y) * width) *
+                         static_cast<std::ptrdiff_t>(sizeof(float));
+        fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, xs, ys));
+    }
     file.setFrameBuffer(fb);
     file.readPixels(window.min.y, window.max.y);
     return out;
@@ -150,19 +151,18 @@ TEST(ExrCompressionNames, RoundTripEveryName) {
     EXPECT_FALSE(parse_exr_compression("jpeg").has_value());
 }
 
-// A frame loop converts each frame into the last one's channels (make_image's spare):
+// A frame loop converts each frame into the last one's channels (make_exr_image's spare):
 // the same storage, and values as from fresh storage, half or float, larger or smaller.
 TEST(ExrChannels, SpareStorageIsTakenAndFullyOverwritten) {
-    const RgbImage first = gradient_image(9, 5), second = gradient_image(9, 5, 0.5f);
+    const Image first = gradient_image(9, 5), second = gradient_image(9, 5, 0.5f);
     for (const bool float32 : {false, true}) {
         SCOPED_TRACE(float32 ? "float" : "half");
         const ExrWriteOptions options{float32, ExrCompression::zip};
-        Image a = make_image(first, PixelRect{0, 0, 9, 5}, 9, 9, options);
+        Image a = make_exr_image(first, options);
         std::vector<const unsigned char*> storage;
         for (const ImageChannel& c : a.channels) storage.push_back(c.samples.data());
-        const Image fresh = make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options);
-        const Image reused =
-            make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, options, {}, std::move(a.channels));
+        const Image fresh = make_exr_image(second, options);
+        const Image reused = make_exr_image(second, options, {}, std::move(a.channels));
         ASSERT_EQ(reused.channels.size(), 3u);
         for (std::size_t k = 0; k < 3; ++k) {
             EXPECT_EQ(reused.channels[k].samples.data(), storage[k]);
@@ -171,15 +171,13 @@ TEST(ExrChannels, SpareStorageIsTakenAndFullyOverwritten) {
         }
     }
     // Spare channels of another size are not kept: the values are still the image's.
-    const Image small = make_image(gradient_image(2, 2), PixelRect{0, 0, 2, 2}, 2, 2, {});
-    const Image big = make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}, {},
-                                 std::vector<ImageChannel>(small.channels));
-    EXPECT_EQ(big.channels[0].samples,
-              make_image(second, PixelRect{0, 0, 9, 5}, 9, 9, {}).channels[0].samples);
+    const Image small = make_exr_image(gradient_image(2, 2), {});
+    const Image big = make_exr_image(second, {}, {}, std::vector<ImageChannel>(small.channels));
+    EXPECT_EQ(big.channels[0].samples, make_exr_image(second, {}).channels[0].samples);
 }
 
 TEST_F(ImageIoTest, ExrRoundTripsEveryCompressionHalfAndFloat) {
-    const RgbImage image = gradient_image(37, 21);  // odd sizes: partial codec blocks
+    const Image image = gradient_image(37, 21);  // odd sizes: partial codec blocks
     for (const bool float32 : {false, true}) {
         for (const ExrCompression c : kAllCompressions) {
             SCOPED_TRACE(std::string(to_string(c)) + (float32 ? " float" : " half"));
@@ -199,7 +197,7 @@ TEST_F(ImageIoTest, ExrRoundTripsEveryCompressionHalfAndFloat) {
             double max_relative_error = 0.0;
             for (int y = 0; y < image.height(); ++y) {
                 for (int x = 0; x < image.width(); ++x) {
-                    const Rgb in = image.at(x, y), out = read.image.at(x, y);
+                    const Rgb in = rgb_at(image, x, y), out = rgb_at(read.image, x, y);
                     const float expected[3] = {in.r, in.g, in.b};
                     const float got[3] = {out.r, out.g, out.b};
                     for (int k = 0; k < 3; ++k) {
@@ -221,7 +219,7 @@ TEST_F(ImageIoTest, ExrRoundTripsEveryCompressionHalfAndFloat) {
 }
 
 TEST_F(ImageIoTest, ExrCompressionIsTheOneAskedFor) {
-    const RgbImage image = gradient_image(8, 8);
+    const Image image = gradient_image(8, 8);
     const std::string path = (dir_ / "c.exr").string();
     write_exr(path, image, {false, ExrCompression::piz});
     EXPECT_EQ(read_exr(path).header.compression(), Imf::PIZ_COMPRESSION);
@@ -260,9 +258,9 @@ TEST_F(ImageIoTest, ExrCarriesEveryAttribute) {
 
 TEST_F(ImageIoTest, ExrRowZeroIsTheTopRow) {
     // Only row 0 is bright; a flipped writer would put it at the bottom of the file.
-    RgbImage image(5, 4);
-    for (int x = 0; x < 5; ++x) image.at(x, 0) = Rgb(1.0f, 0.5f, 0.25f);
-    image.at(4, 3) = Rgb(0.0f, 0.0f, 2.0f);  // bottom-right marker
+    Image image(5, 4, {"R", "G", "B"});
+    for (int x = 0; x < 5; ++x) set_rgb(image, x, 0, Rgb(1.0f, 0.5f, 0.25f));
+    set_rgb(image, 4, 3, Rgb(0.0f, 0.0f, 2.0f));  // bottom-right marker
     const std::string path = (dir_ / "rows.exr").string();
     write_exr(path, image, {true, ExrCompression::none});
 
@@ -286,21 +284,21 @@ TEST_F(ImageIoTest, ExrRowZeroIsTheTopRow) {
     for (float v : line) EXPECT_EQ(v, 0.0f);
 
     const ReadExr read = read_exr(path);
-    EXPECT_EQ(read.image, image);
+    EXPECT_TRUE(same_pixels(read.image, image));
 }
 
 TEST_F(ImageIoTest, NonFinitePixelsSurviveInExr) {
     // The EXR is the HDR product: infinities and NaNs are stored, not clamped.
-    RgbImage image(3, 1);
-    image.at(0, 0) = Rgb(std::numeric_limits<float>::infinity(), 0.0f, 0.0f);
-    image.at(1, 0) = Rgb(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
-    image.at(2, 0) = Rgb(1.0e6f, 0.0f, 0.0f);  // above half's range
+    Image image(3, 1, {"R", "G", "B"});
+    set_rgb(image, 0, 0, Rgb(std::numeric_limits<float>::infinity(), 0.0f, 0.0f));
+    set_rgb(image, 1, 0, Rgb(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f));
+    set_rgb(image, 2, 0, Rgb(1.0e6f, 0.0f, 0.0f));  // above half's range
     const std::string path = (dir_ / "nonfinite.exr").string();
     write_exr(path, image, {true, ExrCompression::zip});
     const ReadExr read = read_exr(path);
-    EXPECT_TRUE(std::isinf(read.image.at(0, 0).r));
-    EXPECT_TRUE(std::isnan(read.image.at(1, 0).r));
-    EXPECT_EQ(read.image.at(2, 0).r, 1.0e6f);
+    EXPECT_TRUE(std::isinf(rgb_at(read.image, 0, 0).r));
+    EXPECT_TRUE(std::isnan(rgb_at(read.image, 1, 0).r));
+    EXPECT_EQ(rgb_at(read.image, 2, 0).r, 1.0e6f);
 }
 
 TEST_F(ImageIoTest, WriteIntoMissingDirectoryThrowsAndLeavesNothing) {
@@ -326,15 +324,16 @@ TEST_F(ImageIoTest, WriteIntoMissingDirectoryThrowsAndLeavesNothing) {
 // (SIGXFSZ, whose default action would kill the process, is ignored meanwhile).
 TEST_F(ImageIoTest, PngWriteFailureSaysTheOsReason) {
     // Noise does not compress: both PNGs are far over the limit and over stdio's buffer.
-    RgbImage noise(128, 128);
+    Image noise(128, 128, {"R", "G", "B"});
     std::vector<std::uint8_t> bytes(3 * 128 * 128);
     std::uint32_t state = 12345;
     const auto next = [&] { return state = state * 1664525u + 1013904223u; };
     for (int y = 0; y < 128; ++y)
         for (int x = 0; x < 128; ++x)
-            noise.at(x, y) = Rgb(static_cast<float>(next() >> 8) / 16777216.0f,
-                                 static_cast<float>(next() >> 8) / 16777216.0f,
-                                 static_cast<float>(next() >> 8) / 16777216.0f);
+            set_rgb(noise, x, y,
+                    Rgb(static_cast<float>(next() >> 8) / 16777216.0f,
+                        static_cast<float>(next() >> 8) / 16777216.0f,
+                        static_cast<float>(next() >> 8) / 16777216.0f));
     for (std::uint8_t& b : bytes) b = static_cast<std::uint8_t>(next() >> 24);
 
     struct rlimit saved {};
@@ -420,8 +419,18 @@ TEST_F(ImageIoTest, TargetThatIsADirectoryFailsCleanly) {
 }
 
 TEST_F(ImageIoTest, EmptyImageIsRefused) {
-    EXPECT_THROW(write_exr((dir_ / "e.exr").string(), RgbImage(), {}), IoError);
-    EXPECT_THROW(write_png_preview((dir_ / "e.png").string(), RgbImage(0, 3)), IoError);
+    EXPECT_THROW(write_exr((dir_ / "e.exr").string(), Image(0, 0, {"R", "G", "B"}), {}),
+                 IoError);
+    EXPECT_THROW(write_png_preview((dir_ / "e.png").string(), Image(0, 3, {"R", "G", "B"})),
+                 IoError);
+    // Not a render's image: 8-bit channels, or R, G, B out of order.
+    Image bytes(2, 2, {"R", "G", "B"});
+    for (ImageChannel& c : bytes.channels)
+        c = make_channel(c.name, std::vector<std::uint8_t>(4));
+    EXPECT_THROW(write_exr((dir_ / "b.exr").string(), bytes, {}), IoError);
+    EXPECT_THROW(write_png_preview((dir_ / "b.png").string(), bytes), IoError);
+    EXPECT_THROW(write_png_preview((dir_ / "c.png").string(), Image(2, 2, {"B", "G", "R"})),
+                 IoError);
     EXPECT_TRUE(entries().empty());
 }
 
@@ -459,12 +468,12 @@ PngPixels read_png(const std::string& path) {
 TEST_F(ImageIoTest, PngEncodesKnownValues) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const float inf = std::numeric_limits<float>::infinity();
-    RgbImage image(4, 2);
-    image.at(0, 0) = Rgb(0.0f, 1.0f, 0.5f);
-    image.at(1, 0) = Rgb(2.0f, -1.0f, nan);
-    image.at(2, 0) = Rgb(0.002f, 0.0031308f, 0.2f);
-    image.at(3, 0) = Rgb(inf, -inf, 1.0001f);
-    image.at(0, 1) = Rgb(0.25f, 0.75f, 0.1f);
+    Image image(4, 2, {"R", "G", "B"});
+    set_rgb(image, 0, 0, Rgb(0.0f, 1.0f, 0.5f));
+    set_rgb(image, 1, 0, Rgb(2.0f, -1.0f, nan));
+    set_rgb(image, 2, 0, Rgb(0.002f, 0.0031308f, 0.2f));
+    set_rgb(image, 3, 0, Rgb(inf, -inf, 1.0001f));
+    set_rgb(image, 0, 1, Rgb(0.25f, 0.75f, 0.1f));
     const std::string path = (dir_ / "known.png").string();
     write_png_preview(path, image);
 
@@ -494,7 +503,7 @@ TEST_F(ImageIoTest, PngEncodesKnownValues) {
 }
 
 TEST_F(ImageIoTest, PngOfLargerImageIsReadable) {
-    const RgbImage image = gradient_image(320, 200);
+    const Image image = gradient_image(320, 200);
     const std::string path = (dir_ / "big.png").string();
     write_png_preview(path, image);
     const PngPixels png = read_png(path);
@@ -610,7 +619,7 @@ TEST_F(ImageIoTest, PngOfIncompressiblePixelsReadsBack) {
 // do not depend on it.
 TEST_F(ImageIoTest, ExrThreadCountIsSetAndDoesNotChangeTheBytes) {
     const int before = exr_thread_count();
-    const RgbImage image = gradient_image(64, 48);
+    const Image image = gradient_image(64, 48);
     set_exr_thread_count(0);
     EXPECT_EQ(exr_thread_count(), 0);
     write_exr((dir_ / "serial.exr").string(), image, ExrWriteOptions{});

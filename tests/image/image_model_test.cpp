@@ -165,5 +165,73 @@ TEST_F(ImageModelTest, EightBitChannelsMakePngsAndNeverExrs) {
     EXPECT_FALSE(std::filesystem::exists(path("f.png")));
 }
 
+// ---- A render's image --------------------------------------------------------------------
+
+TEST(RenderImage, PlanesAreRowsFromTheTopInTheDataWindow) {
+    const PixelRect crop{2, 1, 5, 3}, full{0, 0, 8, 6};
+    Image image = make_rgb_image(crop, full);
+    ASSERT_TRUE(is_rgb_image(image));
+    EXPECT_EQ(image.data_window, crop);
+    EXPECT_EQ(image.display_window, full);
+    EXPECT_EQ(image.channel_names(), (std::vector<std::string>{"R", "G", "B"}));
+    EXPECT_EQ(image.width(), 3);
+    EXPECT_EQ(image.height(), 2);
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 3; ++x) set_rgb(image, x, y, Rgb(0.0f));
+    set_rgb(image, 0, 0, Rgb(1.0f, 2.0f, 3.0f));  // the crop's top-left
+    set_rgb(image, 2, 1, Rgb(4.0f, 5.0f, 6.0f));  // bottom-right
+    EXPECT_EQ(image.plane(0)[0], 1.0f);
+    EXPECT_EQ(image.plane(2)[0], 3.0f);
+    EXPECT_EQ(image.plane(1)[5], 5.0f);  // (2, 1): row 1 of 3 pixels, column 2
+    EXPECT_EQ(rgb_at(image, 2, 1), Rgb(4.0f, 5.0f, 6.0f));
+    EXPECT_EQ(rgb_at(image, std::size_t{5}), Rgb(4.0f, 5.0f, 6.0f));
+    EXPECT_EQ(rgb_pixels(image).size(), 6u);
+    EXPECT_EQ(rgb_pixels(image)[0], Rgb(1.0f, 2.0f, 3.0f));
+}
+
+// A batch renders each frame into the last one's storage (RenderOptions::spare_image).
+TEST(RenderImage, SpareStorageIsTakenOnlyWhenThePixelCountsAgreeAndFreedElse) {
+    Image spare = make_rgb_image(PixelRect{0, 0, 6, 4}, PixelRect{0, 0, 6, 4});
+    const unsigned char* storage[3] = {spare.channels[0].samples.data(),
+                                       spare.channels[1].samples.data(),
+                                       spare.channels[2].samples.data()};
+    const PixelRect other_shape{0, 0, 8, 3};  // 24 pixels either way
+    EXPECT_TRUE(fits_rgb_storage(spare, other_shape));
+    const Image taken = make_rgb_image(other_shape, other_shape, std::move(spare));
+    for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(taken.channels[static_cast<std::size_t>(c)].samples.data(), storage[c]);
+    EXPECT_EQ(taken.width(), 8);
+    EXPECT_EQ(taken.height(), 3);
+
+    Image small = make_rgb_image(PixelRect{0, 0, 5, 5}, PixelRect{0, 0, 5, 5});
+    EXPECT_FALSE(fits_rgb_storage(small, other_shape));
+    const Image fresh = make_rgb_image(other_shape, other_shape, std::move(small));
+    EXPECT_TRUE(is_rgb_image(fresh));
+    EXPECT_EQ(fresh.channels[0].samples.size(), 24 * sizeof(float));
+}
+
+TEST(RenderImage, OnlyFloatRgbInOrderIsARendersImage) {
+    EXPECT_TRUE(is_rgb_image(Image(2, 2, {"R", "G", "B"})));
+    EXPECT_FALSE(is_rgb_image(Image(2, 2, {"R", "G"})));
+    EXPECT_FALSE(is_rgb_image(Image(2, 2, {"B", "G", "R"})));
+    Image half = Image(2, 2, {"R", "G", "B"});
+    half.channels[1] = make_channel("G", PixelFormat::half, half.plane(0), 4);
+    EXPECT_FALSE(is_rgb_image(half));
+    Image short_plane = Image(2, 2, {"R", "G", "B"});
+    short_plane.channels[2].samples.resize(4);
+    EXPECT_FALSE(is_rgb_image(short_plane));
+}
+
+TEST(RenderImage, SamePixelsComparesWindowsAndBitsNotMetadata) {
+    Image a(3, 2, {"R", "G", "B"}), b(3, 2, {"R", "G", "B"});
+    b.attributes.strings.emplace_back("software", "other");
+    EXPECT_TRUE(same_pixels(a, b));
+    set_rgb(b, 1, 1, Rgb(-0.0f, 0.0f, 0.0f));  // -0 is not +0 bit for bit
+    EXPECT_FALSE(same_pixels(a, b));
+    Image moved = a;
+    moved.data_window = PixelRect{1, 0, 4, 2};
+    EXPECT_FALSE(same_pixels(a, moved));
+}
+
 }  // namespace
 }  // namespace octray

@@ -305,8 +305,8 @@ TEST_F(ImageReadTest, ExrAttributesAreReadByNameAndType) {
     written.ints = {{"octray.samplesSoFar", 3}};
     written.strings = {{"octray.claimOwner", "host:1234"}};
     written.floats = {{"octray.samples", 2.5f}};
-    RgbImage image(4, 2);
-    image.at(3, 1) = Rgb(1.0f, 0.5f, 0.25f);
+    Image image(4, 2, {"R", "G", "B"});
+    set_rgb(image, 3, 1, Rgb(1.0f, 0.5f, 0.25f));
     write_exr(path("a.exr"), image, ExrWriteOptions{}, written);
 
     const ExrAttributes read = read_exr_attributes(path("a.exr"));

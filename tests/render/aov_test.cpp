@@ -178,8 +178,7 @@ TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
         options.crop = PixelRect{10, 12, 20, 21};
         const RenderResult result = render_reference(scene, options);
         const Image aovs = compute_aovs(scene, options, AovSet{true, true, true, true});
-        Image exr = make_image(result.image, result.rect, result.full_width, result.full_height,
-                               ExrWriteOptions{float32, ExrCompression::zip});
+        Image exr = make_exr_image(result.image, ExrWriteOptions{float32, ExrCompression::zip});
         const PixelFormat color = float32 ? PixelFormat::float32 : PixelFormat::half;
         append_aov_channels(exr, aovs, color);
         const std::string path = (dir / "aovs.exr").string();
@@ -209,8 +208,7 @@ TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
             EXPECT_EQ(back.find_channel("Z")->value(p), aov_depth(aovs, p));
     }
     const RenderResult whole = render_reference(scene, {});
-    Image wrong = make_image(whole.image, whole.rect, whole.full_width, whole.full_height,
-                             ExrWriteOptions{});
+    Image wrong = make_exr_image(whole.image, ExrWriteOptions{});
     RenderOptions crop;
     crop.crop = PixelRect{0, 0, 5, 5};
     EXPECT_THROW(

@@ -36,10 +36,10 @@ std::vector<PixelRect> blocks_of(int width, int height, int side) {
     return blocks;
 }
 
-bool same_bits(const RgbImage& a, const RgbImage& b) {
+bool same_bits(const Image& a, const Image& b) {
     if (a.width() != b.width() || a.height() != b.height()) return false;
     for (std::size_t k = 0; k < a.pixel_count(); ++k)
-        if (!(a.data()[k] == b.data()[k])) return false;
+        if (!(rgb_at(a, k) == rgb_at(b, k))) return false;
     return true;
 }
 
@@ -67,11 +67,11 @@ TEST(BlockRender, PacketBlocksEqualAWholeRenderBitForBit) {
         RenderOptions options;
         options.frame = c.frame;
         options.accel = c.accel;
-        const RgbImage whole = render_packet(scene, options).image;
+        const Image whole = render_packet(scene, options).image;
         const PreparedScene prepared(scene, c.accel);
         EXPECT_EQ(prepared.bvh() != nullptr, c.accel == Accel::bvh || c.spec[0] == 'r')
             << c.spec;
-        RgbImage picture(scene.image.width, scene.image.height);
+        Image picture(scene.image.width, scene.image.height, {"R", "G", "B"});
         const std::vector<PixelRect> blocks =
             blocks_of(scene.image.width, scene.image.height, 8);
         RenderOptions block_options;
@@ -101,7 +101,7 @@ TEST(BlockRender, APreparedSceneTakesANewCamera) {
     scene.camera.up = Vec3{0.1f, 1.0f, 0.0f};
     prepared.set_camera(scene.camera);
     EXPECT_EQ(prepared.bvh(), bvh);
-    RgbImage picture(scene.image.width, scene.image.height);
+    Image picture(scene.image.width, scene.image.height, {"R", "G", "B"});
     render_packet_blocks(prepared, blocks_of(scene.image.width, scene.image.height, 5),
                          picture);
     EXPECT_TRUE(same_bits(picture, render_packet(scene).image));
@@ -137,7 +137,7 @@ TEST(BlockRender, ReferenceBlocksEqualAWholeReferenceRender) {
     const Scene scene = test_scene("whitted", 2);
     RenderOptions options;
     options.frame = 5;
-    RgbImage picture(scene.image.width, scene.image.height);
+    Image picture(scene.image.width, scene.image.height, {"R", "G", "B"});
     const RenderResult result = render_reference_blocks(
         scene, blocks_of(scene.image.width, scene.image.height, 8), picture, options);
     EXPECT_TRUE(same_bits(picture, render_reference(scene, options).image));
@@ -147,8 +147,8 @@ TEST(BlockRender, ReferenceBlocksEqualAWholeReferenceRender) {
 TEST(BlockRender, BadBlocksAndOptionsAreRefused) {
     const Scene scene = test_scene("whitted", 1);
     const PreparedScene prepared(scene);
-    RgbImage picture(scene.image.width, scene.image.height);
-    const auto both_refuse = [&](const std::vector<PixelRect>& blocks, RgbImage& target,
+    Image picture(scene.image.width, scene.image.height, {"R", "G", "B"});
+    const auto both_refuse = [&](const std::vector<PixelRect>& blocks, Image& target,
                                  const RenderOptions& options) {
         EXPECT_THROW(render_packet_blocks(prepared, blocks, target, options),
                      std::invalid_argument);
@@ -169,7 +169,7 @@ TEST(BlockRender, BadBlocksAndOptionsAreRefused) {
                   0u)
             << e.what();
     }
-    RgbImage small(8, 8);
+    Image small(8, 8, {"R", "G", "B"});
     both_refuse({PixelRect{0, 0, 8, 8}}, small, {});
     RenderOptions crop;
     crop.crop = PixelRect{0, 0, 8, 8};

@@ -35,9 +35,9 @@ TEST(Crop, PixelsEqualTheFullRenderOnBothPaths) {
         const Scene scene = golden_scene(name, 37, 23, name[0] == 'w' ? 3 : 0);
         for (Path path : {Path::reference, Path::packet}) {
             const RenderResult full = render_with(path, scene, {});
-            EXPECT_EQ(full.rect, (PixelRect{0, 0, 37, 23}));
-            EXPECT_EQ(full.full_width, 37);
-            EXPECT_EQ(full.full_height, 23);
+            EXPECT_EQ(full.image.data_window, (PixelRect{0, 0, 37, 23}));
+            EXPECT_EQ(full.image.display_window.width(), 37);
+            EXPECT_EQ(full.image.display_window.height(), 23);
             for (const PixelRect& crop : kCrops)
                 for (const auto& [tw, th] : std::vector<std::pair<int, int>>{
                          {16, 16}, {1, 1}, {3, 5}, {8, 2}, {64, 64}}) {
@@ -49,9 +49,9 @@ TEST(Crop, PixelsEqualTheFullRenderOnBothPaths) {
                     options.tile_width = tw;
                     options.tile_height = th;
                     const RenderResult part = render_with(path, scene, options);
-                    EXPECT_EQ(part.rect, crop);
-                    EXPECT_EQ(part.full_width, 37);
-                    EXPECT_EQ(part.full_height, 23);
+                    EXPECT_EQ(part.image.data_window, crop);
+                    EXPECT_EQ(part.image.display_window.width(), 37);
+                    EXPECT_EQ(part.image.display_window.height(), 23);
                     ASSERT_EQ(part.image.width(), crop.width());
                     ASSERT_EQ(part.image.height(), crop.height());
                     EXPECT_TRUE(same_bits(part.image, sub_image(full.image, crop)));

@@ -95,7 +95,7 @@ Rgb brightest(const Scene& s) {
     return s.ambient * (m.color * m.kd) + l * (m.color * m.kd + Rgb(m.ks));
 }
 
-void expect_disc(const Scene& s, const RgbImage& image, const std::string& what) {
+void expect_disc(const Scene& s, const Image& image, const std::string& what) {
     SCOPED_TRACE(what);
     const std::vector<int> want = analytic_row_coverage(s);
     const Rgb top = brightest(s) * 1.0001f;  // room for the rounding of the sums
@@ -104,7 +104,7 @@ void expect_disc(const Scene& s, const RgbImage& image, const std::string& what)
         int hits = 0, runs = 0;
         bool previous = false;
         for (int i = 0; i < kSize; ++i) {
-            const Rgb p = image.at(i, j);
+            const Rgb p = rgb_at(image, i, j);
             if (!is_finite(p)) ++nonfinite;
             if (p.r > top.r || p.g > top.g || p.b > top.b) ++over;
             // Background is black and ambient lights every hit: a hit is a non-black pixel.
@@ -140,7 +140,7 @@ TEST_P(DistantSphere, RendersAsADiscOnBothPaths) {
             expect_disc(s, simd.image, what);
             std::size_t differing = 0;
             for (std::size_t k = 0; k < ref.image.pixel_count(); ++k)
-                differing += ref.image.data()[k] == simd.image.data()[k] ? 0 : 1;
+                differing += rgb_at(ref.image, k) == rgb_at(simd.image, k) ? 0 : 1;
             EXPECT_EQ(differing, 0u) << what << ": pixels not bit-identical to the reference";
         }
 }

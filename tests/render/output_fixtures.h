@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <string>
 
-#include "core/image.h"
 #include "render/crop.h"
+#include "render/image/image.h"
 #include "render/packet_renderer.h"
 #include "render/reference.h"
 #include "scene/load.h"
@@ -37,17 +37,23 @@ inline RenderResult render_with(Path path, const Scene& scene, const RenderOptio
                                    : render_packet(scene, options);
 }
 
-// Bit-for-bit equality (RgbImage's == treats -0 as +0 and NaN as unequal).
-inline bool same_bits(const RgbImage& a, const RgbImage& b) {
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
+// Bit-for-bit equality of the samples of two images of one size, whatever their windows
+// (float == would take -0 for +0 and NaN for unequal).
+inline bool same_bits(const Image& a, const Image& b) {
+    if (a.width() != b.width() || a.height() != b.height() ||
+        a.channels.size() != b.channels.size())
+        return false;
+    for (std::size_t c = 0; c < a.channels.size(); ++c)
+        if (!(a.channels[c] == b.channels[c])) return false;
+    return true;
 }
 
-// Pixels x0..x1, y0..y1 of `full` as their own image.
-inline RgbImage sub_image(const RgbImage& full, const PixelRect& r) {
-    RgbImage out(r.width(), r.height());
+// Pixels x0..x1, y0..y1 of a render's image `full` as their own image (a crop's windows:
+// data window r inside full's display window).
+inline Image sub_image(const Image& full, const PixelRect& r) {
+    Image out = make_rgb_image(r, full.display_window);
     for (int y = r.y0; y < r.y1; ++y)
-        for (int x = r.x0; x < r.x1; ++x) out.at(x - r.x0, y - r.y0) = full.at(x, y);
+        for (int x = r.x0; x < r.x1; ++x) set_rgb(out, x - r.x0, y - r.y0, rgb_at(full, x, y));
     return out;
 }
 

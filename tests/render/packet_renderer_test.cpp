@@ -41,11 +41,11 @@ struct Agreement {
     bool finite = true;
 };
 
-Agreement agreement(const RgbImage& a, const RgbImage& b) {
+Agreement agreement(const Image& a, const Image& b) {
     Agreement g;
     g.pixels = a.pixel_count();
     for (std::size_t k = 0; k < a.pixel_count(); ++k) {
-        const Rgb pa = a.data()[k], pb = b.data()[k];
+        const Rgb pa = rgb_at(a, k), pb = rgb_at(b, k);
         g.finite = g.finite && is_finite(pa) && is_finite(pb);
         const double e =
             std::max({std::fabs(double(pa.r) - pb.r), std::fabs(double(pa.g) - pb.g),
@@ -176,7 +176,7 @@ TEST(PacketRenderer, DirectLightingIsBitIdentical) {
     const RenderResult ref = render_reference(s, {});
     const RenderResult simd = render_packet(s, {});
     EXPECT_EQ(ref.rays.reflected + ref.rays.refracted, 0u);
-    EXPECT_TRUE(ref.image == simd.image);
+    EXPECT_TRUE(same_pixels(ref.image, simd.image));
     EXPECT_EQ(ref.rays.shadow, simd.rays.shadow);
 }
 
@@ -217,7 +217,7 @@ TEST(PacketRenderer, EveryIsaGivesTheSameImage) {
     for (Isa isa : supported_isas()) {
         SCOPED_TRACE(isa_name(isa));
         const RenderResult r = render_packet(s, {}, isa);
-        EXPECT_TRUE(r.image == first.image);
+        EXPECT_TRUE(same_pixels(r.image, first.image));
         EXPECT_EQ(r.rays.total(), first.rays.total());
     }
 }
@@ -238,7 +238,7 @@ TEST(PacketRenderer, BitIdenticalForAnyThreadCountAndTileSize) {
             SCOPED_TRACE(std::to_string(threads) + " threads, tile " + std::to_string(tw) +
                          "x" + std::to_string(th));
             const RenderResult r = render_packet(s, o);
-            EXPECT_TRUE(r.image == one.image);
+            EXPECT_TRUE(same_pixels(r.image, one.image));
             EXPECT_EQ(r.rays.total(), one.rays.total());
         }
 }
@@ -256,7 +256,7 @@ TEST(PacketRenderer, RayChunksChangeNoPixel) {
             RenderOptions o;
             o.ray_chunk = chunk;
             const RenderResult r = render_packet(s, o);
-            EXPECT_TRUE(r.image == whole.image);
+            EXPECT_TRUE(same_pixels(r.image, whole.image));
             EXPECT_EQ(r.rays.shadow, whole.rays.shadow);
             EXPECT_EQ(r.rays.reflected, whole.rays.reflected);
             EXPECT_EQ(r.rays.refracted, whole.rays.refracted);
@@ -302,7 +302,7 @@ TEST(PacketRenderer, MirrorAndGlassEverywhereStaysWithinBoundedMemory) {
                 static_cast<unsigned long long>(chunked.scratch_bytes));
     // Breadth first, the deepest generations alone would hold many chunks of rays.
     EXPECT_GT(secondary, 16 * std::uint64_t{kDefaultRayChunk});
-    EXPECT_TRUE(chunked.image == reference.image);
+    EXPECT_TRUE(same_pixels(chunked.image, reference.image));
     EXPECT_EQ(chunked.rays.reflected, reference.rays.reflected);
     EXPECT_EQ(chunked.rays.refracted, reference.rays.refracted);
 

@@ -229,7 +229,7 @@ void expect_same_images(Scene scene, const std::string& what, int width = 96, in
     brute.accel = Accel::none;
     const RenderResult a = render_reference(scene, with_bvh),
                        b = render_reference(scene, brute);
-    EXPECT_TRUE(a.image == b.image) << "the images differ";
+    EXPECT_TRUE(same_pixels(a.image, b.image)) << "the images differ";
     EXPECT_EQ(a.rays.primary, b.rays.primary);
     EXPECT_EQ(a.rays.shadow, b.rays.shadow);
     EXPECT_EQ(a.rays.reflected, b.rays.reflected);

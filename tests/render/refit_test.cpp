@@ -31,10 +31,8 @@ Scene moved(const Scene& scene, std::mt19937& rng, float step) {
     return s;
 }
 
-bool same_bits(const RgbImage& a, const RgbImage& b) {
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::equal(a.data(), a.data() + a.pixel_count(), b.data(),
-                      [](const Rgb& x, const Rgb& y) { return x == y; });
+bool same_bits(const Image& a, const Image& b) {
+    return a.width() == b.width() && a.height() == b.height() && rgb_pixels(a) == rgb_pixels(b);
 }
 
 // Boxes that hold what they bound: each leaf's spheres (c -+ r), each inner child's boxes.

@@ -137,16 +137,16 @@ TEST(RenderConfig, ItsRenderOptionsRenderTheCropOfTheWholeImage) {
     c.resolve_isa();
     FrameRenderer whole(scene, c.path, c.isa, c.accel, c.threads);
     whole.prepare(0);
-    const RgbImage full = whole.render(c.render_options()).image;
+    const Image full = whole.render(c.render_options()).image;
     c.crop = PixelRect{3, 5, 20, 17};
     c.check_crop(32, 24);
-    const RgbImage part = whole.render(c.render_options()).image;
+    const Image part = whole.render(c.render_options()).image;
     ASSERT_EQ(part.width(), 17);
     ASSERT_EQ(part.height(), 12);
     for (int y = 0; y < 12; ++y)
         for (int x = 0; x < 17; ++x) {
-            EXPECT_EQ(part.at(x, y).r, full.at(x + 3, y + 5).r);
-            EXPECT_EQ(part.at(x, y).b, full.at(x + 3, y + 5).b);
+            EXPECT_EQ(rgb_at(part, x, y).r, rgb_at(full, x + 3, y + 5).r);
+            EXPECT_EQ(rgb_at(part, x, y).b, rgb_at(full, x + 3, y + 5).b);
         }
 }
 

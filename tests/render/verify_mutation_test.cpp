@@ -70,7 +70,7 @@ std::size_t pixels_caught(const Scene& scene, const std::function<void(BrokenTre
     EXPECT_EQ(simd.image.pixel_count(), ref.image.pixel_count());
     std::size_t differ = 0;
     for (std::size_t k = 0; k < ref.image.pixel_count(); ++k)
-        differ += ref.image.data()[k] == simd.image.data()[k] ? 0 : 1;
+        differ += rgb_at(ref.image, k) == rgb_at(simd.image, k) ? 0 : 1;
     return differ;
 }
 

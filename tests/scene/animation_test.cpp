@@ -596,7 +596,7 @@ TEST(AnimationWrite, EmptyTracksRoundTrip) {
 // ---------------------------------------------------------------------------------------
 // Rendering posed frames (the scalar reference, 32 x 24: fast under sanitizers too)
 
-RgbImage render_frame(const Scene& animated, int frame) {
+Image render_frame(const Scene& animated, int frame) {
     Scene posed = scene_at_frame(animated, frame);
     posed.image.width = 32;
     posed.image.height = 24;
@@ -607,23 +607,11 @@ RgbImage render_frame(const Scene& animated, int frame) {
     return render_reference(posed, options).image;
 }
 
-bool same_pixels(const RgbImage& a, const RgbImage& b) {
-    if (a.width() != b.width() || a.height() != b.height()) return false;
-    for (int y = 0; y < a.height(); ++y) {
-        for (int x = 0; x < a.width(); ++x) {
-            const Rgb p = a.at(x, y), q = b.at(x, y);
-            if (!(same_bits(p.r, q.r) && same_bits(p.g, q.g) && same_bits(p.b, q.b)))
-                return false;
-        }
-    }
-    return true;
-}
-
 TEST(AnimationRender, BounceFramesDifferAndFrameZeroIsTheAuthoredPose) {
     const Scene s = load_scene_file(kBounce);
-    const RgbImage f0 = render_frame(s, 0);
-    const RgbImage f24 = render_frame(s, 24);
-    const RgbImage f47 = render_frame(s, 47);
+    const Image f0 = render_frame(s, 0);
+    const Image f24 = render_frame(s, 24);
+    const Image f47 = render_frame(s, 47);
     EXPECT_FALSE(same_pixels(f0, f24));
     EXPECT_FALSE(same_pixels(f24, f47));
     // bounce.json's frame-0 keys repeat the authored eye, fov and ball center, and the

@@ -49,8 +49,8 @@ class AssembleCliTest : public ::testing::Test {
         batch::add_camera_attributes(attributes, scene_);
         attributes.ints.emplace_back("octray:frame", 3);
         const RenderResult result = render_packet(scene_, options);
-        Image exr = make_image(result.image, result.rect, result.full_width, result.full_height,
-                               ExrWriteOptions{float32, ExrCompression::zip}, attributes);
+        Image exr = make_exr_image(result.image, ExrWriteOptions{float32, ExrCompression::zip},
+                                   attributes);
         append_aov_channels(exr, compute_aovs(scene_, options, AovSet{true, true, false, true}),
                             float32 ? PixelFormat::float32 : PixelFormat::half);
         write_exr(path(name), exr);

@@ -15,16 +15,17 @@
 namespace {
 
 using octray::encode_png_rgb8;
+using octray::Image;
 using octray::Rgb;
-using octray::RgbImage;
+using octray::set_rgb;
 using octray::view::tone_map_srgb8;
 
 TEST(ViewToneMap, ScalesByTwoToTheExposureThenEncodesSrgb) {
-    RgbImage image(4, 1);
-    image.at(0, 0) = Rgb{0.0f, 0.25f, 0.5f};
-    image.at(1, 0) = Rgb{1.0f, 2.0f, -1.0f};
-    image.at(2, 0) = Rgb{std::numeric_limits<float>::quiet_NaN(), 0.001f, 0.2f};
-    image.at(3, 0) = Rgb{std::numeric_limits<float>::infinity(), 0.0f, 0.0f};
+    Image image(4, 1, {"R", "G", "B"});
+    set_rgb(image, 0, 0, Rgb{0.0f, 0.25f, 0.5f});
+    set_rgb(image, 1, 0, Rgb{1.0f, 2.0f, -1.0f});
+    set_rgb(image, 2, 0, Rgb{std::numeric_limits<float>::quiet_NaN(), 0.001f, 0.2f});
+    set_rgb(image, 3, 0, Rgb{std::numeric_limits<float>::infinity(), 0.0f, 0.0f});
     const std::vector<std::uint8_t> plain = tone_map_srgb8(image, 0.0f);
     // sRGB(0.25) = 137, sRGB(0.5) = 188; clamped above 1 and below 0; NaN is black;
     // 0.001 is on the linear segment: 12.92 * 0.001 * 255 = 3.29 -> 3.

@@ -90,9 +90,7 @@ TEST(ViewSave, WritesWhatRenderWrites) {
     // The pixels `octray render` writes: render_packet through the same EXR writer.
     const fs::path expected_path = dir / "expected.exr";
     const octray::RenderResult result = octray::render_packet(scene);
-    octray::write_exr(expected_path.string(),
-                      octray::make_image(result.image, result.rect, result.full_width,
-                                         result.full_height, {}, {}));
+    octray::write_exr(expected_path.string(), octray::make_exr_image(result.image, {}, {}));
     const octray::Image got = octray::read_image((dir / "view.exr").string());
     const octray::Image expected = octray::read_image(expected_path.string());
     EXPECT_EQ(got.file_format, expected.file_format);
@@ -151,9 +149,7 @@ TEST(ViewSave, WritesWhatRenderWrites) {
     const Scene reloaded = octray::load_scene((dir / "moved.json").string());
     EXPECT_EQ(reloaded.camera.eye.x, moved.eye.x);
     const octray::RenderResult again = octray::render_packet(reloaded);
-    octray::write_exr(expected_path.string(),
-                      octray::make_image(again.image, again.rect, again.full_width,
-                                         again.full_height, {}, {}));
+    octray::write_exr(expected_path.string(), octray::make_exr_image(again.image, {}, {}));
     EXPECT_EQ(octray::read_image((dir / "moved.exr").string()).channels,
               octray::read_image(expected_path.string()).channels);
     server.stop();

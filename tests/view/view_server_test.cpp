@@ -42,9 +42,10 @@ using octray::view::ViewSettings;
 using octray::view::testing::small_whitted;
 
 // An image's raw bytes, as /api/image.f32 returns them.
-std::string bytes_of(const octray::RgbImage& image) {
-    return std::string(reinterpret_cast<const char*>(image.data()),
-                       image.pixel_count() * sizeof(octray::Rgb));
+std::string bytes_of(const octray::Image& image) {
+    const std::vector<octray::Rgb> pixels = octray::rgb_pixels(image);
+    return std::string(reinterpret_cast<const char*>(pixels.data()),
+                       pixels.size() * sizeof(octray::Rgb));
 }
 
 // The raw bytes of render_packet's image of `scene`: what /api/image.f32 must return.

@@ -1,48 +1,12 @@
-#include "core/image.h"
+#include "core/aligned.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <utility>
-
-#include "core/aligned.h"
+#include <vector>
 
 namespace octray {
 namespace {
-
-TEST(RgbImage, RowZeroIsTheTopRowStoredFirst) {
-    RgbImage img(3, 2);
-    img.at(0, 0) = Rgb(1.0f);  // top-left
-    img.at(2, 1) = Rgb(2.0f);  // bottom-right
-    EXPECT_EQ(img.data()[0], Rgb(1.0f));
-    EXPECT_EQ(img.data()[5], Rgb(2.0f));
-    EXPECT_EQ(img.pixel_count(), 6u);
-}
-
-TEST(RgbImage, NonSquareDimensionsAreKeptApart) {
-    RgbImage img(4, 2);
-    img.at(3, 0) = Rgb(7.0f);
-    EXPECT_EQ(img.width(), 4);
-    EXPECT_EQ(img.height(), 2);
-    EXPECT_EQ(img.data()[3], Rgb(7.0f));  // (3, 0) is in the first row, not (0, 3)
-}
-
-// A batch renders each frame into the last one's storage (RenderOptions::spare_image).
-TEST(RgbImage, ReuseTakesTheSparesStorageOnlyWhenThePixelCountsAgreeAndFreesItElse) {
-    RgbImage spare(6, 4);
-    const Rgb* storage = spare.data();
-    const RgbImage taken = RgbImage::reuse(std::move(spare), 8, 3);  // 24 pixels either way
-    EXPECT_EQ(taken.data(), storage);
-    EXPECT_EQ(taken.width(), 8);
-    EXPECT_EQ(taken.height(), 3);
-    EXPECT_EQ(spare.pixel_count(), 0u);  // NOLINT(bugprone-use-after-move): left empty
-
-    RgbImage other(5, 5);
-    const RgbImage fresh = RgbImage::reuse(std::move(other), 8, 3);
-    EXPECT_EQ(fresh.pixel_count(), 24u);
-    EXPECT_EQ(fresh.width(), 8);
-    EXPECT_EQ(other.pixel_count(), 0u);  // NOLINT(bugprone-use-after-move): freed first
-}
 
 TEST(AlignedVector, StorageIsSixtyFourByteAligned) {
     for (std::size_t n : {1u, 7u, 8u, 1000u}) {
