@@ -636,7 +636,7 @@ namespace {
 // frames started before (each whole, however it ended) plus the one rendering.
 class FrameFilesObserver : public batch::BatchObserver {
   public:
-    explicit FrameFilesObserver(const std::vector<batch::BatchScene>& scenes,
+    explicit FrameFilesObserver(const std::vector<batch::BatchInput>& scenes,
                                 const std::vector<batch::BatchJob>& jobs)
         : scenes_(scenes), jobs_(jobs) {}
 
@@ -666,7 +666,7 @@ class FrameFilesObserver : public batch::BatchObserver {
     }
 
     std::uint64_t frame_pixels(std::size_t index) const {
-        const batch::BatchScene& scene = scenes_[jobs_[index - 1].scene];
+        const batch::BatchInput& scene = scenes_[jobs_[index - 1].scene];
         return scene.crop ? scene.crop->pixel_count()
                           : static_cast<std::uint64_t>(scene.scene.image.width) *
                                 static_cast<std::uint64_t>(scene.scene.image.height);
@@ -692,7 +692,7 @@ class FrameFilesObserver : public batch::BatchObserver {
         return jobs_.size();
     }
 
-    const std::vector<batch::BatchScene>& scenes_;
+    const std::vector<batch::BatchInput>& scenes_;
     const std::vector<batch::BatchJob>& jobs_;
     std::atomic<std::uint64_t> pixels_{0};
     std::atomic<std::uint64_t> done_{0};
@@ -719,14 +719,14 @@ FrameFilesResult render_frames(const Scene& scene, const RenderOptions& options,
     return translate_errors([&] {
         const auto started = std::chrono::steady_clock::now();
         octray::RenderConfig config = to_config(options);
-        batch::BatchScene loaded;
+        batch::BatchInput loaded;
         loaded.scene = configured_scene(scene, config);
         loaded.spec = loaded.scene.source;
         loaded.name = loaded.spec == "<api>" ? std::string("scene")
                                              : batch::scene_display_name(loaded.spec);
         loaded.sha256 = batch::sha256_hex(scene_to_json(loaded.scene));
         loaded.crop = config.crop;
-        const std::vector<batch::BatchScene> scenes{std::move(loaded)};
+        const std::vector<batch::BatchInput> scenes{std::move(loaded)};
 
         batch::BatchRequest request;
         request.threads = config.threads;

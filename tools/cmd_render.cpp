@@ -244,9 +244,9 @@ void run_render(const RenderArguments& args) {
     // cannot all start (ulimit -v); this says so instead, exit 1.
     check_threads_can_start(args.threads);
     const batch::BatchRequest request = batch_request(args, settings.render);
-    std::vector<batch::BatchScene> scenes;
+    std::vector<batch::BatchInput> scenes;
     for (const std::string& spec : args.scenes) {
-        scenes.push_back(usage_errors([&] { return batch::load_batch_scene(spec, request); }));
+        scenes.push_back(usage_errors([&] { return batch::load_batch_input(spec, request); }));
         print_scene_warnings(scenes.back().scene, args.quiet);
     }
 
@@ -259,7 +259,7 @@ void run_render(const RenderArguments& args) {
     // they finish).
     bool write_behind = !args.progressive;
     memory.write_behind = write_behind;
-    for (batch::BatchScene& scene : scenes) {
+    for (batch::BatchInput& scene : scenes) {
         if (!args.crop.empty()) {
             try {
                 scene.crop = batch::parse_crop(args.crop, scene.scene.image.width,

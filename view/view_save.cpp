@@ -131,7 +131,7 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
     }
 
     posed.camera = frame->camera;
-    batch::BatchScene identity;
+    batch::BatchInput identity;
     identity.spec = settings.spec;
     identity.sha256 = settings.sha256;
     identity.scene = posed;

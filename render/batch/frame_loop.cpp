@@ -54,7 +54,7 @@ std::pair<std::string, float> capture_date() {
 }
 
 // A frame's work for the progress bar: the pixel samples it traces.
-std::uint64_t frame_work(const BatchScene& scene) {
+std::uint64_t frame_work(const BatchInput& scene) {
     const ImageSettings& image = scene.scene.image;
     const PixelRect rect = scene.crop.value_or(PixelRect{0, 0, image.width, image.height});
     return rect.pixel_count() * static_cast<std::uint64_t>(image.spp);
@@ -122,7 +122,7 @@ class BatchRunner {
   public:
     using Account = std::function<void(const FrameResult&)>;
 
-    BatchRunner(const std::vector<BatchScene>& scenes, const BatchSettings& settings,
+    BatchRunner(const std::vector<BatchInput>& scenes, const BatchSettings& settings,
                 BatchObserver& observer, const std::atomic<bool>* cancel, Account account)
         : scenes_(scenes),
           settings_(settings),
@@ -146,14 +146,14 @@ class BatchRunner {
     void finish_pending();
 
   private:
-    ExrAttributes attributes(const BatchScene& scene, const Scene& posed, int frame,
+    ExrAttributes attributes(const BatchInput& scene, const Scene& posed, int frame,
                              const RenderResult& result, int samples_so_far) const;
-    FrameFiles files(const BatchScene& scene, const BatchJob& job, const Scene& posed,
+    FrameFiles files(const BatchInput& scene, const BatchJob& job, const Scene& posed,
                      const RenderResult& result, const Image& aovs, int samples_so_far);
     void finish(const FrameResult& out, std::uint64_t work);
     void write_behind(PendingWrite& p);
 
-    const std::vector<BatchScene>& scenes_;
+    const std::vector<BatchInput>& scenes_;
     const BatchSettings& settings_;
     BatchObserver& observer_;
     const std::atomic<bool>* cancel_;
@@ -177,7 +177,7 @@ class BatchRunner {
 
 }  // namespace
 
-ExrAttributes render_exr_attributes(const BatchScene& scene, const Scene& posed, int frame,
+ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed, int frame,
                                     const RenderResult& result, const std::string& path_label,
                                     int samples_so_far, const std::string& owner) {
     const auto [date, utc_offset] = capture_date();
@@ -219,13 +219,13 @@ ExrAttributes render_exr_attributes(const BatchScene& scene, const Scene& posed,
 
 namespace {
 
-ExrAttributes BatchRunner::attributes(const BatchScene& scene, const Scene& posed, int frame,
+ExrAttributes BatchRunner::attributes(const BatchInput& scene, const Scene& posed, int frame,
                                       const RenderResult& result, int samples_so_far) const {
     return render_exr_attributes(scene, posed, frame, result, render_path_label(settings_),
                                  samples_so_far, owner_);
 }
 
-FrameFiles BatchRunner::files(const BatchScene& scene, const BatchJob& job, const Scene& posed,
+FrameFiles BatchRunner::files(const BatchInput& scene, const BatchJob& job, const Scene& posed,
                               const RenderResult& result, const Image& aovs,
                               int samples_so_far) {
     FrameFiles f;
@@ -287,7 +287,7 @@ void BatchRunner::finish_pending() {
 }
 
 bool BatchRunner::run(std::size_t index, const BatchJob& job) {
-    const BatchScene& scene = scenes_[job.scene];
+    const BatchInput& scene = scenes_[job.scene];
     FrameResult out;
     out.report.index = index;
     out.report.scene = scene.name;
@@ -480,7 +480,7 @@ std::string render_path_label(const BatchSettings& settings) {
     return settings.render.path_label();
 }
 
-BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
+BatchSummary run_batch(const std::vector<BatchInput>& scenes, const std::vector<BatchJob>& jobs,
                        const BatchSettings& settings, BatchObserver& observer,
                        const std::atomic<bool>* cancel) {
     // Limit TBB for the whole run; 0 keeps its default (every core it may use).
@@ -546,7 +546,7 @@ BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<
     summary.interrupted = cancelled();
     // The run's time counts its scenes' loading (done before it, once per scene).
     double load_seconds = 0.0;
-    for (const BatchScene& scene : scenes) load_seconds += scene.load_seconds;
+    for (const BatchInput& scene : scenes) load_seconds += scene.load_seconds;
     summary.seconds =
         load_seconds + std::chrono::duration<double>(Clock::now() - started).count();
     observer.run_finished(summary);

@@ -21,7 +21,7 @@ namespace octray::batch {
 struct BatchSettings {
     // How each frame renders (render/render_config.h): path, ISA (resolved:
     // RenderConfig::resolve_isa), acceleration, threads, tiles and AOVs. Its crop and
-    // overrides are not read here: each scene carries its own (BatchScene::crop, and the
+    // overrides are not read here: each scene carries its own (BatchInput::crop, and the
     // overrides applied when it was loaded: BatchRequest).
     RenderConfig render;
     ExrWriteOptions exr;
@@ -47,7 +47,7 @@ std::string render_path_label(const BatchSettings& settings);
 // SHA-256, `path_label` (render_path_label), seed, spp, depth, frame and time, the ray
 // counts and render time of `result`, the camera matrices and the frame rate; and for an
 // unfinished progressive image (samples_so_far < the spp) the samples so far and `owner`.
-ExrAttributes render_exr_attributes(const BatchScene& scene, const Scene& posed, int frame,
+ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed, int frame,
                                     const RenderResult& result, const std::string& path_label,
                                     int samples_so_far, const std::string& owner);
 
@@ -59,7 +59,7 @@ ExrAttributes render_exr_attributes(const BatchScene& scene, const Scene& posed,
 // on. Once *cancel is set (a signal handler may set it), the frame in progress is
 // abandoned at its next tile, leaving nothing half-written and its claim released, and no
 // further frame starts; `cancel` may be nullptr.
-BatchSummary run_batch(const std::vector<BatchScene>& scenes, const std::vector<BatchJob>& jobs,
+BatchSummary run_batch(const std::vector<BatchInput>& scenes, const std::vector<BatchJob>& jobs,
                        const BatchSettings& settings, BatchObserver& observer,
                        const std::atomic<bool>* cancel);
 

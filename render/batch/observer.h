@@ -20,8 +20,8 @@ enum class FrameOutcome { rendered, skipped_existing, skipped_claimed, failed };
 
 struct FrameReport {
     std::size_t index = 0;   // 1-based position in this run's frame list
-    std::string scene;       // BatchScene::name
-    std::string scene_spec;  // BatchScene::spec, as given
+    std::string scene;       // BatchInput::name
+    std::string scene_spec;  // BatchInput::spec, as given
     int frame = 0;
     std::string output;
     std::string preview;  // the PNG, if any
@@ -52,7 +52,7 @@ struct BatchSummary {
 
 // What a run is about to do, before its first frame.
 struct RunStart {
-    const std::vector<BatchScene>& scenes;
+    const std::vector<BatchInput>& scenes;
     const std::vector<BatchJob>& jobs;
     std::string path;         // the render path as octray.path names it: "simd (avx2)"
     std::size_t threads = 0;  // the worker threads of the run

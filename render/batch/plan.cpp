@@ -39,7 +39,7 @@ std::string default_pattern(bool sequence) {
 
 // How to keep two jobs that would write one file apart: what the pattern lacks, or, when
 // it has {scene}, which scenes share a name (scene files named alike in two folders).
-std::string collision_advice(const BatchScene& a, const BatchScene& b,
+std::string collision_advice(const BatchInput& a, const BatchInput& b,
                              const std::string& pattern, bool different_frames) {
     if (&a == &b)
         return different_frames ? "put #### or {frame:04d} in the pattern"
@@ -81,8 +81,8 @@ std::pair<Scene, std::string> load_scene_and_digest(const std::string& spec, int
     return {std::move(scene), std::move(digest)};
 }
 
-BatchScene load_batch_scene(const std::string& spec, const BatchRequest& request) {
-    BatchScene loaded;
+BatchInput load_batch_input(const std::string& spec, const BatchRequest& request) {
+    BatchInput loaded;
     loaded.spec = spec;
     loaded.name = scene_display_name(spec);
     const auto load_start = std::chrono::steady_clock::now();
@@ -105,7 +105,7 @@ BatchScene load_batch_scene(const std::string& spec, const BatchRequest& request
     return loaded;
 }
 
-std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
+std::vector<BatchJob> plan_jobs(const std::vector<BatchInput>& scenes,
                                 const BatchRequest& request) {
     std::vector<BatchJob> jobs;
     std::size_t total = 0;

@@ -41,7 +41,10 @@ struct BatchRequest {
     std::string png;  // the PNG previews' pattern; empty: no preview
 };
 
-struct BatchScene {
+// One input of a batch run: a scene as the run takes it (loaded once, overrides applied)
+// and what the run says of it. Not another shape of a scene: the Scene is `scene`
+// (render/README.md, "Scene shapes").
+struct BatchInput {
     std::string spec;               // as given on the command line
     std::string name;               // {scene} in output patterns
     std::string sha256;             // octray.sceneSha256
@@ -67,14 +70,14 @@ std::pair<Scene, std::string> load_scene_and_digest(const std::string& spec, int
 // The scene of `spec` with its name, digest, load time and the request's overrides,
 // validated again when any applies (RequestError when they make it invalid). Throws
 // SceneError for a scene that cannot be loaded.
-BatchScene load_batch_scene(const std::string& spec, const BatchRequest& request);
+BatchInput load_batch_input(const std::string& spec, const BatchRequest& request);
 
 // The frame list of the whole run, in order: each scene's frames (request.frames, else
 // its animation's 0..frames-1, or 0 for a still), scene after scene, with the output and
 // preview files of each. RequestError for a bad frame spec or pattern, a pattern without
 // a frame field for several frames, -o and --png naming one file, or two frames that
 // would write one file, however spelled (output_paths.h, output_identity).
-std::vector<BatchJob> plan_jobs(const std::vector<BatchScene>& scenes,
+std::vector<BatchJob> plan_jobs(const std::vector<BatchInput>& scenes,
                                 const BatchRequest& request);
 
 }  // namespace octray::batch

@@ -46,7 +46,7 @@ void render_like_the_cli(const std::string& scene_file, const std::string& outpu
     batch::BatchRequest request;
     request.threads = 2;
     request.output = output;
-    std::vector<batch::BatchScene> scenes{batch::load_batch_scene(scene_file, request)};
+    std::vector<batch::BatchInput> scenes{batch::load_batch_input(scene_file, request)};
     if (!crop.empty())
         scenes[0].crop =
             batch::parse_crop(crop, scenes[0].scene.image.width, scenes[0].scene.image.height);

@@ -108,7 +108,7 @@ class FrameLoopTest : public ::testing::Test {
         request_.overrides.height = kHeight;
         request_.frames = "0-2";
         request_.output = (dir_ / "w.#.exr").string();
-        scenes_.push_back(load_batch_scene("whitted", request_));
+        scenes_.push_back(load_batch_input("whitted", request_));
         settings_.render.resolve_isa();
         settings_.render.threads = 2;
     }
@@ -146,7 +146,7 @@ class FrameLoopTest : public ::testing::Test {
         std::ofstream(file) << json;
         request_ = BatchRequest{};
         request_.output = (dir_ / (prefix + ".#.exr")).string();
-        scenes_ = {load_batch_scene(file.string(), request_)};
+        scenes_ = {load_batch_input(file.string(), request_)};
         settings_.exr.float32 = true;
     }
 
@@ -163,7 +163,7 @@ class FrameLoopTest : public ::testing::Test {
 
     fs::path dir_;
     BatchRequest request_;
-    std::vector<BatchScene> scenes_;
+    std::vector<BatchInput> scenes_;
     BatchSettings settings_;
 };
 
@@ -472,8 +472,8 @@ TEST_F(FrameLoopTest, AWriteThatFailsWhileTheNextFrameRendersFailsThatFrameAlone
     BatchRequest small_request, large_request;
     small_request.overrides.width = 8, small_request.overrides.height = 8;
     large_request.overrides.width = 160, large_request.overrides.height = 160;
-    scenes_ = {load_batch_scene("whitted", small_request),
-               load_batch_scene("whitted", large_request)};
+    scenes_ = {load_batch_input("whitted", small_request),
+               load_batch_input("whitted", large_request)};
     const std::vector<BatchJob> jobs = {{0, 0, (dir_ / "small.0.exr").string(), ""},
                                         {1, 0, (dir_ / "large.0.exr").string(), ""},
                                         {0, 1, (dir_ / "small.1.exr").string(), ""}};
