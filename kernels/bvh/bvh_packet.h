@@ -35,7 +35,7 @@
 // values) and of O - c. (The textbook form used before was far worse: a fuzzy sphere of
 // radius ~sqrt(19u)|O'| around a tiny sphere far away, and a widening of
 // sqrt(r_min^2 + 32u(D^2 + r_max^2)) - r_min, up to half a radius on random:1048576.)
-// The tests (tests/kernels/bvh_traversal_test.cpp) check hit for hit against brute force
+// The tests (tests/kernels/bvh/bvh_traversal_test.cpp) check hit for hit against brute force
 // on degenerate scenes (radii from 1e-6 to 1e3, coincident spheres, spheres far apart).
 
 #ifndef OCTRAY_KERNEL_NAMESPACE

@@ -4,7 +4,7 @@
 // and its children's boxes, empty slots last and never entered, the same bytes for any
 // thread count, leaves that are small parts of the root on spread-out spheres; secondary
 // rays ray by ray in large and in dense scenes. The traversal:
-// tests/kernels/bvh_traversal_test.cpp.
+// tests/kernels/bvh/bvh_traversal_test.cpp.
 
 #include "render/prepare/bvh_build.h"
 
@@ -20,7 +20,7 @@
 
 #include "render/prepare/scene_view.h"
 #include "scene/compile.h"
-#include "tests/kernels/bvh_test_scenes.h"
+#include "tests/kernels/bvh/bvh_test_scenes.h"
 
 namespace octray {
 namespace {

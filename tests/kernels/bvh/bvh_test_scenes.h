@@ -1,9 +1,9 @@
 #pragma once
 // The scenes the sphere BVH's tests share: the builder's
 // (tests/render/prepare/bvh_build_test.cpp) and the traversal's
-// (tests/kernels/bvh_traversal_test.cpp). Random and degenerate sphere sets: one sphere, all at
-// one point, radii from 1e-6 to 1e3, spheres far apart along one axis, duplicates that tie,
-// planes.
+// (tests/kernels/bvh/bvh_traversal_test.cpp). Random and degenerate sphere sets: one sphere,
+// all at one point, radii from 1e-6 to 1e3, spheres far apart along one axis, duplicates that
+// tie, planes.
 
 #include <random>
 #include <string>

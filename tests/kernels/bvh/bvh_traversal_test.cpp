@@ -1,9 +1,9 @@
 // The sphere BVH's traversal (kernels/stream/hit_kernels.h and the kernels/bvh/ headers it
 // includes), under every ISA the CPU runs and with packets, single rays and the switch
 // between them: closest hits equal the scalar reference's (brute force) bit for bit and hit
-// for hit on random rays over random and degenerate scenes (tests/kernels/bvh_test_scenes.h);
-// any-hit equals the reference's occlusion and agrees with closest hit. The builder:
-// tests/render/prepare/bvh_build_test.cpp.
+// for hit on random rays over random and degenerate scenes
+// (tests/kernels/bvh/bvh_test_scenes.h); any-hit equals the reference's occlusion and agrees
+// with closest hit. The builder: tests/render/prepare/bvh_build_test.cpp.
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -21,7 +21,7 @@
 #include "render/prepare/scene_view.h"
 #include "render/reference.h"
 #include "scene/compile.h"
-#include "tests/kernels/bvh_test_scenes.h"
+#include "tests/kernels/bvh/bvh_test_scenes.h"
 
 namespace octray {
 namespace {
