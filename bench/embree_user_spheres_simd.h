@@ -49,8 +49,8 @@ Lanes sphere_lanes(const EmbreeSphereData& s, unsigned prim, const int* valid, f
     const F tfar = F::load_unaligned(ray + 8 * n + i);
     // octray's operations in octray's order (kernels/geometry/sphere_test.h, sphere_quadratic
     // and sphere_roots), without FMA: the same t bit for bit. With FMA the roots moved by an
-    // ulp or two, enough to flip shadow rays at sphereflake's touching spheres: 1.4 % of an
-    // Embree frame's pixels off by more than 0.01, which failed its validation.
+    // ulp or two, enough to flip shadow rays at sphereflake's touching spheres and fail the
+    // Embree frame's validation (docs/performance-log.md, "Figures from source comments").
     const F a = dx * dx + dy * dy + dz * dz;
     const F b = ox * dx + oy * dy + oz * dz;
     const F bt = b / a;

@@ -19,9 +19,10 @@ inline constexpr std::size_t kSimdAlignment = 64;
 // Storage that asks for Pages::huge and holds 4 MiB or more starts on a 2 MiB boundary and
 // is offered to Linux's transparent huge pages, which Debian's kernel gives only where
 // asked (madvise): a 2 MiB page takes one page fault where 4 KiB pages take 512. The BVH
-// and its builder's buffers ask (building random:1048576 took 15 % less time); frames
-// do not: a frame is allocated per render, and rendering whitted and random:64 went 5-20 %
-// slower with its pages huge (the kernel zeroes, and may first compact, 2 MiB at a time).
+// and its builder's buffers ask (it builds faster); frames do not: a frame is allocated
+// per render, and renders went slower with its pages huge (the kernel zeroes, and may
+// first compact, 2 MiB at a time). Measured: docs/performance-log.md, "Figures from
+// source comments".
 enum class Pages { normal, huge };
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 inline constexpr std::size_t kHugePageMinBytes = std::size_t{4} << 20;
@@ -44,8 +45,8 @@ inline void* allocate_aligned(std::size_t bytes, Pages pages = Pages::normal) {
 }
 // The same offer for storage allocated elsewhere (a std::string or std::vector that is
 // about to be filled): the whole 2 MiB pages inside [p, p + bytes), if it holds 4 MiB or
-// more. Reading the 114 MB scene file of random:1048576 into a string offered this way
-// took 0.06 s instead of 0.11 s. Advice only.
+// more: a large scene file is read faster into a string offered this way (measured there
+// too). Advice only.
 inline void offer_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     if (bytes < kHugePageMinBytes) return;
