@@ -74,7 +74,7 @@ TEST(HalfBits, F16cGivesImathsBitsEverywhereRoundingIsHard) {
         }
 }
 
-// A frame's R, G and B: stride 3, lengths that leave 0 to 8 values after the 8-wide blocks,
+// Every third float (stride 3), lengths that leave 0 to 8 values after the 8-wide blocks,
 // a NaN inside a block; each out[k] written, nothing past count, nothing read past the
 // buffer (which holds exactly the count's pixels: ASan checks the reads).
 TEST(HalfBits, StridesAndTailsGiveEachValueItsHalf) {
@@ -93,9 +93,9 @@ TEST(HalfBits, StridesAndTailsGiveEachValueItsHalf) {
     }
 }
 
-// The F16C build on interleaved RGB (stride 3, 24 floats converted at a time and every
-// third half picked): every hard float, as R, as G and as B.
-TEST(HalfBits, F16cOnInterleavedRgbGivesImathsBits) {
+// The F16C build with a stride (the floats gathered 8 at a time): every hard float, at
+// each of three offsets.
+TEST(HalfBits, F16cWithAStrideGivesImathsBits) {
     if (!half_bits_use_f16c())
         GTEST_SKIP() << "this CPU has no F16C (or no AVX state): nothing to compare";
     const std::vector<float> v = hard_floats();
