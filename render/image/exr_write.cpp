@@ -308,7 +308,10 @@ class ChunkEncoder {
     // Chunk `chunk`'s data as the file stores it after its y and size: compressed when
     // that makes it smaller, as OpenEXR's reader expects (it reads a chunk whose size is
     // its raw size as raw).
-    void encode(int chunk, std::vector<unsigned char>& out) const {
+    // `out` is uninitialised storage: only the bytes written are touched (resizing a
+    // std::vector to the raw size zeroed 5.5 MB for a 1280x720 half RGB frame, page
+    // faults included, for ~0.7 MB of compressed chunks).
+    void encode(int chunk, SampleBytes& out) const {
         const std::size_t raw = raw_bytes(chunk);
         if (compression_ == ExrCompression::none) {
             out.resize(raw);
@@ -434,7 +437,7 @@ void write_exr_with_own_chunks(const std::string& path, const Image& image,
     // In the caller's arena, whose threads the frame's other work (its PNG) shares: a
     // task arena of its own here would wait for a worker the PNG holds.
     const bool parallel = Imf::globalThreadCount() > 1;
-    std::vector<std::vector<unsigned char>> encoded;
+    std::vector<SampleBytes> encoded;
     for (int first = 0; first < chunks;) {
         int last = first;
         for (std::size_t bytes = 0;
@@ -450,8 +453,7 @@ void write_exr_with_own_chunks(const std::string& path, const Image& image,
         else
             encode_range(tbb::blocked_range<int>(first, last));
         for (int k = first; k < last; ++k) {
-            const std::vector<unsigned char>& data =
-                encoded[static_cast<std::size_t>(k - first)];
+            const SampleBytes& data = encoded[static_cast<std::size_t>(k - first)];
             offsets[static_cast<std::size_t>(k)] = file.position();
             file.write_le<std::int32_t>(image.data_window.y0 + encoder.first_line(k));
             file.write_le<std::int32_t>(static_cast<std::int32_t>(data.size()));
