@@ -329,17 +329,18 @@ void ProgressReporter::run_finished(const BatchSummary& summary) {
         if (summary.interrupted_frames > 0)
             std::printf(", %zu interrupted", summary.interrupted_frames);
         if (summary.not_started > 0) std::printf(", %zu not started", summary.not_started);
-        // The phases of short runs in milliseconds' precision: "0.0s" says nothing.
+        // The run and its phases in milliseconds' precision when short: "0.0s" says
+        // nothing.
         const auto phase = [](double seconds) {
             if (seconds >= 10.0) return format_duration(seconds);
             char text[32];
             std::snprintf(text, sizeof text, "%.3fs", seconds);
             return std::string(text);
         };
-        std::printf(
-            " in %s: prepare %s, trace %s (%.2f Mrays/s), write %s\n",
-            format_duration(summary.seconds).c_str(), phase(summary.prepare_seconds).c_str(),
-            phase(summary.trace_seconds).c_str(), mrays, phase(summary.write_seconds).c_str());
+        std::printf(" in %s: prepare %s, trace %s (%.2f Mrays/s), write %s\n",
+                    phase(summary.seconds).c_str(), phase(summary.prepare_seconds).c_str(),
+                    phase(summary.trace_seconds).c_str(), mrays,
+                    phase(summary.write_seconds).c_str());
         // What to do next: the finished frames stay, so the same command with
         // --skip-existing renders only the rest.
         if (summary.interrupted && summary.interrupted_frames + summary.not_started > 0)
