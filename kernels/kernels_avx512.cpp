@@ -4,12 +4,14 @@
 //
 // The BVH traversal takes 16 rays at a time, one 16-lane register per packet: two of the
 // stream's 8-ray packets share every node visit and every leaf's sphere loads
-// (OCTRAY_TRAVERSAL_ARCH, kernels/bvh/bvh_packet.h). Node tests (8 children), camera rays,
-// shading and the brute-force kernels stay 8 lanes wide: measured, AVX-512 encodings of
-// the 8-lane kernels gained nothing (docs/performance-log.md).
+// (OCTRAY_TRAVERSAL_ARCH, kernels/bvh/bvh_packet.h), and so does brute force; shading
+// takes 16 rays per register while 16 remain (OCTRAY_SHADE_ARCH, kernels/stream/shading.h).
+// Node tests (8 children) and camera rays stay 8 lanes wide: measured, AVX-512 encodings
+// of the 8-lane kernels gained nothing (docs/performance-log.md).
 
 #define OCTRAY_KERNEL_NAMESPACE avx512
 #define OCTRAY_TRAVERSAL_ARCH xsimd::avx512f
+#define OCTRAY_SHADE_ARCH xsimd::avx512f
 #include "kernels/kernel_table.h"
 #include "kernels/stream/camera_rays.h"
 #include "kernels/stream/hit_kernels.h"

@@ -135,17 +135,24 @@ void mask_to_flags(const M& m, float* flags) {
 // The object (or material) each lane reads, and whether they are all the same: coherent
 // packets (a 4x2 pixel block on one sphere) then load each field once and broadcast it.
 struct LaneIndex {
-    alignas(64) std::int32_t index[kPacketWidth];
+    alignas(64) std::int32_t index[16];  // a packet's lanes: 4, 8, or 16 (AVX-512 shading)
     bool uniform;
 };
 
 // base[index[i]] per lane, as float (T: float, or a small unsigned count or flag). AVX2
-// gathers in one instruction; SSE builds the register from four scalar loads. Neither
-// writes lanes to memory to load them back as a whole register (a store-forwarding stall).
+// and AVX-512 gather in one instruction; SSE builds the register from four scalar loads.
+// Neither writes lanes to memory to load them back as a whole register (a store-forwarding
+// stall).
 template <class F, class T>
 F gather(const T* base, const LaneIndex& ix) {
     if (ix.uniform) return F(static_cast<float>(base[ix.index[0]]));
-    if constexpr (F::size == 8) {
+    if constexpr (F::size == 16) {
+        const __m512i index = _mm512_load_si512(ix.index);
+        if constexpr (std::is_same_v<T, float>)
+            return _mm512_i32gather_ps(index, base, 4);
+        else
+            return _mm512_cvtepi32_ps(_mm512_i32gather_epi32(index, base, 4));
+    } else if constexpr (F::size == 8) {
         const __m256i index = _mm256_load_si256(reinterpret_cast<const __m256i*>(ix.index));
         if constexpr (std::is_same_v<T, float>)
             return _mm256_i32gather_ps(base, index, 4);

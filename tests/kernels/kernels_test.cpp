@@ -2,14 +2,19 @@
 // (typed tests; an ISA the CPU lacks is skipped): closest hit and any hit for random
 // rays and scenes, partially live packets, rays missing everything, rays starting inside
 // spheres, grazing and tangent rays, sphere/plane ties; camera rays for every camera;
-// shading never produces NaN. Results must equal the reference's bit for bit.
+// shading never produces NaN, and AVX-512's 16-lane shading is AVX2's 8-lane shading bit for
+// bit. Results must equal the reference's bit for bit.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <optional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "core/aligned.h"
@@ -460,6 +465,99 @@ TYPED_TEST(KernelTest, ShadingNeverProducesNaN) {
         EXPECT_LT(link[i] >> 1, n);
         EXPECT_TRUE(std::isfinite(next.dx[i]) && std::isfinite(next.ox[i]) &&
                     std::isfinite(next.wr[i]));
+    }
+}
+
+// AVX-512 shades 16 rays per register, then its last 8-ray packet 8 wide (shading.h):
+// for every count from 1 to 40 (both paths, and every tail), its colors, shadow rays and
+// children are AVX2's, bit for bit and in the same order, and nothing is written past a
+// stream's capacity (whole packets plus the spare one: ASan checks it).
+TEST(ShadeWidths, SixteenLanesShadeAsEight) {
+    if (!isa_supported(Isa::avx512) || !isa_supported(Isa::avx2))
+        GTEST_SKIP() << "this CPU lacks AVX-512 or AVX2: no two widths to compare";
+    const Scene scene = load_scene("whitted,width=16,height=16");
+    const CompiledScene compiled = compile_scene(scene);
+    const kernels::SceneView view = make_scene_view(compiled);
+    const std::uint32_t lights = static_cast<std::uint32_t>(compiled.lights.count);
+    struct Shaded {
+        kernels::ShadeCounts counts{};
+        std::vector<AlignedVector<float>> color;
+        Rays shadows, next;
+        AlignedVector<float> term;
+        AlignedVector<std::uint32_t> parent, link;
+        AlignedVector<float> factor;
+        Shaded(std::size_t n, std::uint32_t lights)
+            : color(9, AlignedVector<float>(padded(n) + kPacketWidth, -1.0f)),
+              shadows(0, padded(n * lights) + kPacketWidth),
+              next(0, padded(2 * n) + kPacketWidth),
+              link(next.ox.size(), 0u),
+              factor(3 * next.ox.size(), 0.0f) {}
+    };
+    for (std::size_t n = 1; n <= 40; ++n) {
+        SCOPED_TRACE("count " + std::to_string(n));
+        std::mt19937 rng(static_cast<unsigned>(n));
+        Rays rays(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            Ray r = random_ray(rng, 0.0f);
+            r.origin = r.origin * 0.5f + Vec3{0, 1, 0};
+            rays.set(i, r);
+            rays.wr[i] = 0.9f, rays.wg[i] = 0.5f, rays.wb[i] = 0.2f;
+        }
+        AlignedVector<float> t(padded(n));
+        AlignedVector<std::int32_t> object(padded(n));
+        kernel_table(Isa::avx2).closest_hit(view, rays.stream(), static_cast<std::uint32_t>(n),
+                                            0.0f, {t.data(), object.data()});
+        const auto shade = [&](Isa isa) {
+            auto out = std::make_unique<Shaded>(n, lights);
+            Shaded& o = *out;
+            const kernels::ShadowStream sh = o.shadows.shadow_stream(o.term, o.parent);
+            const std::size_t cap = o.next.ox.size();
+            o.counts = kernel_table(isa).shade(
+                view,
+                {rays.stream(), {t.data(), object.data()}, static_cast<std::uint32_t>(n), 0},
+                {{o.color[0].data(), o.color[1].data(), o.color[2].data(), o.color[3].data(),
+                  o.color[4].data(), o.color[5].data(), o.color[6].data(), o.color[7].data(),
+                  o.color[8].data()},
+                 sh,
+                 o.next.stream(),
+                 {o.link.data(), o.factor.data(), o.factor.data() + cap,
+                  o.factor.data() + 2 * cap}});
+            return out;
+        };
+        const auto narrow = shade(Isa::avx2), wide = shade(Isa::avx512);
+        ASSERT_EQ(wide->counts.shadow, narrow->counts.shadow);
+        ASSERT_EQ(wide->counts.next, narrow->counts.next);
+        EXPECT_EQ(wide->counts.reflected, narrow->counts.reflected);
+        EXPECT_EQ(wide->counts.refracted, narrow->counts.refracted);
+        for (std::size_t c = 0; c < 9; ++c)
+            for (std::size_t i = 0; i < n; ++i)
+                EXPECT_EQ(wide->color[c][i], narrow->color[c][i])
+                    << "color " << c << ", ray " << i;
+        // The streams' order differs (16 rays' shadow rays light by light, then the next 16,
+        // against 8 at a time), never the order of one parent's rays: each stream sorted
+        // stably by parent slot must be the same.
+        const auto shadow_rays = [](const Shaded& o, std::uint32_t count) {
+            std::vector<std::array<float, 6>> v;
+            for (std::uint32_t i = 0; i < count; ++i)
+                v.push_back({static_cast<float>(o.parent[i]), o.shadows.ox[i], o.shadows.dz[i],
+                             o.shadows.t_max[i], o.term[i],
+                             o.term[o.shadows.t_max.size() + i]});
+            std::stable_sort(v.begin(), v.end(),
+                             [](const auto& a, const auto& b) { return a[0] < b[0]; });
+            return v;
+        };
+        const auto children = [](const Shaded& o, std::uint32_t count) {
+            std::vector<std::array<float, 5>> v;
+            for (std::uint32_t i = 0; i < count; ++i)
+                v.push_back({static_cast<float>(o.link[i]), o.next.dx[i], o.next.oy[i],
+                             o.next.wb[i], o.factor[i]});
+            std::stable_sort(v.begin(), v.end(),
+                             [](const auto& a, const auto& b) { return a[0] < b[0]; });
+            return v;
+        };
+        EXPECT_EQ(shadow_rays(*wide, wide->counts.shadow),
+                  shadow_rays(*narrow, narrow->counts.shadow));
+        EXPECT_EQ(children(*wide, wide->counts.next), children(*narrow, narrow->counts.next));
     }
 }
 
