@@ -45,9 +45,12 @@ Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMod
 
 // A whole-frame row: warm-up frames, then o.reps timed repetitions of frames (each
 // frame's own seconds, repeat_timed), the last frame's ray counts, the rates and frames
-// per second, the spread.
-void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
-                 const BenchOptions& o);
+// per second, the spread. `render(spare)` renders one frame; with `reuse_storage` `spare`
+// holds the frame before's pixels, for RenderOptions::spare_image (a sequence's frames
+// render into the last one's storage, as octray render's frame loop does), otherwise it
+// is nullptr and every frame maps fresh storage (a still's one picture).
+void time_frames(BenchRow& row, const std::function<RenderResult(Image* spare)>& render,
+                 const BenchOptions& o, bool reuse_storage);
 // The row's timing from its seconds and rays, its spread against o.max_spread.
 void set_timing(BenchRow& row, const BenchOptions& o);
 

@@ -624,14 +624,16 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile, 
                 std::optional<PreparedScene> prepared;
                 if (w == Workload::frame)
                     run.arena.execute([&] { prepared.emplace(bs.scene, accel, ro.threads); });
-                const auto render = [&] {
-                    if (path == RenderPath::scalar) return render_reference(bs.scene, ro);
-                    return prepared ? render_packet(*prepared, ro, isa)
-                                    : render_packet(bs.scene, ro, isa);
+                const auto render = [&](Image* spare) {
+                    RenderOptions frame_ro = ro;
+                    frame_ro.spare_image = spare;
+                    if (path == RenderPath::scalar) return render_reference(bs.scene, frame_ro);
+                    return prepared ? render_packet(*prepared, frame_ro, isa)
+                                    : render_packet(bs.scene, frame_ro, isa);
                 };
                 {
                     detail::Stopwatch timed(run.report.context.timed_seconds);
-                    detail::time_frames(row, render, o);
+                    detail::time_frames(row, render, o, w == Workload::frame);
                 }
                 run.report.rows.push_back(std::move(row));
                 ++run.rows_done;
@@ -663,15 +665,17 @@ void measure_embree_renders(BenchRun& run, BenchScene& bs, TileSize tile, Worklo
         }
         row.valid = ok;
         const RenderOptions ro = frame_options(run, tile);
-        const auto render = [&] {
-            if (w == Workload::frame) return frames.render(bs.compiled, ro);
+        const auto render = [&](Image* spare) {
+            RenderOptions frame_ro = ro;
+            frame_ro.spare_image = spare;
+            if (w == Workload::frame) return frames.render(bs.compiled, frame_ro);
             const auto start = std::chrono::steady_clock::now();
             const CompiledScene compiled = compile_scene(bs.scene);  // as octray's still
             const double compile =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             double build = 0.0;
             run.arena.execute([&] { build = scene.rebuild(); });
-            RenderResult r = frames.render(bs.compiled, ro);
+            RenderResult r = frames.render(bs.compiled, frame_ro);
             r.compile_seconds = compile;
             r.bvh_seconds = build;
             r.seconds += compile + build;
@@ -679,7 +683,7 @@ void measure_embree_renders(BenchRun& run, BenchScene& bs, TileSize tile, Worklo
         };
         {
             detail::Stopwatch timed(run.report.context.timed_seconds);
-            detail::time_frames(row, render, run.o);
+            detail::time_frames(row, render, run.o, w == Workload::frame);
         }
         run.report.rows.push_back(std::move(row));
         ++run.rows_done;

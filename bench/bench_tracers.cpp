@@ -145,12 +145,14 @@ Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMod
 
 // A whole-frame row: warm-up frames, then o.reps timed repetitions (each frame's own
 // seconds), the last frame's ray counts, the rates and frames per second.
-void time_frames(BenchRow& row, const std::function<RenderResult()>& render,
-                 const BenchOptions& o) {
+void time_frames(BenchRow& row, const std::function<RenderResult(Image* spare)>& render,
+                 const BenchOptions& o, bool reuse_storage) {
     RenderResult last;
+    Image spare;
     Repetitions reps = repeat_timed(
         [&] {
-            last = render();
+            last = render(reuse_storage ? &spare : nullptr);
+            if (reuse_storage) spare = std::move(last.image);
             return last.seconds;
         },
         o);

@@ -1,5 +1,5 @@
-// bench/bench_runner.h: statistics, ratios, and the JSON report's schema (timings are
-// never asserted, only their shape).
+// bench/bench_runner.h: statistics, ratios, the JSON report's schema, and the frames' storage
+// (timings are never asserted, only their shape).
 
 #include "bench/bench_runner.h"
 
@@ -10,8 +10,12 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <vector>
 
+#include "bench/bench_detail.h"
 #include "bench/embree_baseline.h"
+#include "render/packet_renderer.h"
+#include "scene/load.h"
 
 namespace octray::bench {
 namespace {
@@ -53,6 +57,43 @@ TEST(RepeatTimed, EachRepetitionRunsUntilTheMinimumTime) {
     calls = 0;
     EXPECT_EQ(repeat_timed(run, o).runs, (std::vector<std::uint32_t>{1, 1, 1}));
     EXPECT_EQ(calls, 2 + 3);
+}
+
+// Issue 42: a `frame` row renders each frame into the storage of the frame before (as
+// octray render's frame loop does with RenderOptions::spare_image); a `still` row maps
+// fresh storage for every frame, as a one-picture render does.
+TEST(TimeFrames, FramesRenderIntoTheLastFramesStorageStillsIntoFreshStorage) {
+    const PreparedScene prepared(load_scene("whitted,width=16,height=8"), Accel::automatic, 1);
+    BenchOptions o;
+    o.warmup = 1;
+    o.reps = 2;
+    o.min_time = 0.0;
+    for (const bool reuse : {true, false}) {
+        SCOPED_TRACE(reuse ? "frame" : "still");
+        std::vector<const float*> planes;
+        std::vector<bool> given_spare;
+        BenchRow row;
+        detail::time_frames(
+            row,
+            [&](Image* spare) {
+                given_spare.push_back(spare != nullptr);
+                RenderOptions ro;
+                ro.threads = 1;
+                ro.spare_image = spare;
+                RenderResult r = render_packet(prepared, ro);
+                planes.push_back(r.image.plane(0));
+                return r;
+            },
+            o, reuse);
+        ASSERT_EQ(planes.size(), 3u);   // one warm-up frame, two timed
+        EXPECT_GE(row.rays, 16u * 8u);  // the last frame's rays, its primary rays at least
+        for (std::size_t i = 0; i < planes.size(); ++i) {
+            EXPECT_EQ(given_spare[i], reuse) << "frame " << i;
+            if (reuse && i > 0) {
+                EXPECT_EQ(planes[i], planes[0]) << "frame " << i;
+            }
+        }
+    }
 }
 
 BenchRow row(std::string system, Workload w, double mrays, bool valid = true) {
