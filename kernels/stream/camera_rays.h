@@ -30,6 +30,7 @@ std::uint32_t camera_rays(const SceneView& s, const CameraSamples& in, std::uint
     const V3<F> eye = broadcast<F>(s.eye), ln = broadcast<F>(s.ln);
     const V3<F> u_hat = broadcast<F>(s.u_hat), v_hat = broadcast<F>(s.v_hat);
     const V3<F> u = broadcast<F>(s.u), v = broadcast<F>(s.v);
+    const F one(1.0f);
     std::uint32_t written = 0;
     for (std::uint32_t base = 0; base < count; base += W) {
         const std::uint32_t lanes = count - base < W ? count - base : W;
@@ -96,10 +97,13 @@ std::uint32_t camera_rays(const SceneView& s, const CameraSamples& in, std::uint
         if (s.camera != CameraKind::fisheye) {
             store3(origin, out.ox, out.oy, out.oz, base);
             store3(direction, out.dx, out.dy, out.dz, base);
-            for (std::uint32_t i = 0; i < W; ++i) {
-                out.wr[base + i] = out.wg[base + i] = out.wb[base + i] = 1.0f;
-                out.pixel[base + i] = i < lanes ? in.pixel[base + i] : 0u;
-            }
+            store3(V3<F>{one, one, one}, out.wr, out.wg, out.wb, base);
+            // The samples' pixels, 0 past the count (whole registers: the lanes are loaded
+            // as floats, bit for bit, and the dead ones zeroed; a lane at or past the count
+            // may hold anything the caller's padding left).
+            const F pixels = F::load_aligned(reinterpret_cast<const float*>(in.pixel) + base);
+            xsimd::select(live_lanes<F>(base, count), pixels, F(0.0f))
+                .store_aligned(reinterpret_cast<float*>(out.pixel) + base);
             written += lanes;
             continue;
         }
