@@ -60,8 +60,8 @@ inline constexpr int kMaxTileSide = 4096;
 
 // The width x height of the tiles a frame is cut into.
 struct TileSize {
-    int width = 16;
-    int height = 16;
+    int width = 32;
+    int height = 32;
     friend bool operator==(const TileSize&, const TileSize&) = default;
 };
 

@@ -205,8 +205,8 @@ struct RenderOptions {
     int height = 0;
     int frame = 0;  // frame number (>= 0) of an animated scene: its pose and jitter
     // Threads, tile size (sides 1 .. 4096) and ISA never change the image: only its speed.
-    int tile_width = 16;
-    int tile_height = 16;
+    int tile_width = 32;
+    int tile_height = 32;
     // Called on the thread that called render(): once before the render starts, then about
     // every progress_interval_ms while it runs, and once at the end (all pixels done; its
     // answer then changes nothing). Returning false stops the render at its next tile (it

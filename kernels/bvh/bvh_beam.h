@@ -64,7 +64,8 @@
 
 namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 
-// Rays per beam: a 16 x 16 tile of one sample per pixel.
+// Rays per beam: a 16 x 16 tile of one sample per pixel, or a 32 x 8 strip of the default
+// 32 x 32 tile.
 constexpr std::uint32_t kBeamRays = 256;
 // The most spheres a beam gathers; a beam that meets more is left to the packet traversal.
 constexpr std::uint32_t kBeamMaxSpheres = 256;

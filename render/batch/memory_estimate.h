@@ -28,8 +28,8 @@ namespace octray::batch {
 // How the render will run: what the per-thread terms depend on.
 struct RenderMemoryParams {
     int threads = 0;  // 0: std::thread::hardware_concurrency()
-    int tile_width = 16;
-    int tile_height = 16;
+    int tile_width = 32;
+    int tile_height = 32;
     bool packet_path = true;         // the SIMD renderer's per-tile ray streams (the default)
     Accel accel = Accel::automatic;  // the sphere BVH of either path (--accel)
     bool float32_output = false;     // EXR written as 32-bit floats instead of half

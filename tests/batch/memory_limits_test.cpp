@@ -97,6 +97,7 @@ TEST(MemoryLimit, ASceneFileTooLargeToParseIsRefusedFromItsSize) {
 TEST(RenderMemory, PacketScratchGrowsWithSppLightsDepthAndThreads) {
     RenderMemoryParams p;
     p.threads = 2;
+    p.tile_width = p.tile_height = 16;  // the counts below are 16 x 16 tiles' (not the default)
     const Scene base = image_scene(640, 480, 1);
     const RenderMemoryEstimate e1 = estimate_render_memory(base, p);
     EXPECT_GT(e1.per_thread, 0u);
@@ -171,9 +172,9 @@ TEST(MemoryLimit, RefusesUpFrontWithTheEstimateInTheMessage) {
 }
 
 TEST(MemoryLimit, HugeSppIsBoundedByTheTileChunks) {
-    // A small image with 16 x 16 tiles of 10^6 samples each: the packet path traces them a
-    // chunk at a time (render/README.md, "Bounded memory"), so its scratch is that of any
-    // tile with a full chunk, and the render fits where the framebuffer does.
+    // A small image with (default, 32 x 32) tiles of 10^6 samples each: the packet path
+    // traces them a chunk at a time (render/README.md, "Bounded memory"), so its scratch is
+    // that of any tile with a full chunk, and the render fits where the framebuffer does.
     Scene s = image_scene(64, 64, 1000000);
     RenderMemoryParams p;
     p.threads = 1;
