@@ -40,6 +40,10 @@
 
 namespace octray::api {
 
+// The API's default tile is the renderer's (core/pixel_rect.h), so a render through the
+// API runs as `octray render` does.
+static_assert(kDefaultTileSide == TileSize{}.width && kDefaultTileSide == TileSize{}.height);
+
 struct Scene::Impl {
     octray::Scene scene;
 };

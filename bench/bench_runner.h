@@ -54,7 +54,7 @@ struct BenchOptions {
     int width = 1920, height = 1080;
     // Knobs; each list is measured in one run, every value a row of its own. The first
     // value of each list is the default configuration.
-    std::vector<TileSize> tiles{TileSize{32, 32}};
+    std::vector<TileSize> tiles{TileSize{}};
     std::vector<PixelOrder> orders{PixelOrder::tiled};
     std::vector<Isa> isas{Isa::automatic};
     std::vector<RenderPath> paths{

@@ -533,7 +533,7 @@ class PacketTracer {
         // Up to the stream's capacity for n samples (whole packets and the spare one), not
         // the buffer's: a buffer grown by a larger tile (64x64 after 16x16, the viewer's
         // frameless blocks after whole tiles) had every call pad thousands of samples.
-        for (std::size_t m = n; m < std::min(stream_capacity(n), s.samples.x.size()); ++m) {
+        for (std::size_t m = n; m < stream_capacity(n); ++m) {  // reserve(n) sized it
             sx[m] = sy[m] = su[m] = sv[m] = 0.0f;
             spixel[m] = 0;
         }

@@ -63,10 +63,10 @@ struct SampleRange {
 };
 
 struct RenderOptions {
-    int threads = 0;          // 0: every core TBB sees
-    std::uint32_t frame = 0;  // the frame counter of the random hash
-    int tile_width = 32;
-    int tile_height = 32;
+    int threads = 0;                    // 0: every core TBB sees
+    std::uint32_t frame = 0;            // the frame counter of the random hash
+    int tile_width = TileSize{}.width;  // core/pixel_rect.h's default
+    int tile_height = TileSize{}.height;
     // Batch rendering (render/batch/frame_loop.h), both optional: the renderers poll *cancel
     // between tiles and inside them (the simd path between chunks of packets, the scalar
     // one before each ray), so a frame of any size, spp and depth stops within a few

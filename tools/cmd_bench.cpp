@@ -320,7 +320,8 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
                     "Tile sizes WxH (or N for NxN), sides " +
                         integer_range_text(1, kMaxTileSide) +
                         " (tiled order, whole renders); a list is measured in one run "
-                        "[default: 32x32]")
+                        "[default: " +
+                        tile_size_name(TileSize{}) + "]")
         ->delimiter(',')
         ->type_name("LIST")
         ->transform(tile_size(kMaxTileSide));

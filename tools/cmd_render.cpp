@@ -72,7 +72,7 @@ struct RenderArguments {
     std::string png;
     bool float32 = false;
     std::string compression{to_string(ExrWriteOptions{}.compression)};
-    std::string tile = "32x32";
+    std::string tile = tile_size_name(TileSize{});
     // Set only when the user gave the option, so the scene's own value stays otherwise.
     CLI::Option* width_option = nullptr;
     CLI::Option* height_option = nullptr;

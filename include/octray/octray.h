@@ -196,6 +196,10 @@ struct Crop {
     int height() const { return y1 - y0; }
 };
 
+// The side of a render's square tiles unless RenderOptions says otherwise: the octray
+// command's `--tile` default (api/octray.cpp checks that the two agree).
+inline constexpr int kDefaultTileSide = 32;
+
 struct RenderOptions {
     Path path = Path::simd;
     Isa isa = Isa::automatic;  // simd path only; a forced ISA the CPU lacks is an Error
@@ -205,8 +209,8 @@ struct RenderOptions {
     int height = 0;
     int frame = 0;  // frame number (>= 0) of an animated scene: its pose and jitter
     // Threads, tile size (sides 1 .. 4096) and ISA never change the image: only its speed.
-    int tile_width = 32;
-    int tile_height = 32;
+    int tile_width = kDefaultTileSide;
+    int tile_height = kDefaultTileSide;
     // Called on the thread that called render(): once before the render starts, then about
     // every progress_interval_ms while it runs, and once at the end (all pixels done; its
     // answer then changes nothing). Returning false stops the render at its next tile (it

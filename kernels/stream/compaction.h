@@ -60,7 +60,8 @@ __m256i compaction_index(std::uint32_t bits) {
         _mm_loadl_epi64(reinterpret_cast<const __m128i*>(kCompressTable.lanes[bits])));
 }
 
-// The lower and upper 8 lanes of a 16-lane register.
+// The lower and upper 8 lanes of a 16-lane register. (This and store_slots are templates so
+// that a translation unit without AVX-512 or AVX2 never instantiates their intrinsics.)
 template <class F>
 __m256 lower_half(const F& v) {
     return _mm512_castps512_ps256(v);

@@ -27,9 +27,9 @@ namespace octray::batch {
 
 // How the render will run: what the per-thread terms depend on.
 struct RenderMemoryParams {
-    int threads = 0;  // 0: std::thread::hardware_concurrency()
-    int tile_width = 32;
-    int tile_height = 32;
+    int threads = 0;                    // 0: std::thread::hardware_concurrency()
+    int tile_width = TileSize{}.width;  // core/pixel_rect.h's default
+    int tile_height = TileSize{}.height;
     bool packet_path = true;         // the SIMD renderer's per-tile ray streams (the default)
     Accel accel = Accel::automatic;  // the sphere BVH of either path (--accel)
     bool float32_output = false;     // EXR written as 32-bit floats instead of half
