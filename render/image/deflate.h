@@ -19,6 +19,31 @@ std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out
 // The most bytes zlib_compress can need for `size` bytes at `level`.
 std::size_t zlib_compress_bound(int level, std::size_t size);
 
+// ---- Bands of one DEFLATE stream, compressed in parallel (deflate_runs.cpp) --------------
+// libdeflate compresses a buffer into one whole stream, so one PNG's pixels would be
+// compressed on one thread. deflate_band compresses a band of them into raw DEFLATE blocks
+// (RFC 1951) that end on a byte boundary, so that bands compressed on their own, in order,
+// make one stream: literals, runs of a repeated byte (matches at distance 1, as zlib's
+// Z_RLE) and repeats of a pixel's bytes (matches at a pixel's size), one Huffman block per
+// band, or the band stored when that is smaller.
+
+// The room deflate_band needs for `size` bytes (its output is shorter: the writer stores
+// 8 bytes at a time).
+std::size_t deflate_band_bound(std::size_t size);
+
+// Compresses in[0, size) into out (deflate_band_bound(size) bytes) and returns the length
+// written. Matches are at distance 1 and at `repeat` (1 ... 4: a pixel's bytes; 1 for runs
+// alone). `last` marks the stream's final band (it ends the stream; the others end with
+// an empty stored block, as zlib's Z_SYNC_FLUSH). References stay inside the band.
+std::size_t deflate_band(const std::uint8_t* in, std::size_t size, std::size_t repeat,
+                         bool last, std::uint8_t* out);
+
+// Adler-32 (a zlib stream's checksum) of data[0, size), continuing from `adler` (1 to
+// start); and the Adler-32 of A followed by B from A's, B's and B's length.
+std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size);
+std::uint32_t adler32_combine(std::uint32_t first, std::uint32_t second,
+                              std::size_t second_size);
+
 // CRC-32 (the PNG chunk's) of data[0, size), continuing from `crc` (0 to start).
 std::uint32_t crc32(std::uint32_t crc, const void* data, std::size_t size);
 

@@ -615,6 +615,32 @@ TEST_F(ImageIoTest, PngOfIncompressiblePixelsReadsBack) {
     EXPECT_TRUE(png.rgb == bytes);
 }
 
+// A picture of flat areas, stripes and noise, tall enough for its rows to be compressed in
+// many bands (render/image/png.cpp): libpng reads every byte back, and the flat areas
+// compress.
+TEST_F(ImageIoTest, PngOfManyBandsReadsBack) {
+    const int width = 333, height = 777;
+    std::vector<std::uint8_t> bytes(3 * static_cast<std::size_t>(width) * height);
+    std::uint32_t state = 99;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            for (int k = 0; k < 3; ++k) {
+                const int area = (y / 40 + x / 100) % 3;
+                const std::uint32_t noise = (state = state * 1664525u + 1013904223u) >> 24;
+                bytes[(static_cast<std::size_t>(y) * width + x) * 3 + k] =
+                    static_cast<std::uint8_t>(area == 0   ? 40 * k
+                                              : area == 1 ? (x / 3 + y) % 256
+                                                          : noise);
+            }
+    const std::string path = (dir_ / "bands.png").string();
+    write_png_rgb8(path, width, height, bytes);
+    EXPECT_LT(fs::file_size(path), bytes.size() / 2);
+    const PngPixels png = read_png(path);
+    ASSERT_EQ(png.width, width);
+    ASSERT_EQ(png.height, height);
+    EXPECT_TRUE(png.rgb == bytes);
+}
+
 // OpenEXR's pool of compression threads, as `octray render` sets it; the bytes of a file
 // do not depend on it.
 TEST_F(ImageIoTest, ExrThreadCountIsSetAndDoesNotChangeTheBytes) {
