@@ -26,7 +26,15 @@ std::uint32_t padded(std::uint32_t n) {
     return rounded > 0 ? rounded : kCompiledPadding;
 }
 
-// Grows every array to the padded size with the given filler (NaN geometry never hits).
+// Sizes an array of `count` entries that the caller writes to `padded` entries, the ones
+// past `count` set to `filler` (NaN geometry never hits). The entries below `count` are
+// left unwritten: zero-filling 22 arrays of a million entries on one thread before the
+// parallel fill wrote them again was most of compile_scene's time on random:1048576.
+template <class T>
+void size_for(GeometryArray<T>& v, std::uint32_t count, std::uint32_t padded, T filler) {
+    v.resize(padded);
+    std::fill(v.begin() + count, v.end(), filler);
+}
 template <class T>
 void pad(AlignedVector<T>& v, std::uint32_t n, T filler) {
     v.resize(n, filler);
@@ -132,23 +140,27 @@ CompiledScene compile_scene(const Scene& scene) {
 
     s.count = objects - planes_before[blocks];
     s.padded_count = padded(s.count);
-    for (auto* v : {&s.cx, &s.cy, &s.cz, &s.r2, &s.radius}) pad(*v, s.padded_count, kNaN);
-    pad(s.material, s.padded_count, 0u);
-    pad(s.object, s.padded_count, std::numeric_limits<std::uint32_t>::max());
+    for (auto* v : {&s.cx, &s.cy, &s.cz, &s.r2, &s.radius})
+        size_for(*v, s.count, s.padded_count, kNaN);
+    size_for(s.material, s.count, s.padded_count, 0u);
+    size_for(s.object, s.count, s.padded_count, std::numeric_limits<std::uint32_t>::max());
 
     p.count = planes_before[blocks];
     p.padded_count = padded(p.count);
-    for (auto* v : {&p.nx, &p.ny, &p.nz, &p.d}) pad(*v, p.padded_count, kNaN);
-    pad(p.material, p.padded_count, 0u);
-    pad(p.object, p.padded_count, std::numeric_limits<std::uint32_t>::max());
+    for (auto* v : {&p.nx, &p.ny, &p.nz, &p.d}) size_for(*v, p.count, p.padded_count, kNaN);
+    size_for(p.material, p.count, p.padded_count, 0u);
+    size_for(p.object, p.count, p.padded_count, std::numeric_limits<std::uint32_t>::max());
 
     o.count = objects;
     o.padded_count = padded(o.count);
-    for (auto* v : {&o.is_plane, &o.material, &o.checker}) pad(*v, o.padded_count, 0u);
+    for (auto* v : {&o.is_plane, &o.material, &o.checker})
+        size_for(*v, o.count, o.padded_count, 0u);
     for (auto* v : {&o.cx, &o.cy, &o.cz, &o.nx, &o.ny, &o.nz, &o.t1x, &o.t1y, &o.t1z, &o.t2x,
                     &o.t2y, &o.t2z})
-        pad(*v, o.padded_count, 0.0f);
+        size_for(*v, o.count, o.padded_count, 0.0f);
 
+    // Every entry below the counts, each array's own and (for an object) the other kind's
+    // zeros: a sphere has no normal or tangents, a plane no center.
     tbb::parallel_for(std::uint32_t{0}, blocks, [&](std::uint32_t block) {
         std::uint32_t pi = planes_before[block];
         std::uint32_t si = block * kBlock - pi;
@@ -167,6 +179,7 @@ CompiledScene compile_scene(const Scene& scene) {
                 p.object[pi] = k;
                 ++pi;
                 const TangentBasis tb = checker_basis(obj.normal);
+                o.cx[k] = o.cy[k] = o.cz[k] = 0.0f;
                 o.nx[k] = obj.normal.x, o.ny[k] = obj.normal.y, o.nz[k] = obj.normal.z;
                 o.t1x[k] = tb.t1.x, o.t1y[k] = tb.t1.y, o.t1z[k] = tb.t1.z;
                 o.t2x[k] = tb.t2.x, o.t2y[k] = tb.t2.y, o.t2z[k] = tb.t2.z;
@@ -175,6 +188,9 @@ CompiledScene compile_scene(const Scene& scene) {
                 s.object[si] = k;
                 write_sphere(out, si, k, obj);
                 ++si;
+                o.nx[k] = o.ny[k] = o.nz[k] = 0.0f;
+                o.t1x[k] = o.t1y[k] = o.t1z[k] = 0.0f;
+                o.t2x[k] = o.t2y[k] = o.t2z[k] = 0.0f;
             }
         }
     });

@@ -23,23 +23,29 @@ namespace octray {
 // lines of floats).
 inline constexpr std::uint32_t kCompiledPadding = 8;
 
+// The geometry arrays: sized without being written, so that compile_scene's parallel fill
+// is the first to touch their pages (on huge pages, a million spheres compiled slower:
+// 0.048 s against 0.027 s).
+template <class T>
+using GeometryArray = UninitializedVector<T>;
+
 // Spheres in file order (among spheres). `object` is the index in Scene::objects, the key
 // that breaks ties between a sphere and a plane at the same t (the first listed wins).
 struct CompiledSpheres {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;
-    AlignedVector<float> cx, cy, cz;
-    AlignedVector<float> r2;      // radius * radius, as the reference computes it
-    AlignedVector<float> radius;  // for the BVH builder's boxes and the Embree baseline
-    AlignedVector<std::uint32_t> material, object;
+    GeometryArray<float> cx, cy, cz;
+    GeometryArray<float> r2;      // radius * radius, as the reference computes it
+    GeometryArray<float> radius;  // for the BVH builder's boxes and the Embree baseline
+    GeometryArray<std::uint32_t> material, object;
 };
 
 // Planes in file order (among planes): N normalised on load, d = P0.N.
 struct CompiledPlanes {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;
-    AlignedVector<float> nx, ny, nz, d;
-    AlignedVector<std::uint32_t> material, object;
+    GeometryArray<float> nx, ny, nz, d;
+    GeometryArray<std::uint32_t> material, object;
 };
 
 // Everything shading needs per object, indexed by the object's index in the file (the id
@@ -48,12 +54,12 @@ struct CompiledPlanes {
 struct CompiledObjects {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;
-    AlignedVector<std::uint32_t> is_plane;  // 0 sphere, 1 plane
-    AlignedVector<std::uint32_t> material;
-    AlignedVector<std::uint32_t> checker;  // 1: a plane whose material has a checker
-    AlignedVector<float> cx, cy, cz;
-    AlignedVector<float> nx, ny, nz;
-    AlignedVector<float> t1x, t1y, t1z, t2x, t2y, t2z;  // checker tangent basis (planes)
+    GeometryArray<std::uint32_t> is_plane;  // 0 sphere, 1 plane
+    GeometryArray<std::uint32_t> material;
+    GeometryArray<std::uint32_t> checker;  // 1: a plane whose material has a checker
+    GeometryArray<float> cx, cy, cz;
+    GeometryArray<float> nx, ny, nz;
+    GeometryArray<float> t1x, t1y, t1z, t2x, t2y, t2z;  // checker tangent basis (planes)
 };
 
 struct CompiledMaterials {
