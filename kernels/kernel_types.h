@@ -38,11 +38,11 @@ struct SceneView {
     const float *plane_nx, *plane_ny, *plane_nz, *plane_d;
     const std::uint32_t* plane_object;
 
-    // Per object (file index): what shading needs.
+    // Per object (file index): what shading needs. object_record: kObjectRecordFloats
+    // (8) floats an object, center x y z, plane normal x y z, kind (0 sphere, 1 plane,
+    // 2 checkered plane), the material index's bits (scene/compile.h, CompiledObjects).
     std::uint32_t object_count;
-    const std::uint32_t *object_is_plane, *object_material, *object_checker;
-    const float *object_cx, *object_cy, *object_cz;
-    const float *object_nx, *object_ny, *object_nz;
+    const float* object_record;
     const float *object_t1x, *object_t1y, *object_t1z, *object_t2x, *object_t2y, *object_t2z;
 
     // Materials.

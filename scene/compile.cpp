@@ -73,8 +73,9 @@ void write_sphere(CompiledScene& out, std::uint32_t si, std::uint32_t k, const O
     s.cx[si] = obj.center.x, s.cy[si] = obj.center.y, s.cz[si] = obj.center.z;
     s.r2[si] = obj.radius * obj.radius;
     s.radius[si] = obj.radius;
-    CompiledObjects& o = out.objects;
-    o.cx[k] = obj.center.x, o.cy[k] = obj.center.y, o.cz[k] = obj.center.z;
+    float* record = out.objects.record.data() + std::size_t{k} * kObjectRecordFloats;
+    record[kRecordCx] = obj.center.x, record[kRecordCy] = obj.center.y;
+    record[kRecordCz] = obj.center.z;
 }
 
 }  // namespace
@@ -153,10 +154,9 @@ CompiledScene compile_scene(const Scene& scene) {
 
     o.count = objects;
     o.padded_count = padded(o.count);
-    for (auto* v : {&o.is_plane, &o.material, &o.checker})
-        size_for(*v, o.count, o.padded_count, 0u);
-    for (auto* v : {&o.cx, &o.cy, &o.cz, &o.nx, &o.ny, &o.nz, &o.t1x, &o.t1y, &o.t1z, &o.t2x,
-                    &o.t2y, &o.t2z})
+    size_for(o.record, o.count * kObjectRecordFloats, o.padded_count * kObjectRecordFloats,
+             0.0f);  // padding: a sphere at the origin of material 0 (no hit carries its id)
+    for (auto* v : {&o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
         size_for(*v, o.count, o.padded_count, 0.0f);
 
     // Every entry below the counts, each array's own and (for an object) the other kind's
@@ -169,9 +169,11 @@ CompiledScene compile_scene(const Scene& scene) {
             const Object& obj = scene.objects[k];
             const Material& m = scene.materials[obj.material].material;
             const bool plane = obj.type == ObjectType::plane;
-            o.is_plane[k] = plane ? 1u : 0u;
-            o.material[k] = obj.material;
-            o.checker[k] = plane && m.checker ? 1u : 0u;
+            float* record = o.record.data() + std::size_t{k} * kObjectRecordFloats;
+            record[kRecordKind] = !plane      ? kKindSphere
+                                  : m.checker ? kKindCheckerPlane
+                                              : kKindPlane;
+            record[kRecordMaterial] = std::bit_cast<float>(obj.material);
             if (plane) {
                 p.nx[pi] = obj.normal.x, p.ny[pi] = obj.normal.y, p.nz[pi] = obj.normal.z;
                 p.d[pi] = dot(obj.point, obj.normal);
@@ -179,8 +181,9 @@ CompiledScene compile_scene(const Scene& scene) {
                 p.object[pi] = k;
                 ++pi;
                 const TangentBasis tb = checker_basis(obj.normal);
-                o.cx[k] = o.cy[k] = o.cz[k] = 0.0f;
-                o.nx[k] = obj.normal.x, o.ny[k] = obj.normal.y, o.nz[k] = obj.normal.z;
+                record[kRecordCx] = record[kRecordCy] = record[kRecordCz] = 0.0f;
+                record[kRecordNx] = obj.normal.x, record[kRecordNy] = obj.normal.y;
+                record[kRecordNz] = obj.normal.z;
                 o.t1x[k] = tb.t1.x, o.t1y[k] = tb.t1.y, o.t1z[k] = tb.t1.z;
                 o.t2x[k] = tb.t2.x, o.t2y[k] = tb.t2.y, o.t2z[k] = tb.t2.z;
             } else {
@@ -188,7 +191,7 @@ CompiledScene compile_scene(const Scene& scene) {
                 s.object[si] = k;
                 write_sphere(out, si, k, obj);
                 ++si;
-                o.nx[k] = o.ny[k] = o.nz[k] = 0.0f;
+                record[kRecordNx] = record[kRecordNy] = record[kRecordNz] = 0.0f;
                 o.t1x[k] = o.t1y[k] = o.t1z[k] = 0.0f;
                 o.t2x[k] = o.t2y[k] = o.t2z[k] = 0.0f;
             }

@@ -10,6 +10,7 @@
 
 #include <math.h>
 
+#include <bit>
 #include <cstdint>
 
 #include "kernels/packet_math.h"
@@ -69,9 +70,11 @@ template <class Arch>
         raw_id.store_aligned(lanes);
         id = xsimd::select(hit, raw_id, F(lanes[__builtin_ctz(hit_bits)]));
     }
-    LaneIndex ids;
+    LaneIndex ids, records;  // records: where each lane's object record starts, in floats
     xsimd::to_int(id).store_aligned(ids.index);
     ids.uniform = xsimd::all(id == F(static_cast<float>(ids.index[0])));
+    (xsimd::to_int(id) * 8).store_aligned(records.index);
+    records.uniform = ids.uniform;
     const V3<F> o = load3<F>(rays.ox, rays.oy, rays.oz, base);
     const V3<F> d = load3<F>(rays.dx, rays.dy, rays.dz, base);
     const V3<F> weight = load3<F>(rays.wr, rays.wg, rays.wb, base);
@@ -90,11 +93,15 @@ template <class Arch>
     // normalize(P - c), or -V^ for a hit at the very center; plane N.
     const F t = F::load_aligned(in.hits.t + base);
     const V3<F> p = add(o, mul(d, t));
-    const M is_plane = gather<F>(s.object_is_plane, ids) != zero;
-    const V3<F> center{gather<F>(s.object_cx, ids), gather<F>(s.object_cy, ids),
-                       gather<F>(s.object_cz, ids)};
-    const V3<F> plane_n{gather<F>(s.object_nx, ids), gather<F>(s.object_ny, ids),
-                        gather<F>(s.object_nz, ids)};
+    // The object record (scene/compile.h): center 0-2, plane normal 3-5, kind 6,
+    // material 7.
+    const float* record = s.object_record;
+    const F kind = gather<F>(record + 6, records);
+    const M is_plane = kind != zero;
+    const V3<F> center{gather<F>(record + 0, records), gather<F>(record + 1, records),
+                       gather<F>(record + 2, records)};
+    const V3<F> plane_n{gather<F>(record + 3, records), gather<F>(record + 4, records),
+                        gather<F>(record + 5, records)};
     const V3<F> v_hat = normalize(d);
     const V3<F> pc = sub(p, center);
     const V3<F> sphere_n = select(dot(pc, pc) > zero, normalize(pc), neg(v_hat));
@@ -109,7 +116,7 @@ template <class Arch>
     LaneIndex mats;
     mats.uniform = ids.uniform;
     for (std::uint32_t i = 0; i < (ids.uniform ? 1 : W); ++i)
-        mats.index[i] = static_cast<std::int32_t>(s.object_material[ids.index[i]]);
+        mats.index[i] = std::bit_cast<std::int32_t>(record[records.index[i] + 7]);
     V3<F> cd{gather<F>(s.mat_cd_r, mats), gather<F>(s.mat_cd_g, mats),
              gather<F>(s.mat_cd_b, mats)};
     const F kd = gather<F>(s.mat_kd, mats), ks = gather<F>(s.mat_ks, mats);
@@ -120,7 +127,7 @@ template <class Arch>
     const F kt = gather<F>(s.mat_kt, mats), ior = gather<F>(s.mat_ior, mats);
 
     // Checker (planes only): Cd2 where floor(P.T1/size) + floor(P.T2/size) is odd.
-    const M checker = hit && gather<F>(s.object_checker, ids) != zero;
+    const M checker = hit && kind == F(2.0f);
     if (xsimd::any(checker)) {
         const V3<F> t1{gather<F>(s.object_t1x, ids), gather<F>(s.object_t1y, ids),
                        gather<F>(s.object_t1z, ids)};

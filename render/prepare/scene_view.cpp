@@ -22,10 +22,9 @@ kernels::SceneView make_scene_view(const CompiledScene& c) {
 
     const CompiledObjects& o = c.objects;
     v.object_count = o.count;
-    v.object_is_plane = o.is_plane.data(), v.object_material = o.material.data();
-    v.object_checker = o.checker.data();
-    v.object_cx = o.cx.data(), v.object_cy = o.cy.data(), v.object_cz = o.cz.data();
-    v.object_nx = o.nx.data(), v.object_ny = o.ny.data(), v.object_nz = o.nz.data();
+    static_assert(kObjectRecordFloats == 8 && kRecordKind == 6 && kRecordMaterial == 7,
+                  "kernels/stream/shading.h reads the object record's fields by these places");
+    v.object_record = o.record.data();
     v.object_t1x = o.t1x.data(), v.object_t1y = o.t1y.data(), v.object_t1z = o.t1z.data();
     v.object_t2x = o.t2x.data(), v.object_t2y = o.t2y.data(), v.object_t2z = o.t2z.data();
 

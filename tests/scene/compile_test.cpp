@@ -46,15 +46,12 @@ void expect_every_entry(std::uint32_t count) {
     for (std::uint32_t k = 0; k < count; ++k) {
         const Object& obj = scene.objects[k];
         const bool plane = obj.type == ObjectType::plane;
-        ASSERT_EQ(o.is_plane[k], plane ? 1u : 0u) << k;
-        ASSERT_EQ(o.material[k], obj.material) << k;
-        ASSERT_EQ(o.checker[k], plane && obj.material != 0 ? 1u : 0u) << k;
+        ASSERT_EQ(o.is_plane(k), plane) << k;
+        ASSERT_EQ(o.material(k), obj.material) << k;
+        ASSERT_EQ(o.checker(k), plane && obj.material != 0) << k;
         if (plane) {
-            ASSERT_EQ(o.cx[k], 0.0f) << k;  // a plane has no center
-            ASSERT_EQ(o.cy[k], 0.0f) << k;
-            ASSERT_EQ(o.cz[k], 0.0f) << k;
-            ASSERT_EQ(o.nx[k], obj.normal.x) << k;
-            ASSERT_EQ(o.nz[k], obj.normal.z) << k;
+            ASSERT_EQ(o.center(k), (Vec3{0, 0, 0})) << k;  // a plane has no center
+            ASSERT_EQ(o.normal(k), obj.normal) << k;
             const TangentBasis tb = checker_basis(obj.normal);
             ASSERT_EQ(o.t1x[k], tb.t1.x) << k;
             ASSERT_EQ(o.t2z[k], tb.t2.z) << k;
@@ -64,12 +61,10 @@ void expect_every_entry(std::uint32_t count) {
             ASSERT_EQ(p.d[pi], dot(obj.point, obj.normal));
             ++pi;
         } else {
-            ASSERT_EQ(o.cx[k], obj.center.x) << k;
-            ASSERT_EQ(o.cy[k], obj.center.y) << k;
-            ASSERT_EQ(o.cz[k], obj.center.z) << k;
-            for (const auto* a :
-                 {&o.nx, &o.ny, &o.nz, &o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
-                ASSERT_EQ((*a)[k], 0.0f) << k;  // a sphere has no normal or tangents
+            ASSERT_EQ(o.center(k), obj.center) << k;
+            ASSERT_EQ(o.normal(k), (Vec3{0, 0, 0})) << k;  // a sphere has no normal
+            for (const auto* a : {&o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
+                ASSERT_EQ((*a)[k], 0.0f) << k;  // nor tangents
             ASSERT_EQ(s.object[si], k);
             ASSERT_EQ(s.material[si], obj.material);
             ASSERT_EQ(s.cx[si], obj.center.x);
@@ -83,11 +78,10 @@ void expect_every_entry(std::uint32_t count) {
     ASSERT_EQ(s.count, si);
     ASSERT_EQ(p.count, pi);
     // The padding: geometry that no ray hits, no object, no material, no checker.
+    ASSERT_EQ(o.record.size(), std::size_t{o.padded_count} * kObjectRecordFloats);
     for (std::uint32_t k = count; k < o.padded_count; ++k) {
-        EXPECT_EQ(o.is_plane[k], 0u);
-        EXPECT_EQ(o.material[k], 0u);
-        EXPECT_EQ(o.checker[k], 0u);
-        EXPECT_EQ(o.cx[k], 0.0f);
+        for (std::uint32_t f = 0; f < kObjectRecordFloats; ++f)
+            EXPECT_EQ(o.record_of(k)[f], 0.0f);  // a sphere at the origin, material 0
         EXPECT_EQ(o.t2z[k], 0.0f);
     }
     for (std::uint32_t i = s.count; i < s.padded_count; ++i) {

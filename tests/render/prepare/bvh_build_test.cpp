@@ -149,12 +149,12 @@ void check_invariants(const NamedScene& ns) {
         const std::uint32_t obj = bvh.object[i];
         ASSERT_LT(obj, c.objects.count);
         ++object_seen[obj];
-        EXPECT_EQ(c.objects.is_plane[obj], 0u);
-        EXPECT_EQ(bvh.cx[i], c.objects.cx[obj]);
+        EXPECT_FALSE(c.objects.is_plane(obj));
+        EXPECT_EQ(bvh.cx[i], c.objects.center(obj).x);
         EXPECT_EQ(bvh.r2[i], r2_of_object[obj]);
     }
     for (std::uint32_t k = 0; k < c.objects.count; ++k)
-        EXPECT_EQ(object_seen[k], c.objects.is_plane[k] ? 0 : 1) << "object " << k;
+        EXPECT_EQ(object_seen[k], c.objects.is_plane(k) ? 0 : 1) << "object " << k;
     // Padding: a packet of never-hit entries.
     ASSERT_EQ(bvh.cx.size(), bvh.sphere_count + 8u);
     EXPECT_TRUE(std::isnan(bvh.r2[bvh.sphere_count]));
