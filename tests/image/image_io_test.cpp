@@ -29,6 +29,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace octray {
@@ -693,6 +694,42 @@ TEST(Srgb8, TheTableGivesTheFormulasByteForEveryFloat) {
     EXPECT_EQ(mismatches, 0u);
     EXPECT_EQ(srgb8(1.0f), 255);
     EXPECT_EQ(srgb8(std::numeric_limits<float>::quiet_NaN()), 0);
+}
+
+// srgb8_interleaved (three planes into one row of bytes, as the preview and the viewer's
+// pictures make them) gives srgb8's byte of each sample times the scale: every 997th float's
+// bits (NaNs, infinities, negatives and denormals included) and every float within 4 ulps of a
+// step, in planes of several lengths.
+TEST(Srgb8, InterleavedPlanesGiveSrgb8sBytes) {
+    std::vector<float> values;
+    for (std::uint64_t bits = 0; bits <= 0xFFFFFFFFu; bits += 997)
+        values.push_back(std::bit_cast<float>(static_cast<std::uint32_t>(bits)));
+    std::uint8_t last = 0;
+    for (std::uint32_t bits = 0; bits <= std::bit_cast<std::uint32_t>(1.0f); bits += 4096) {
+        const std::uint8_t v = srgb8(std::bit_cast<float>(bits));
+        if (v != last)
+            for (std::uint32_t s = bits > 4100 ? bits - 4100 : 0; s <= bits + 4; ++s)
+                values.push_back(std::bit_cast<float>(s));
+        last = v;
+    }
+    for (const float scale : {1.0f, 0.5f, 4.0f}) {
+        for (std::size_t count : {values.size() / 3, std::size_t{7}, std::size_t{13}}) {
+            const float* r = values.data();
+            const float* g = values.data() + values.size() / 3;
+            const float* b = values.data() + 2 * (values.size() / 3);
+            std::vector<std::uint8_t> out(3 * count + 1, 77);
+            srgb8_interleaved(r, g, b, count, scale, out.data());
+            std::size_t mismatches = 0;
+            for (std::size_t i = 0; i < count; ++i)
+                for (const auto& [plane, k] :
+                     {std::pair{r, 0}, std::pair{g, 1}, std::pair{b, 2}})
+                    if (out[3 * i + k] != srgb8(plane[i] * scale) && ++mismatches <= 5)
+                        ADD_FAILURE() << "scale " << scale << ", sample " << i << " of plane "
+                                      << k << ": " << plane[i];
+            EXPECT_EQ(mismatches, 0u);
+            EXPECT_EQ(out[3 * count], 77) << "nothing written past the last pixel";
+        }
+    }
 }
 
 }  // namespace
