@@ -85,6 +85,7 @@ class BitWriter {
         bits_ = 0;
     }
     void put_bytes(const std::uint8_t* data, std::size_t size) {  // after align()
+        if (size == 0) return;  // data may be null then (an empty band)
         std::memcpy(out_, data, size);
         out_ += size;
     }
