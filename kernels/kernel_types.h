@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "kernels/bvh/bvh_node.h"
+#include "scene/object_record.h"
 
 namespace octray::kernels {
 
@@ -39,8 +40,8 @@ struct SceneView {
     const std::uint32_t* plane_object;
 
     // Per object (file index): what shading needs. object_record: kObjectRecordFloats
-    // (8) floats an object, center x y z, plane normal x y z, kind (0 sphere, 1 plane,
-    // 2 checkered plane), the material index's bits (scene/compile.h, CompiledObjects).
+    // floats an object, laid out as scene/object_record.h says; the checker's tangents in
+    // columns.
     std::uint32_t object_count;
     const float* object_record;
     const float *object_t1x, *object_t1y, *object_t1z, *object_t2x, *object_t2y, *object_t2z;

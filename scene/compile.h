@@ -17,6 +17,7 @@
 #include "core/color.h"
 #include "core/vec3.h"
 #include "scene/camera.h"
+#include "scene/object_record.h"
 #include "scene/scene.h"
 
 namespace octray {
@@ -56,20 +57,8 @@ struct CompiledPlanes {
 // where nine columns cost up to nine, and shading the hits of random:1048576 waited on
 // those gathers for half of its time. Spheres have a zero normal, planes center 0:
 // shading evaluates both normal formulas for every lane and selects. The checker's
-// tangent basis, read only for checkered planes, stays in columns.
-inline constexpr std::uint32_t kObjectRecordFloats = 8;
-enum ObjectRecordField : std::uint32_t {
-    kRecordCx,
-    kRecordCy,
-    kRecordCz,  // a sphere's center
-    kRecordNx,
-    kRecordNy,
-    kRecordNz,        // a plane's normal
-    kRecordKind,      // kKindSphere, kKindPlane or kKindCheckerPlane, as a float
-    kRecordMaterial,  // the material's index, its bits (std::bit_cast)
-};
-inline constexpr float kKindSphere = 0.0f, kKindPlane = 1.0f, kKindCheckerPlane = 2.0f;
-
+// tangent basis, read only for checkered planes, stays in columns. The record's layout:
+// scene/object_record.h.
 struct CompiledObjects {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;

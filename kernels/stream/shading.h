@@ -10,7 +10,6 @@
 
 #include <math.h>
 
-#include <bit>
 #include <cstdint>
 
 #include "kernels/packet_math.h"
@@ -73,7 +72,8 @@ template <class Arch>
     LaneIndex ids, records;  // records: where each lane's object record starts, in floats
     xsimd::to_int(id).store_aligned(ids.index);
     ids.uniform = xsimd::all(id == F(static_cast<float>(ids.index[0])));
-    (xsimd::to_int(id) * 8).store_aligned(records.index);
+    (xsimd::to_int(id) * static_cast<std::int32_t>(kObjectRecordFloats))
+        .store_aligned(records.index);
     records.uniform = ids.uniform;
     const V3<F> o = load3<F>(rays.ox, rays.oy, rays.oz, base);
     const V3<F> d = load3<F>(rays.dx, rays.dy, rays.dz, base);
@@ -93,15 +93,16 @@ template <class Arch>
     // normalize(P - c), or -V^ for a hit at the very center; plane N.
     const F t = F::load_aligned(in.hits.t + base);
     const V3<F> p = add(o, mul(d, t));
-    // The object record (scene/compile.h): center 0-2, plane normal 3-5, kind 6,
-    // material 7.
+    // The object's record (scene/object_record.h).
     const float* record = s.object_record;
-    const F kind = gather<F>(record + 6, records);
-    const M is_plane = kind != zero;
-    const V3<F> center{gather<F>(record + 0, records), gather<F>(record + 1, records),
-                       gather<F>(record + 2, records)};
-    const V3<F> plane_n{gather<F>(record + 3, records), gather<F>(record + 4, records),
-                        gather<F>(record + 5, records)};
+    const F kind = gather<F>(record + kRecordKind, records);
+    const M is_plane = kind != F(kKindSphere);
+    const V3<F> center{gather<F>(record + kRecordCx, records),
+                       gather<F>(record + kRecordCy, records),
+                       gather<F>(record + kRecordCz, records)};
+    const V3<F> plane_n{gather<F>(record + kRecordNx, records),
+                        gather<F>(record + kRecordNy, records),
+                        gather<F>(record + kRecordNz, records)};
     const V3<F> v_hat = normalize(d);
     const V3<F> pc = sub(p, center);
     const V3<F> sphere_n = select(dot(pc, pc) > zero, normalize(pc), neg(v_hat));
@@ -115,8 +116,9 @@ template <class Arch>
     // Material.
     LaneIndex mats;
     mats.uniform = ids.uniform;
-    for (std::uint32_t i = 0; i < (ids.uniform ? 1 : W); ++i)
-        mats.index[i] = std::bit_cast<std::int32_t>(record[records.index[i] + 7]);
+    // The material's index travels as a float's bits: gathered as floats, reinterpreted.
+    xsimd::bitwise_cast<I>(gather<F>(record + kRecordMaterial, records))
+        .store_aligned(mats.index);
     V3<F> cd{gather<F>(s.mat_cd_r, mats), gather<F>(s.mat_cd_g, mats),
              gather<F>(s.mat_cd_b, mats)};
     const F kd = gather<F>(s.mat_kd, mats), ks = gather<F>(s.mat_ks, mats);
@@ -127,7 +129,7 @@ template <class Arch>
     const F kt = gather<F>(s.mat_kt, mats), ior = gather<F>(s.mat_ior, mats);
 
     // Checker (planes only): Cd2 where floor(P.T1/size) + floor(P.T2/size) is odd.
-    const M checker = hit && kind == F(2.0f);
+    const M checker = hit && kind == F(kKindCheckerPlane);
     if (xsimd::any(checker)) {
         const V3<F> t1{gather<F>(s.object_t1x, ids), gather<F>(s.object_t1y, ids),
                        gather<F>(s.object_t1z, ids)};

@@ -22,8 +22,6 @@ kernels::SceneView make_scene_view(const CompiledScene& c) {
 
     const CompiledObjects& o = c.objects;
     v.object_count = o.count;
-    static_assert(kObjectRecordFloats == 8 && kRecordKind == 6 && kRecordMaterial == 7,
-                  "kernels/stream/shading.h reads the object record's fields by these places");
     v.object_record = o.record.data();
     v.object_t1x = o.t1x.data(), v.object_t1y = o.t1y.data(), v.object_t1z = o.t1z.data();
     v.object_t2x = o.t2x.data(), v.object_t2y = o.t2y.data(), v.object_t2z = o.t2z.data();
