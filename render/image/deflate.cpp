@@ -1,8 +1,9 @@
-// zlib streams by libdeflate (deflate.h).
+// zlib streams by libdeflate, and the checksums of zlib streams and PNG chunks (deflate.h).
 
 #include "render/image/deflate.h"
 
 #include <libdeflate.h>
+#include <zlib.h>
 
 #include <array>
 #include <memory>
@@ -42,6 +43,16 @@ std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out
 
 std::size_t zlib_compress_bound(int level, std::size_t size) {
     return libdeflate_zlib_compress_bound(compressor(level), size);
+}
+
+std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size) {
+    return libdeflate_adler32(adler, data, size);
+}
+
+std::uint32_t adler32_combine(std::uint32_t first, std::uint32_t second,
+                              std::size_t second_size) {
+    return static_cast<std::uint32_t>(
+        ::adler32_combine(first, second, static_cast<z_off_t>(second_size)));
 }
 
 std::uint32_t crc32(std::uint32_t crc, const void* data, std::size_t size) {

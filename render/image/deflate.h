@@ -38,8 +38,10 @@ std::size_t deflate_band_bound(std::size_t size);
 std::size_t deflate_band(const std::uint8_t* in, std::size_t size, std::size_t repeat,
                          bool last, std::uint8_t* out);
 
+// ---- Checksums (deflate.cpp) --------------------------------------------------------------
 // Adler-32 (a zlib stream's checksum) of data[0, size), continuing from `adler` (1 to
-// start); and the Adler-32 of A followed by B from A's, B's and B's length.
+// start), by libdeflate; and the Adler-32 of A followed by B from A's, B's and B's length,
+// by zlib (what joins the bands' sums).
 std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size);
 std::uint32_t adler32_combine(std::uint32_t first, std::uint32_t second,
                               std::size_t second_size);

@@ -12,7 +12,6 @@
 // passes over a band: the matches, the histogram, then the codes.
 
 #include <emmintrin.h>
-#include <libdeflate.h>
 
 #include <algorithm>
 #include <array>
@@ -475,27 +474,6 @@ std::size_t deflate_band(const std::uint8_t* in, std::size_t size, std::size_t r
     if (!last && !stored) put_stored(bits, in, 0, false);
     bits.align();
     return static_cast<std::size_t>(bits.end() - out);
-}
-
-std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size) {
-    return libdeflate_adler32(adler, data, size);
-}
-
-std::uint32_t adler32_combine(std::uint32_t first, std::uint32_t second,
-                              std::size_t second_size) {
-    // Adler-32 of A then B from theirs (as zlib's adler32_combine): the sums run on from
-    // A's, B's first sum weighted by B's length.
-    constexpr std::uint32_t kBase = 65521;
-    const std::uint32_t length = static_cast<std::uint32_t>(second_size % kBase);
-    std::uint32_t a = first & 0xFFFF;
-    std::uint32_t b = (length * a) % kBase;
-    a += (second & 0xFFFF) + kBase - 1;
-    b += (first >> 16) + (second >> 16) + kBase - length;
-    if (a >= kBase) a -= kBase;
-    if (a >= kBase) a -= kBase;
-    if (b >= 2 * kBase) b -= 2 * kBase;
-    if (b >= kBase) b -= kBase;
-    return (b << 16) | a;
 }
 
 }  // namespace octray::detail
