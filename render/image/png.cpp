@@ -155,6 +155,7 @@ std::string encode_png(int width, int height, const Row& row, SrgbChunks chunks)
                 PngBand& band = bands[b];
                 band.filtered = filtered.size();
                 band.stream.resize(detail::deflate_band_bound(filtered.size()));
+                // Matches at distance 3 as well as 1: a pixel's 3 bytes repeated.
                 band.size = detail::deflate_band(filtered.data(), filtered.size(), 3,
                                                  b + 1 == band_count, band.stream.data());
                 band.adler = detail::adler32(1, filtered.data(), filtered.size());
