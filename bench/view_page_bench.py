@@ -2,7 +2,7 @@
 """The page of `octray view` as a user sees it: its frame rate in a real browser.
 
     view_page_bench.py OCTRAY [SCENE] [--width W] [--height H] [--threads T]
-                       [--moves N] [--move-ms MS] [--preview-divisor D]
+                       [--moves N] [--move-ms MS | --script-ms MS] [--preview-divisor D]
 
 `octray view --bench` times the renderer and the PNG encoding without a browser. This
 opens the page in headless Chromium (chromedriver, python3-selenium: tools/setup.sh
@@ -16,10 +16,12 @@ installs them), as `octray view SCENE` serves it on a free port, and reports:
                   printed beside the pictures a second, since the page cannot draw more
                   pictures than the camera makes; the camera orbits the look-at point and
                   the server renders reduced-size previews while it moves), with the
-                  page's Mrays/s of the last picture,
+                  page's Mrays/s of the last picture; with --script-ms the page's own
+                  script makes the same camera moves every MS ms instead (a mouse, and
+                  chromedriver's pointer, give about 60 a second at most),
   refined         ms from the end of the drag to the refined picture (target spp) drawn.
 
-Each picture is the server's event, the PNG fetch, the decode and the draw: the loopback
+Each picture is a message of the picture stream, its decode and the draw: the loopback
 transfer and the browser's work are in these figures. A bench, not a test: it asserts
 nothing about speed; exit 1 if the page never draws, 77 if Chromium, chromedriver or
 selenium is missing.
@@ -50,8 +52,9 @@ def start_view(args):
     sys.exit("octray view printed no URL: " + process.stderr.read())
 
 
-def measure(browser, url, moves, move_ms, ActionChains, WebDriverWait):
+def measure(browser, url, moves, move_ms, script_ms, ActionChains, WebDriverWait):
     browser.set_page_load_timeout(WAIT)
+    browser.set_script_timeout(WAIT + moves * (script_ms or 0) / 1000)
     browser.get(url)
     WebDriverWait(browser, WAIT).until(
         lambda b: b.execute_script("return window.octrayDrawTimes.length > 0"))
@@ -65,13 +68,31 @@ def measure(browser, url, moves, move_ms, ActionChains, WebDriverWait):
         "document.body.dataset.spp === document.getElementById('target-spp').textContent"))
 
     canvas = browser.find_element("id", "view")
-    # One W3C action sequence: chromedriver plays the moves, each lasting move_ms.
-    chain = ActionChains(browser, duration=move_ms).move_to_element(canvas).click_and_hold()
-    for k in range(moves):
-        chain.move_by_offset(1 if (k // 120) % 2 == 0 else -1, 0)
-    start = browser.execute_script("return performance.now()")
-    chain.release().perform()
-    end = browser.execute_script("return performance.now()")
+    if script_ms is None:
+        # One W3C action sequence: chromedriver plays the moves, each lasting move_ms.
+        chain = ActionChains(browser, duration=move_ms).move_to_element(canvas).click_and_hold()
+        for k in range(moves):
+            chain.move_by_offset(1 if (k // 120) % 2 == 0 else -1, 0)
+        start = browser.execute_script("return performance.now()")
+        chain.release().perform()
+        end = browser.execute_script("return performance.now()")
+    else:
+        # The page's own camera calls, as a drag makes them (orbit by one pixel's angle,
+        # sendCamera moving), every script_ms ms from a timer: camera changes faster
+        # than the ~60 a second chromedriver's pointer moves reach.
+        start, end = browser.execute_async_script("""
+            const [moves, everyMs, done] = arguments;
+            const from = camera, step = Math.PI / canvas.clientWidth;
+            const start = performance.now();
+            let k = 0, x = 0;
+            const timer = setInterval(() => {
+              x += (Math.floor(k / 120) % 2 === 0) ? 1 : -1;
+              sendCamera(orbit(from, -x * step, 0), true);
+              if (++k < moves) return;
+              clearInterval(timer);
+              sendCamera(camera, false);
+              done([start, performance.now()]);
+            }, everyMs);""", moves, script_ms)
     draws = browser.execute_script(
         "return window.octrayDrawTimes.filter(t => t >= arguments[0] && t <= arguments[1])"
         ".length", start, end)
@@ -103,6 +124,10 @@ def main():
                              "fast as chromedriver plays them)")
     parser.add_argument("--preview-divisor", type=int, default=0,
                         help="passed to octray view (default: its own)")
+    parser.add_argument("--script-ms", type=int, default=None,
+                        help="move the camera from the page's own script every MS ms "
+                             "instead of by a pointer drag (which chromedriver plays at "
+                             "~60 moves a second at most)")
     args = parser.parse_args()
     try:
         from selenium import webdriver
@@ -131,8 +156,8 @@ def main():
             browser = webdriver.Chrome(service=Service(driver), options=options)
             try:
                 first_ms, loaded_ms, draws, seconds, mrays, refined_ms, transport = measure(
-                    browser, url, max(1, args.moves), max(0, args.move_ms), ActionChains,
-                    WebDriverWait)
+                    browser, url, max(1, args.moves), max(0, args.move_ms), args.script_ms,
+                    ActionChains, WebDriverWait)
             finally:
                 browser.quit()
     finally:
@@ -142,7 +167,8 @@ def main():
     print(f"scene {args.scene} {args.width}x{args.height}, {args.threads} threads, "
           f"pictures by {transport}")
     print(f"first picture: drawn {first_ms:.0f} ms after navigation began{loaded}")
-    print(f"orbit: {draws} pictures drawn in {seconds:.2f} s of dragging ({args.moves} moves, "
+    motion = "dragging" if args.script_ms is None else f"camera moves every {args.script_ms} ms"
+    print(f"orbit: {draws} pictures drawn in {seconds:.2f} s of {motion} ({args.moves} moves, "
           f"{args.moves / seconds:.1f} a second): {draws / seconds:.1f} pictures/s; "
           f"last picture {mrays} Mrays/s")
     if refined_ms >= 0:
