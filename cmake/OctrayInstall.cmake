@@ -18,6 +18,10 @@ foreach(lib core scene kernels prepare render reference image warnings fp_model 
 endforeach()
 
 install(TARGETS octray RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The executables that `octray view` and `octray bench` run (tools/own_executable.h): octray
+# finds them at this place relative to itself (tools/CMakeLists.txt,
+# OCTRAY_OWN_EXECUTABLES_RELATIVE_DIR).
+install(TARGETS octray_viewer octray_bencher RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/octray)
 # Its man pages (octray(1), octray-render(1), ...) and shell completions, generated at build
 # time from the parser's options (target octray_docs, tools/CMakeLists.txt).
 install(DIRECTORY ${OCTRAY_SHARE_DIR}/man/man1 DESTINATION ${CMAKE_INSTALL_MANDIR}

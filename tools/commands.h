@@ -59,6 +59,10 @@ std::string help_hint(const std::string& command);
 int run_command(const std::function<void()>& action, const std::string& command,
                 int usage_status);
 
+// main() of both executables, octray and octray-view (tools/view_launch.h): parses the
+// command line with the whole application and runs the chosen command; the exit status.
+int octray_main(int argc, char** argv);
+
 // The whole `octray` application, every command registered (with `run`) as main() parses
 // with it; tests walk its options.
 std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run);

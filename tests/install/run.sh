@@ -39,6 +39,15 @@ completed=$(bash -c 'source "$1" && COMP_WORDS=(octray ma) COMP_CWORD=1 && _octr
   echo "${COMPREPLY[*]}"' _ "$prefix/share/bash-completion/completions/octray")
 test "$completed" = $'man\n--threads'
 
+# `octray view` and `octray bench` run the executables installed in libexec/octray
+# (tools/own_executable.h).
+test -x "$prefix/libexec/octray/octray-view"
+test -x "$prefix/libexec/octray/octray-bench"
+"$prefix/bin/octray" view whitted --width 32 --height 18 --threads 1 --bench 2 |
+  grep -q '^first picture: 32x18'
+"$prefix/bin/octray" bench random:4 --rays primary --threads 1 --reps 1 --warmup 0 \
+  --min-time 0 --width 16 --height 8 --no-embree 2>/dev/null | grep -q '^random:4 '
+
 cmake -S examples/embed -B "$tmp/embed" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$tmp/prefix"
 cmake --build "$tmp/embed" -j2
