@@ -83,23 +83,33 @@ void record_failure(FrameResult& out, const std::exception_ptr& error) {
     }
 }
 
-// A frame's files, ready to write: the EXR (channels converted, attributes set) and where
-// the preview of its pixels goes.
+// A frame's files, ready to write: where the EXR and the preview of its pixels go, and
+// how the EXR stores them. Without AOVs the EXR is written from the frame's own float32
+// pixels (write_exr converts each line to half as it packs the chunks); with them, `exr`
+// holds the whole file's channels, converted before (the AOVs appended).
 struct FrameFiles {
     std::string exr_path, png_path;  // either may be empty
-    Image exr;
+    ExrWriteOptions exr_options;
+    ExrAttributes exr_attributes;
+    Image exr;  // with AOVs only
 
+    void write_exr_file(const Image& pixels) const {
+        if (exr.channels.empty())
+            write_exr(exr_path, pixels, exr_options, exr_attributes);
+        else
+            write_exr(exr_path, exr);
+    }
     // Both are written atomically, each on its own; the frame counts as finished only
     // when both are (resume.h).
     void write(const Image& pixels) const {
         if (exr_path.empty()) {
             write_png_preview(png_path, pixels);
         } else if (png_path.empty()) {
-            write_exr(exr_path, exr);
+            write_exr_file(pixels);
         } else {
-            // The preview is encoded while OpenEXR compresses the EXR's blocks: on 2
-            // cores the two files take the time of the longer one.
-            tbb::parallel_invoke([&] { write_exr(exr_path, exr); },
+            // The preview is encoded while the EXR's chunks are compressed: on 2 cores the
+            // two files take the time of the longer one.
+            tbb::parallel_invoke([&] { write_exr_file(pixels); },
                                  [&] { write_png_preview(png_path, pixels); });
         }
     }
@@ -162,8 +172,8 @@ class BatchRunner {
     // The last frame written: the next frame renders into its storage (RenderOptions::
     // spare_image), so only a run's first frame maps fresh pages for its pixels.
     Image spare_frame_;
-    // The channels of the last EXR written, converted into again by the next (the same
-    // reason: make_exr_image's `spare`).
+    // The channels of the last EXR made with AOVs, converted into again by the next (the
+    // same reason: make_exr_image's `spare`).
     std::vector<ImageChannel> spare_channels_;
     // The frames of scene renderer_index_, posed and prepared once (FrameRenderer).
     // (A pointer: g++ 12 takes an optional holding an optional for maybe-uninitialized.)
@@ -235,12 +245,14 @@ FrameFiles BatchRunner::files(const BatchInput& scene, const BatchJob& job, cons
     }
     f.exr_path = job.output;
     f.png_path = job.png;
-    f.exr = make_exr_image(result.image, settings_.exr,
-                           attributes(scene, posed, job.frame, result, samples_so_far),
-                           std::move(spare_channels_));
-    if (!aovs.channels.empty())
+    f.exr_options = settings_.exr;
+    f.exr_attributes = attributes(scene, posed, job.frame, result, samples_so_far);
+    if (!aovs.channels.empty()) {
+        f.exr = make_exr_image(result.image, settings_.exr, f.exr_attributes,
+                               std::move(spare_channels_));
         append_aov_channels(f.exr, aovs,
                             settings_.exr.float32 ? PixelFormat::float32 : PixelFormat::half);
+    }
     return f;
 }
 

@@ -36,7 +36,8 @@ constexpr std::uint64_t kFramebufferBytesPerPixel = 12;
 constexpr std::uint64_t kProgressiveImages = 4;
 // render/image/exr_write.cpp make_exr_image and render/aov.cpp append_aov_channels: every
 // channel is copied into the EXR image, as half (2 bytes) or float (4); the id AOV is
-// UINT (4).
+// UINT (4). (Without AOVs, a ZIP, ZIPS or uncompressed EXR is packed from the render's
+// own float32 lines and no copy is made; the copy is counted anyway: an upper bound.)
 constexpr std::uint64_t kColorChannels = 3;
 constexpr std::uint64_t kDepthChannels = 1, kNormalChannels = 3, kAlbedoChannels = 3;
 // OpenEXR's scan-line writer holds one block of lines of every channel, uncompressed and

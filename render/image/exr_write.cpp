@@ -245,11 +245,22 @@ struct MagicAndVersion : Imf::GenericOutputFile {
 static_assert(std::endian::native == std::endian::little,
               "the samples are copied as they lie in memory into a little-endian file");
 
-std::vector<const ImageChannel*> channels_in_file_order(const Image& image) {
-    std::vector<const ImageChannel*> channels;
-    for (const ImageChannel& c : image.channels) channels.push_back(&c);
-    std::sort(channels.begin(), channels.end(),
-              [](const ImageChannel* a, const ImageChannel* b) { return a->name < b->name; });
+// A channel as the file stores it: its samples, and the format the file holds them in,
+// which is theirs or, for a render's float32 channel written as half, half (converted a
+// line at a time as the chunks are packed: write_exr of a render).
+struct FileChannel {
+    const ImageChannel* source;
+    PixelFormat format;
+};
+
+// The channels of `image` in file order, each stored as `as(channel)` says.
+template <class Format>
+std::vector<FileChannel> channels_in_file_order(const Image& image, Format as) {
+    std::vector<FileChannel> channels;
+    for (const ImageChannel& c : image.channels) channels.push_back({&c, as(c)});
+    std::sort(channels.begin(), channels.end(), [](const FileChannel& a, const FileChannel& b) {
+        return a.source->name < b.source->name;
+    });
     return channels;
 }
 
@@ -290,13 +301,14 @@ void predict(const unsigned char* in, std::size_t size, unsigned char* out) {
 // Packs, and for ZIP and ZIPS compresses, one chunk of scan lines.
 class ChunkEncoder {
   public:
-    ChunkEncoder(const Image& image, int lines_per_chunk)
-        : channels_(channels_in_file_order(image)),
-          width_(static_cast<std::size_t>(image.data_window.width())),
-          height_(image.data_window.height()),
-          lines_per_chunk_(lines_per_chunk),
-          compression_(image.compression) {
-        for (const ImageChannel* c : channels_) line_bytes_ += width_ * sample_size(c->format);
+    ChunkEncoder(std::vector<FileChannel> channels, const PixelRect& data_window,
+                 ExrCompression compression)
+        : channels_(std::move(channels)),
+          width_(static_cast<std::size_t>(data_window.width())),
+          height_(data_window.height()),
+          lines_per_chunk_(exr_lines_per_chunk(compression)),
+          compression_(compression) {
+        for (const FileChannel& c : channels_) line_bytes_ += width_ * sample_size(c.format);
     }
 
     int chunk_count() const { return (height_ + lines_per_chunk_ - 1) / lines_per_chunk_; }
@@ -345,14 +357,25 @@ class ChunkEncoder {
     }
 
   private:
+    // Each line of each channel of the chunk, in file order, as the file's bytes: a float32
+    // line stored as half is converted into this thread's line buffer first.
     template <class Visit>
     void for_each_line(int chunk, Visit&& visit) const {
+        thread_local std::vector<std::uint16_t> half_line;
         const int y0 = first_line(chunk);
         const int y1 = std::min(height_, y0 + lines_per_chunk_);
         for (int y = y0; y < y1; ++y)
-            for (const ImageChannel* c : channels_) {
-                const std::size_t bytes = width_ * sample_size(c->format);
-                visit(c->samples.data() + static_cast<std::size_t>(y) * bytes, bytes);
+            for (const FileChannel& c : channels_) {
+                const std::size_t line = static_cast<std::size_t>(y) * width_;
+                if (c.format == c.source->format) {
+                    const std::size_t bytes = width_ * sample_size(c.format);
+                    visit(c.source->samples.data() + line * sample_size(c.format), bytes);
+                    continue;
+                }
+                half_line.resize(width_);
+                floats_to_half_bits(c.source->floats() + line, width_, 1, half_line.data());
+                visit(reinterpret_cast<const unsigned char*>(half_line.data()),
+                      width_ * sizeof(std::uint16_t));
             }
     }
 
@@ -363,7 +386,7 @@ class ChunkEncoder {
         });
     }
 
-    std::vector<const ImageChannel*> channels_;
+    std::vector<FileChannel> channels_;
     std::size_t width_;
     int height_;
     int lines_per_chunk_;
@@ -418,15 +441,14 @@ class OutputBytes {
 // exr_thread_count() of 0 or 1 the calling thread encodes them alone.
 constexpr std::size_t kRawBytesPerGroup = std::size_t{16} << 20;
 
-void write_exr_with_own_chunks(const std::string& path, const Image& image,
-                               const Imf::Header& header) {
+void write_exr_with_own_chunks(const std::string& path, const ChunkEncoder& encoder,
+                               int first_line, const Imf::Header& header) {
     header.sanityCheck();
     Imf::StdOSStream head;
     MagicAndVersion().write(head, header);
     header.writeTo(head);
     const std::string head_bytes = head.str();
 
-    const ChunkEncoder encoder(image, exr_lines_per_chunk(image.compression));
     const int chunks = encoder.chunk_count();
     OutputBytes file(path);
     file.write(head_bytes.data(), head_bytes.size());
@@ -456,7 +478,7 @@ void write_exr_with_own_chunks(const std::string& path, const Image& image,
         for (int k = first; k < last; ++k) {
             const SampleBytes& data = encoded[static_cast<std::size_t>(k - first)];
             offsets[static_cast<std::size_t>(k)] = file.position();
-            file.write_le<std::int32_t>(image.data_window.y0 + encoder.first_line(k));
+            file.write_le<std::int32_t>(first_line + encoder.first_line(k));
             file.write_le<std::int32_t>(static_cast<std::int32_t>(data.size()));
             file.write(data.data(), data.size());
         }
@@ -469,10 +491,14 @@ void write_exr_with_own_chunks(const std::string& path, const Image& image,
 
 void write_exr_file(const std::string& path, const Image& image) {
     const Imf::Header header = make_header(image);
-    if (packs_chunks_itself(image.compression))
-        write_exr_with_own_chunks(path, image, header);
-    else
+    if (packs_chunks_itself(image.compression)) {
+        const ChunkEncoder encoder(
+            channels_in_file_order(image, [](const ImageChannel& c) { return c.format; }),
+            image.data_window, image.compression);
+        write_exr_with_own_chunks(path, encoder, image.data_window.y0, header);
+    } else {
         write_exr_with_openexr(path, image, header);
+    }
 }
 
 void require_render_image(const Image& image) {
@@ -569,10 +595,31 @@ void write_exr(const std::string& path, const Image& render, const ExrWriteOptio
                const ExrAttributes& attributes) {
     try {
         require_render_image(render);
+        check_exr_image(render);  // its windows and sample counts, as the file's would be
     } catch (const std::exception& e) {
         throw IoError("cannot write " + path + ": " + e.what());
     }
-    write_exr(path, make_exr_image(render, options, attributes));
+    if (!packs_chunks_itself(options.compression)) {
+        write_exr(path, make_exr_image(render, options, attributes));
+        return;
+    }
+    // The chunks are packed from the render's float32 samples, each line converted to
+    // half as it is packed (unless float32): the file make_exr_image's image makes, byte
+    // for byte, without a half copy of the frame (5.5 MB at 1280x720, its first touch
+    // included) made before the chunks.
+    Image shape;  // the file's channels and header, without samples
+    shape.display_window = render.display_window;
+    shape.data_window = render.data_window;
+    shape.compression = options.compression;
+    shape.attributes = attributes;
+    const PixelFormat type = options.float32 ? PixelFormat::float32 : PixelFormat::half;
+    for (const ImageChannel& c : render.channels) shape.channels.push_back({c.name, type, {}});
+    write_file_atomically(path, [&](const std::string& tmp) {
+        const ChunkEncoder encoder(
+            channels_in_file_order(render, [type](const ImageChannel&) { return type; }),
+            render.data_window, options.compression);
+        write_exr_with_own_chunks(tmp, encoder, render.data_window.y0, make_header(shape));
+    });
 }
 
 void set_exr_thread_count(int threads) { Imf::setGlobalThreadCount(threads); }

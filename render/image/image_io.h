@@ -70,7 +70,9 @@ Image make_exr_image(const Image& render, const ExrWriteOptions& options,
 // two channels or attributes of one name, ...).
 void write_exr(const std::string& path, const Image& image);
 
-// Writes a render's image (float32 R, G, B; row 0 on top) as make_exr_image makes it.
+// Writes a render's image (float32 R, G, B; row 0 on top) as make_exr_image makes it, the
+// same file byte for byte. With ZIP, ZIPS or no compression (the chunks octray packs
+// itself) no EXR image is made: each line is converted to half as its chunk is packed.
 // Throws IoError, also for an image that is not a render's.
 void write_exr(const std::string& path, const Image& render, const ExrWriteOptions& options,
                const ExrAttributes& attributes = {});
