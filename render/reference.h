@@ -93,7 +93,6 @@ class ReferenceTracer {
     CameraFrame camera_;
     Vec3 background_up_;  // the camera's up as given, normalised (gradient background)
     float epsilon_;
-    std::vector<TangentBasis> checker_bases_;  // per object; planes only
 };
 
 // Renders the whole image, or options.crop of it, and options.samples of each pixel (see
