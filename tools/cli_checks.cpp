@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/decimal.h"
+#include "render/batch/memory_estimate.h"
 #include "scene/scene.h"
 #include "scene/suggest.h"
 #include "tools/commands.h"
@@ -207,6 +208,14 @@ CLI::Validator real_number(double lo, double hi, bool allow_infinity) {
             return {};
         },
         "", "real_number " + real_range_text(lo, hi, allow_infinity));
+}
+
+std::uint64_t max_memory_limit(const std::string& value) {
+    if (value.empty()) return batch::machine_memory_bytes();
+    const auto parsed = batch::parse_memory_size(value);
+    if (!parsed)
+        throw UsageError("--max-memory: expected a size such as 512M, 4G or 1T, not " + value);
+    return *parsed;
 }
 
 void print_scene_warnings(const Scene& scene, bool quiet) {

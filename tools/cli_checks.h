@@ -102,6 +102,13 @@ std::optional<ImageFormat> image_format_of(std::string_view path);
 ImageFormat require_image_format(std::string_view option, const std::string& path,
                                  bool png_accepted, std::string_view advice);
 
+// ---- Memory -------------------------------------------------------------------------------
+
+// The memory limit a command's --max-memory VALUE sets (512M, 4G, ...; render/batch/
+// memory_estimate.h), or this machine's physical memory when VALUE is empty (0 when that is
+// unknown: no limit). A VALUE that is not a size is a UsageError naming the option.
+std::uint64_t max_memory_limit(const std::string& value);
+
 // ---- Scene warnings ----------------------------------------------------------------------
 
 // Prints scene_warnings(scene) (scene/scene.h: what is legal but probably not meant, such as

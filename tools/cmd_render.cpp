@@ -200,14 +200,7 @@ void run_render(const RenderArguments& args) {
     settings.placeholders = args.placeholders;
     const auto progress = parse_progress_mode(args.progress, ::isatty(STDERR_FILENO) == 1);
     if (!progress) throw UsageError("--progress: expected auto, bar, lines, json or none");
-    std::uint64_t memory_limit = batch::machine_memory_bytes();  // 0 if unknown: no limit
-    if (!args.max_memory.empty()) {
-        const auto limit = batch::parse_memory_size(args.max_memory);
-        if (!limit)
-            throw UsageError("--max-memory: expected a size such as 512M, 4G or 1T, not " +
-                             args.max_memory);
-        memory_limit = *limit;
-    }
+    const std::uint64_t memory_limit = max_memory_limit(args.max_memory);  // 0: no limit
     batch::Shard shard{0, 1};
     if (!args.shard.empty())
         shard = resolve_shard(args);

@@ -24,6 +24,7 @@
 #include "render/image/image_io.h"
 #include "render/render_config.h"
 #include "scene/load.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 #include "tools/view_arguments.h"
 #include "view/compare_view.h"
@@ -173,14 +174,7 @@ RenderConfig view_config(const ViewArguments& args) {
 // starting and failing on its first picture with std::bad_alloc.
 void check_view_memory(const Scene& scene, const RenderConfig& config,
                        const ViewArguments& args) {
-    std::uint64_t limit = batch::machine_memory_bytes();  // 0 if unknown: no limit
-    if (!args.max_memory.empty()) {
-        const auto parsed = batch::parse_memory_size(args.max_memory);
-        if (!parsed)
-            throw UsageError("--max-memory: expected a size such as 512M, 4G or 1T, not " +
-                             args.max_memory);
-        limit = *parsed;
-    }
+    const std::uint64_t limit = max_memory_limit(args.max_memory);  // 0: no limit
     if (limit == 0) return;
     batch::RenderMemoryParams memory = batch::memory_params(config);
     memory.progressive = true;
