@@ -281,6 +281,12 @@ TEST_F(BatchCliTest, BadInputIsAClearErrorAndLeavesNothing) {
         {{"render", "shot.json", "--crop", "5,5,2,2", "-o", "out/x#.exr"}, 2, "--crop"},
         {{"render", "shot.json", "--aov", "depth,color", "-o", "out/x#.exr"}, 2, "--aov"},
         {{"render", "shot.json", "--max-memory", "1K", "-o", "out/x#.exr"}, 2, "max-memory"},
+        {{"render", "shot.json", "--max-memory", "lots", "-o", "out/x#.exr"},
+         2,
+         "--max-memory: expected a size such as 512M, 4G or 1T, not lots"},
+        {{"view", "shot.json", "--max-memory", "lots", "--bench", "1"},
+         2,
+         "--max-memory: expected a size such as 512M, 4G or 1T, not lots"},
         {{"render", "shot.json", "-o", "shot.json/x#.exr"}, 4, "shot.json"},
         {{"render", "shot.json", "-o", "out/x{frame:q}.exr"}, 2, "{frame:q}"},
     };
