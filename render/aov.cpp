@@ -159,21 +159,40 @@ Image compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
     return aovs_from(scene, options, set, &hits);
 }
 
-void append_aov_channels(Image& image, const Image& aovs, PixelFormat color_type) {
-    if (!(image.data_window == aovs.data_window))
-        throw std::invalid_argument(
-            "append_aov_channels: the AOVs cover " + to_string(aovs.data_window) +
-            ", the image's data window is " + to_string(image.data_window));
+namespace {
+
+// The format a file stores AOV channel `c` in: depth keeps float32 (its +inf misses and far
+// hits); normals and albedo take the colour channels' type, ids stay uint32.
+PixelFormat aov_file_format(const ImageChannel& c, PixelFormat color_type) {
+    return c.format != PixelFormat::float32 || c.name == "Z" ? c.format : color_type;
+}
+
+void check_aov_appending(const PixelRect& data_window, const Image& aovs,
+                         PixelFormat color_type, const char* function) {
+    if (!(data_window == aovs.data_window))
+        throw std::invalid_argument(std::string(function) + ": the AOVs cover " +
+                                    to_string(aovs.data_window) +
+                                    ", the image's data window is " + to_string(data_window));
     if (color_type != PixelFormat::half && color_type != PixelFormat::float32)
-        throw std::invalid_argument("append_aov_channels: colors are half or float");
+        throw std::invalid_argument(std::string(function) + ": colors are half or float");
+}
+
+}  // namespace
+
+void append_aov_channels(Image& image, const Image& aovs, PixelFormat color_type) {
+    check_aov_appending(image.data_window, aovs, color_type, "append_aov_channels");
     for (const ImageChannel& c : aovs.channels) {
-        // Depth keeps float32 (its +inf misses and far hits); normals and albedo take the
-        // colour channels' type, ids stay uint32.
-        if (c.format != PixelFormat::float32 || c.name == "Z")
+        if (aov_file_format(c, color_type) == c.format)
             image.channels.push_back(c);
         else
             image.channels.push_back(make_channel(c.name, color_type, c.floats(), c.size()));
     }
+}
+
+void append_aov_sources(ExrSources& exr, const Image& aovs, PixelFormat color_type) {
+    check_aov_appending(exr.data_window, aovs, color_type, "append_aov_sources");
+    for (const ImageChannel& c : aovs.channels)
+        exr.channels.push_back({&c, aov_file_format(c, color_type)});
 }
 
 }  // namespace octray

@@ -58,4 +58,9 @@ Image compute_aovs(const Scene& scene, const RenderOptions& options, AovSet set,
 // uint32. Throws std::invalid_argument if the windows disagree.
 void append_aov_channels(Image& image, const Image& aovs, PixelFormat color_type);
 
+// The same channels as sources of an EXR written from the AOVs themselves (image_io.h's
+// ExrSources; `aovs` must outlive the write), in the same formats. Throws
+// std::invalid_argument if the windows disagree.
+void append_aov_sources(ExrSources& exr, const Image& aovs, PixelFormat color_type);
+
 }  // namespace octray

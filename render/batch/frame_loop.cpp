@@ -84,20 +84,21 @@ void record_failure(FrameResult& out, const std::exception_ptr& error) {
 }
 
 // A frame's files, ready to write: where the EXR and the preview of its pixels go, and
-// how the EXR stores them. Without AOVs the EXR is written from the frame's own float32
-// pixels (write_exr converts each line to half as it packs the chunks); with them, `exr`
-// holds the whole file's channels, converted before (the AOVs appended).
+// how the EXR stores them. The EXR is written from the frame's own float32 pixels and its
+// AOVs (write_exr of ExrSources converts each line to half as it packs the chunks): no
+// converted copy of either is made.
 struct FrameFiles {
     std::string exr_path, png_path;  // either may be empty
     ExrWriteOptions exr_options;
     ExrAttributes exr_attributes;
-    Image exr;  // with AOVs only
+    std::shared_ptr<const Image> aovs;  // null: none
 
     void write_exr_file(const Image& pixels) const {
-        if (exr.channels.empty())
-            write_exr(exr_path, pixels, exr_options, exr_attributes);
-        else
-            write_exr(exr_path, exr);
+        ExrSources sources = exr_sources(pixels, exr_options, exr_attributes);
+        if (aovs)
+            append_aov_sources(sources, *aovs,
+                               exr_options.float32 ? PixelFormat::float32 : PixelFormat::half);
+        write_exr(exr_path, sources);
     }
     // Both are written atomically, each on its own; the frame counts as finished only
     // when both are (resume.h).
@@ -159,7 +160,8 @@ class BatchRunner {
     ExrAttributes attributes(const BatchInput& scene, const Scene& posed, int frame,
                              const RenderResult& result, int samples_so_far) const;
     FrameFiles files(const BatchInput& scene, const BatchJob& job, const Scene& posed,
-                     const RenderResult& result, const Image& aovs, int samples_so_far);
+                     const RenderResult& result, const std::shared_ptr<const Image>& aovs,
+                     int samples_so_far);
     void finish(const FrameResult& out, std::uint64_t work);
     void write_behind(PendingWrite& p);
 
@@ -172,9 +174,6 @@ class BatchRunner {
     // The last frame written: the next frame renders into its storage (RenderOptions::
     // spare_image), so only a run's first frame maps fresh pages for its pixels.
     Image spare_frame_;
-    // The channels of the last EXR made with AOVs, converted into again by the next (the
-    // same reason: make_exr_image's `spare`).
-    std::vector<ImageChannel> spare_channels_;
     // The frames of scene renderer_index_, posed and prepared once (FrameRenderer).
     // (A pointer: g++ 12 takes an optional holding an optional for maybe-uninitialized.)
     std::unique_ptr<FrameRenderer> renderer_;
@@ -236,8 +235,8 @@ ExrAttributes BatchRunner::attributes(const BatchInput& scene, const Scene& pose
 }
 
 FrameFiles BatchRunner::files(const BatchInput& scene, const BatchJob& job, const Scene& posed,
-                              const RenderResult& result, const Image& aovs,
-                              int samples_so_far) {
+                              const RenderResult& result,
+                              const std::shared_ptr<const Image>& aovs, int samples_so_far) {
     FrameFiles f;
     if (settings_.png_output) {
         f.png_path = job.output;
@@ -247,12 +246,7 @@ FrameFiles BatchRunner::files(const BatchInput& scene, const BatchJob& job, cons
     f.png_path = job.png;
     f.exr_options = settings_.exr;
     f.exr_attributes = attributes(scene, posed, job.frame, result, samples_so_far);
-    if (!aovs.channels.empty()) {
-        f.exr = make_exr_image(result.image, settings_.exr, f.exr_attributes,
-                               std::move(spare_channels_));
-        append_aov_channels(f.exr, aovs,
-                            settings_.exr.float32 ? PixelFormat::float32 : PixelFormat::half);
-    }
+    if (!aovs->channels.empty()) f.aovs = aovs;
     return f;
 }
 
@@ -294,7 +288,6 @@ void BatchRunner::finish_pending() {
     p->writer.join();
     // Its storage serves the frame after the next.
     spare_frame_ = std::move(p->pixels);
-    spare_channels_ = std::move(p->files.exr.channels);
     if (p->report_error) std::rethrow_exception(p->report_error);
 }
 
@@ -407,29 +400,26 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         options.cancel = cancel_;
         options.pixels_done = observer_.pixel_counter();
         options.crop = scene.crop;
-        // A spare frame and channels of another size would only add to this frame's
-        // memory (the estimate counts one frame): they go before it renders.
+        // A spare frame of another size would only add to this frame's memory (the
+        // estimate counts one frame): it goes before this one renders.
         const std::uint64_t pixels = scene.crop
                                          ? scene.crop->pixel_count()
                                          : static_cast<std::uint64_t>(posed.image.width) *
                                                static_cast<std::uint64_t>(posed.image.height);
-        if (spare_frame_.pixel_count() != pixels) {
-            spare_frame_ = Image();
-            spare_channels_.clear();
-        }
+        if (spare_frame_.pixel_count() != pixels) spare_frame_ = Image();
         options.spare_image = &spare_frame_;
         // Writing (EXR and PNG encoding) is timed apart from tracing: the frame line and
         // the summary report each, and the rate is rays over trace time alone.
         const auto trace_started = Clock::now();
 
         const auto render_pass = [&](const RenderOptions& o) { return renderer_->render(o); };
-        const Image aovs = renderer_->aovs(options, settings_.render.aovs);
+        const auto aovs =
+            std::make_shared<const Image>(renderer_->aovs(options, settings_.render.aovs));
         double write_seconds = 0.0;
         const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
             const auto write_started = Clock::now();
             FrameFiles f = files(scene, job, posed, r, aovs, samples_so_far);
             f.write(r.image);
-            spare_channels_ = std::move(f.exr.channels);
             write_seconds +=
                 std::chrono::duration<double>(Clock::now() - write_started).count();
         };

@@ -34,10 +34,11 @@ constexpr std::uint64_t kFramebufferBytesPerPixel = 12;
 // render/batch/progressive.cpp: while a pass renders, the last pass's image and sample sums are
 // kept, and the pass makes its own: four images.
 constexpr std::uint64_t kProgressiveImages = 4;
-// render/image/exr_write.cpp make_exr_image and render/aov.cpp append_aov_channels: every
-// channel is copied into the EXR image, as half (2 bytes) or float (4); the id AOV is
-// UINT (4). (Without AOVs, a ZIP, ZIPS or uncompressed EXR is packed from the render's
-// own float32 lines and no copy is made; the copy is counted anyway: an upper bound.)
+// render/image/exr_write.cpp write_exr(path, ExrSources): an EXR in a compression OpenEXR
+// packs (PIZ, DWAA, ...) is first made as an image, every channel copied in as half (2
+// bytes) or float (4), the id AOV as UINT (4). (ZIP, ZIPS and uncompressed files are packed
+// from the render's and the AOVs' own planes, without that copy; it is counted anyway: an
+// upper bound.)
 constexpr std::uint64_t kColorChannels = 3;
 constexpr std::uint64_t kDepthChannels = 1, kNormalChannels = 3, kAlbedoChannels = 3;
 // OpenEXR's scan-line writer holds one block of lines of every channel, uncompressed and

@@ -160,29 +160,45 @@ void insert_attributes(Imf::Header& header, const ExrAttributes& attributes) {
     }
 }
 
-void check_exr_image(const Image& image) {
-    if (image.display_window.empty())
-        throw std::invalid_argument("the display window " + window_text(image.display_window) +
+// What a file's channel is made of, for the checks: its name, the format of its samples
+// and how many bytes of them there are.
+struct ChannelFacts {
+    const std::string& name;
+    PixelFormat format;
+    std::size_t bytes;
+};
+
+void check_exr_layout(const PixelRect& display_window, const PixelRect& data_window,
+                      const std::vector<ChannelFacts>& channels) {
+    if (display_window.empty())
+        throw std::invalid_argument("the display window " + window_text(display_window) +
                                     " is empty");
-    if (image.data_window.empty())
-        throw std::invalid_argument("the data window " + window_text(image.data_window) +
+    if (data_window.empty())
+        throw std::invalid_argument("the data window " + window_text(data_window) +
                                     " is empty");
-    if (image.channels.empty()) throw std::invalid_argument("the image has no channels");
+    if (channels.empty()) throw std::invalid_argument("the image has no channels");
     std::set<std::string> names;
-    for (const ImageChannel& c : image.channels) {
+    for (const ChannelFacts& c : channels) {
         if (c.name.empty()) throw std::invalid_argument("a channel has an empty name");
         if (!names.insert(c.name).second)
             throw std::invalid_argument("channel '" + c.name + "' is given twice");
         if (c.format == PixelFormat::uint8)
             throw std::invalid_argument("channel '" + c.name +
                                         "' holds 8-bit samples, which OpenEXR cannot store");
-        const std::size_t expected = image.data_window.pixel_count() * sample_size(c.format);
-        if (c.samples.size() != expected)
+        const std::size_t expected = data_window.pixel_count() * sample_size(c.format);
+        if (c.bytes != expected)
             throw std::invalid_argument(
-                "channel '" + c.name + "' holds " + std::to_string(c.samples.size()) +
-                " bytes, but the data window " + window_text(image.data_window) + " needs " +
+                "channel '" + c.name + "' holds " + std::to_string(c.bytes) +
+                " bytes, but the data window " + window_text(data_window) + " needs " +
                 std::to_string(expected));
     }
+}
+
+void check_exr_image(const Image& image) {
+    std::vector<ChannelFacts> facts;
+    for (const ImageChannel& c : image.channels)
+        facts.push_back({c.name, c.format, c.samples.size()});
+    check_exr_layout(image.display_window, image.data_window, facts);
 }
 
 Imf::Header make_header(const Image& image) {
@@ -245,22 +261,19 @@ struct MagicAndVersion : Imf::GenericOutputFile {
 static_assert(std::endian::native == std::endian::little,
               "the samples are copied as they lie in memory into a little-endian file");
 
-// A channel as the file stores it: its samples, and the format the file holds them in,
-// which is theirs or, for a render's float32 channel written as half, half (converted a
-// line at a time as the chunks are packed: write_exr of a render).
-struct FileChannel {
-    const ImageChannel* source;
-    PixelFormat format;
-};
+// The channels in file order (OpenEXR sorts them by name), each from its samples.
+std::vector<ExrChannelSource> channels_in_file_order(std::vector<ExrChannelSource> channels) {
+    std::sort(channels.begin(), channels.end(),
+              [](const ExrChannelSource& a, const ExrChannelSource& b) {
+                  return a.samples->name < b.samples->name;
+              });
+    return channels;
+}
 
-// The channels of `image` in file order, each stored as `as(channel)` says.
-template <class Format>
-std::vector<FileChannel> channels_in_file_order(const Image& image, Format as) {
-    std::vector<FileChannel> channels;
-    for (const ImageChannel& c : image.channels) channels.push_back({&c, as(c)});
-    std::sort(channels.begin(), channels.end(), [](const FileChannel& a, const FileChannel& b) {
-        return a.source->name < b.source->name;
-    });
+// An Image's channels as sources of themselves.
+std::vector<ExrChannelSource> sources_of(const Image& image) {
+    std::vector<ExrChannelSource> channels;
+    for (const ImageChannel& c : image.channels) channels.push_back({&c, c.format});
     return channels;
 }
 
@@ -301,14 +314,15 @@ void predict(const unsigned char* in, std::size_t size, unsigned char* out) {
 // Packs, and for ZIP and ZIPS compresses, one chunk of scan lines.
 class ChunkEncoder {
   public:
-    ChunkEncoder(std::vector<FileChannel> channels, const PixelRect& data_window,
+    ChunkEncoder(std::vector<ExrChannelSource> channels, const PixelRect& data_window,
                  ExrCompression compression)
-        : channels_(std::move(channels)),
+        : channels_(channels_in_file_order(std::move(channels))),
           width_(static_cast<std::size_t>(data_window.width())),
           height_(data_window.height()),
           lines_per_chunk_(exr_lines_per_chunk(compression)),
           compression_(compression) {
-        for (const FileChannel& c : channels_) line_bytes_ += width_ * sample_size(c.format);
+        for (const ExrChannelSource& c : channels_)
+            line_bytes_ += width_ * sample_size(c.format);
     }
 
     int chunk_count() const { return (height_ + lines_per_chunk_ - 1) / lines_per_chunk_; }
@@ -365,15 +379,15 @@ class ChunkEncoder {
         const int y0 = first_line(chunk);
         const int y1 = std::min(height_, y0 + lines_per_chunk_);
         for (int y = y0; y < y1; ++y)
-            for (const FileChannel& c : channels_) {
+            for (const ExrChannelSource& c : channels_) {
                 const std::size_t line = static_cast<std::size_t>(y) * width_;
-                if (c.format == c.source->format) {
+                if (c.format == c.samples->format) {
                     const std::size_t bytes = width_ * sample_size(c.format);
-                    visit(c.source->samples.data() + line * sample_size(c.format), bytes);
+                    visit(c.samples->samples.data() + line * sample_size(c.format), bytes);
                     continue;
                 }
                 half_line.resize(width_);
-                floats_to_half_bits(c.source->floats() + line, width_, 1, half_line.data());
+                floats_to_half_bits(c.samples->floats() + line, width_, 1, half_line.data());
                 visit(reinterpret_cast<const unsigned char*>(half_line.data()),
                       width_ * sizeof(std::uint16_t));
             }
@@ -386,7 +400,7 @@ class ChunkEncoder {
         });
     }
 
-    std::vector<FileChannel> channels_;
+    std::vector<ExrChannelSource> channels_;
     std::size_t width_;
     int height_;
     int lines_per_chunk_;
@@ -492,9 +506,7 @@ void write_exr_with_own_chunks(const std::string& path, const ChunkEncoder& enco
 void write_exr_file(const std::string& path, const Image& image) {
     const Imf::Header header = make_header(image);
     if (packs_chunks_itself(image.compression)) {
-        const ChunkEncoder encoder(
-            channels_in_file_order(image, [](const ImageChannel& c) { return c.format; }),
-            image.data_window, image.compression);
+        const ChunkEncoder encoder(sources_of(image), image.data_window, image.compression);
         write_exr_with_own_chunks(path, encoder, image.data_window.y0, header);
     } else {
         write_exr_with_openexr(path, image, header);
@@ -591,34 +603,76 @@ void write_exr(const std::string& path, const Image& image) {
     write_file_atomically(path, [&](const std::string& tmp) { write_exr_file(tmp, image); });
 }
 
+ExrSources exr_sources(const Image& render, const ExrWriteOptions& options,
+                       const ExrAttributes& attributes) {
+    ExrSources exr;
+    exr.display_window = render.display_window;
+    exr.data_window = render.data_window;
+    exr.compression = options.compression;
+    exr.attributes = attributes;
+    const PixelFormat type = options.float32 ? PixelFormat::float32 : PixelFormat::half;
+    for (const ImageChannel& c : render.channels) {
+        if (c.format != PixelFormat::float32)
+            throw std::invalid_argument("exr_sources: channel " + c.name + " is " +
+                                        std::string(to_string(c.format)) +
+                                        ", not a render's float32");
+        exr.channels.push_back({&c, type});
+    }
+    return exr;
+}
+
 void write_exr(const std::string& path, const Image& render, const ExrWriteOptions& options,
                const ExrAttributes& attributes) {
     try {
         require_render_image(render);
-        check_exr_image(render);  // its windows and sample counts, as the file's would be
     } catch (const std::exception& e) {
         throw IoError("cannot write " + path + ": " + e.what());
     }
-    if (!packs_chunks_itself(options.compression)) {
-        write_exr(path, make_exr_image(render, options, attributes));
-        return;
+    write_exr(path, exr_sources(render, options, attributes));
+}
+
+void write_exr(const std::string& path, const ExrSources& sources) {
+    // The file's image without samples: its header, and the checks write_exr(path, Image)
+    // makes, on the sources' own samples.
+    Image shape;
+    shape.display_window = sources.display_window;
+    shape.data_window = sources.data_window;
+    shape.compression = sources.compression;
+    shape.attributes = sources.attributes;
+    try {
+        std::vector<ChannelFacts> facts;
+        for (const ExrChannelSource& c : sources.channels) {
+            if (c.format != c.samples->format &&
+                !(c.format == PixelFormat::half && c.samples->format == PixelFormat::float32))
+                throw std::invalid_argument("channel '" + c.samples->name + "' holds " +
+                                            std::string(to_string(c.samples->format)) +
+                                            " samples, which are not " + "written as " +
+                                            std::string(to_string(c.format)));
+            shape.channels.push_back({c.samples->name, c.format, {}});
+            facts.push_back({c.samples->name, c.samples->format, c.samples->samples.size()});
+        }
+        check_exr_layout(sources.display_window, sources.data_window, facts);
+        if (!packs_chunks_itself(sources.compression)) {
+            // OpenEXR packs these: the image is made, converted, and written as it is.
+            Image image = shape;
+            for (std::size_t k = 0; k < sources.channels.size(); ++k) {
+                const ExrChannelSource& c = sources.channels[k];
+                image.channels[k] = c.format == c.samples->format
+                                        ? *c.samples
+                                        : make_channel(c.samples->name, c.format,
+                                                       c.samples->floats(), c.samples->size());
+            }
+            write_exr(path, image);
+            return;
+        }
+    } catch (const IoError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw IoError("cannot write " + path + ": " + e.what());
     }
-    // The chunks are packed from the render's float32 samples, each line converted to
-    // half as it is packed (unless float32): the file make_exr_image's image makes, byte
-    // for byte, without a half copy of the frame (5.5 MB at 1280x720, its first touch
-    // included) made before the chunks.
-    Image shape;  // the file's channels and header, without samples
-    shape.display_window = render.display_window;
-    shape.data_window = render.data_window;
-    shape.compression = options.compression;
-    shape.attributes = attributes;
-    const PixelFormat type = options.float32 ? PixelFormat::float32 : PixelFormat::half;
-    for (const ImageChannel& c : render.channels) shape.channels.push_back({c.name, type, {}});
     write_file_atomically(path, [&](const std::string& tmp) {
-        const ChunkEncoder encoder(
-            channels_in_file_order(render, [type](const ImageChannel&) { return type; }),
-            render.data_window, options.compression);
-        write_exr_with_own_chunks(tmp, encoder, render.data_window.y0, make_header(shape));
+        const ChunkEncoder encoder(sources.channels, sources.data_window, sources.compression);
+        write_exr_with_own_chunks(tmp, encoder, sources.data_window.y0, make_header(shape));
     });
 }
 

@@ -71,11 +71,42 @@ Image make_exr_image(const Image& render, const ExrWriteOptions& options,
 void write_exr(const std::string& path, const Image& image);
 
 // Writes a render's image (float32 R, G, B; row 0 on top) as make_exr_image makes it, the
-// same file byte for byte. With ZIP, ZIPS or no compression (the chunks octray packs
-// itself) no EXR image is made: each line is converted to half as its chunk is packed.
+// same file byte for byte, through write_exr(path, ExrSources) (no EXR image is made).
 // Throws IoError, also for an image that is not a render's.
 void write_exr(const std::string& path, const Image& render, const ExrWriteOptions& options,
                const ExrAttributes& attributes = {});
+
+// ---- Writing from samples held elsewhere -------------------------------------------------
+
+// A channel of an EXR written from samples the caller holds: the file stores them in
+// `format`, theirs or, for float32 samples, half (each line converted as it is packed).
+struct ExrChannelSource {
+    const ImageChannel* samples;
+    PixelFormat format;
+};
+
+// An EXR to write from channels held elsewhere (a render's planes, its AOVs): an Image's
+// windows, compression and attributes, and its channels as sources.
+struct ExrSources {
+    PixelRect display_window, data_window;
+    ExrCompression compression = ExrCompression::zip;
+    ExrAttributes attributes;
+    std::vector<ExrChannelSource> channels;
+};
+
+// The sources of a render's image (float32 R, G, B) as make_exr_image converts it: each
+// channel half, or float32 with options.float32. Throws std::invalid_argument for a
+// channel that is not float32.
+ExrSources exr_sources(const Image& render, const ExrWriteOptions& options,
+                       const ExrAttributes& attributes = {});
+
+// Writes the EXR `sources` describe, atomically: the file write_exr(path, Image) writes
+// of the Image whose channels are the sources converted, byte for byte. With ZIP, ZIPS or
+// no compression (the chunks octray packs itself) that Image is never made: each line is
+// converted as its chunk is packed; other compressions make it first. Throws IoError as
+// write_exr does (also for a source whose sample count is not the data window's, or a
+// conversion other than float32 to half).
+void write_exr(const std::string& path, const ExrSources& sources);
 
 // An 8-bit sRGB preview of a render's image (float32 R, G, B): linear values clamped to
 // [0, 1], sRGB-encoded. Throws IoError, also for an image that is not a render's.

@@ -8,6 +8,9 @@
 #include <half.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -214,6 +217,52 @@ TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
     EXPECT_THROW(
         append_aov_channels(wrong, compute_aovs(scene, crop, AovSet{true}), PixelFormat::half),
         std::invalid_argument);
+}
+
+// The frame loop writes a frame's EXR from its planes and its AOVs as they are (ExrSources:
+// each line converted as its chunk is packed): the file of the image make_exr_image and
+// append_aov_channels make, byte for byte, in every compression, half and float, over a
+// crop; the sources refuse AOVs of another window as append_aov_channels does.
+TEST(Aov, AnExrWrittenFromItsSourcesIsTheFileOfItsImage) {
+    const Scene scene = known_scene();
+    const std::filesystem::path dir = testing::test_dir();
+    const auto bytes = [](const std::filesystem::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in),
+                           std::istreambuf_iterator<char>());
+    };
+    RenderOptions options;
+    options.crop = PixelRect{3, 5, 30, 26};
+    const RenderResult result = render_reference(scene, options);
+    const Image aovs = compute_aovs(scene, options, AovSet{true, true, true, true});
+    ExrAttributes attributes;
+    attributes.strings.emplace_back("octray.test", "sources");
+    for (const bool float32 : {false, true})
+        for (const ExrCompression c :
+             {ExrCompression::none, ExrCompression::rle, ExrCompression::zips,
+              ExrCompression::zip, ExrCompression::piz, ExrCompression::pxr24,
+              ExrCompression::b44, ExrCompression::dwaa}) {
+            SCOPED_TRACE(std::string(to_string(c)) + (float32 ? " float" : " half"));
+            const ExrWriteOptions exr{float32, c};
+            const PixelFormat color = float32 ? PixelFormat::float32 : PixelFormat::half;
+            Image image = make_exr_image(result.image, exr, attributes);
+            append_aov_channels(image, aovs, color);
+            write_exr((dir / "image.exr").string(), image);
+            ExrSources sources = exr_sources(result.image, exr, attributes);
+            append_aov_sources(sources, aovs, color);
+            write_exr((dir / "sources.exr").string(), sources);
+            const std::string written = bytes(dir / "sources.exr");
+            EXPECT_GT(written.size(), 1000u);
+            EXPECT_EQ(written, bytes(dir / "image.exr"));
+        }
+    const RenderResult whole = render_reference(scene, {});
+    ExrSources wrong = exr_sources(whole.image, ExrWriteOptions{});
+    EXPECT_THROW(append_aov_sources(wrong, aovs, PixelFormat::half), std::invalid_argument);
+    // A source whose samples are not the data window's: an IoError naming the file.
+    ExrSources short_one = exr_sources(result.image, ExrWriteOptions{});
+    short_one.data_window.x1 += 1;
+    EXPECT_THROW(write_exr((dir / "short.exr").string(), short_one), IoError);
+    EXPECT_FALSE(std::filesystem::exists(dir / "short.exr"));
 }
 
 }  // namespace
