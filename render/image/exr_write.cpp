@@ -522,6 +522,27 @@ void require_render_image(const Image& image) {
                                     "x" + std::to_string(image.height()) + ")");
 }
 
+// The image `sources` describe: each float32 source converted (or copied) by make_channel
+// into storage taken from `spare` in turn where there is some, any other copied.
+Image exr_image_of(const ExrSources& sources, std::vector<ImageChannel> spare = {}) {
+    Image image;
+    image.display_window = sources.display_window;
+    image.data_window = sources.data_window;
+    image.compression = sources.compression;
+    image.attributes = sources.attributes;
+    for (std::size_t k = 0; k < sources.channels.size(); ++k) {
+        const ImageChannel& c = *sources.channels[k].samples;
+        if (c.format != PixelFormat::float32) {
+            image.channels.push_back(c);
+            continue;
+        }
+        SampleBytes storage = k < spare.size() ? std::move(spare[k].samples) : SampleBytes();
+        image.channels.push_back(make_channel(c.name, sources.channels[k].format, c.floats(),
+                                              c.size(), 1, std::move(storage)));
+    }
+    return image;
+}
+
 }  // namespace
 
 std::optional<ExrCompression> parse_exr_compression(std::string_view name) {
@@ -575,23 +596,7 @@ ExrRational exr_rational(double value) {
 
 Image make_exr_image(const Image& render, const ExrWriteOptions& options,
                      const ExrAttributes& attributes, std::vector<ImageChannel> spare) {
-    Image exr;
-    exr.display_window = render.display_window;
-    exr.data_window = render.data_window;
-    exr.compression = options.compression;
-    exr.attributes = attributes;
-    const PixelFormat type = options.float32 ? PixelFormat::float32 : PixelFormat::half;
-    for (std::size_t k = 0; k < render.channels.size(); ++k) {
-        const ImageChannel& c = render.channels[k];
-        if (c.format != PixelFormat::float32)
-            throw std::invalid_argument("make_exr_image: channel " + c.name + " is " +
-                                        std::string(to_string(c.format)) +
-                                        ", not a render's float32");
-        SampleBytes storage = k < spare.size() ? std::move(spare[k].samples) : SampleBytes();
-        exr.channels.push_back(
-            make_channel(c.name, type, c.floats(), c.size(), 1, std::move(storage)));
-    }
-    return exr;
+    return exr_image_of(exr_sources(render, options, attributes), std::move(spare));
 }
 
 void write_exr(const std::string& path, const Image& image) {
@@ -654,15 +659,7 @@ void write_exr(const std::string& path, const ExrSources& sources) {
         check_exr_layout(sources.display_window, sources.data_window, facts);
         if (!packs_chunks_itself(sources.compression)) {
             // OpenEXR packs these: the image is made, converted, and written as it is.
-            Image image = shape;
-            for (std::size_t k = 0; k < sources.channels.size(); ++k) {
-                const ExrChannelSource& c = sources.channels[k];
-                image.channels[k] = c.format == c.samples->format
-                                        ? *c.samples
-                                        : make_channel(c.samples->name, c.format,
-                                                       c.samples->floats(), c.samples->size());
-            }
-            write_exr(path, image);
+            write_exr(path, exr_image_of(sources));
             return;
         }
     } catch (const IoError&) {
