@@ -163,6 +163,16 @@ TEST(Aov, FromThePacketPathsFirstHitsTheSameBits) {
                 EXPECT_TRUE(same(scalar, packet))
                     << spec << ", camera " << static_cast<int>(camera) << ", accel "
                     << accel_name(accel);
+                if (camera == CameraType::fisheye) {
+                    // The crop's corner pixel (3, 2) lies outside the image circle: no ray,
+                    // a miss's values, written though nothing was traced.
+                    for (const Image* a : {&scalar, &packet}) {
+                        EXPECT_TRUE(std::isinf(aov_depth(*a, 0)) && aov_depth(*a, 0) > 0.0f);
+                        EXPECT_EQ(aov_normal(*a, 0), (Vec3{0, 0, 0}));
+                        EXPECT_EQ(aov_albedo(*a, 0), (Rgb{0, 0, 0}));
+                        EXPECT_EQ(aov_id(*a, 0), 0u);
+                    }
+                }
             }
     // Hits of another rectangle are refused.
     const Scene scene = make_builtin_scene("whitted,width=8,height=8");
