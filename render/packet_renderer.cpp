@@ -427,6 +427,16 @@ class PacketTracer {
         pixel_order_for(tile, s);
         const std::size_t pixels = static_cast<std::size_t>(tile.width) * tile.height;
         const auto w = static_cast<std::uint32_t>(tile.width);
+        // A miss in every pixel of the tile first: a pixel without a ray keeps it.
+        for (int y = tile.y0; y < tile.y0 + tile.height; ++y) {
+            const std::size_t row = static_cast<std::size_t>(y - out.rect.y0) *
+                                        static_cast<std::size_t>(out.rect.width()) +
+                                    static_cast<std::size_t>(tile.x0 - out.rect.x0);
+            std::fill_n(out.t.begin() + static_cast<std::ptrdiff_t>(row), tile.width,
+                        std::numeric_limits<float>::infinity());
+            std::fill_n(out.object.begin() + static_cast<std::ptrdiff_t>(row), tile.width,
+                        kernels::kNoHit);
+        }
         for (std::size_t first = 0; first < pixels; first += ray_chunk_) {
             const std::size_t n = std::min<std::size_t>(ray_chunk_, pixels - first);
             camera_samples(tile, s, first, n, 0, 1);
@@ -706,8 +716,10 @@ FirstHits trace_first_hits(const PreparedScene& prepared, const RenderOptions& o
     const CompiledScene& scene = prepared.compiled();
     FirstHits out;
     out.rect = render_rect(options, scene.width, scene.height);
-    out.t.assign(out.rect.pixel_count(), std::numeric_limits<float>::infinity());
-    out.object.assign(out.rect.pixel_count(), kernels::kNoHit);
+    // Sized, not filled: each tile writes its pixels' misses first (first_hits), on the
+    // render's threads.
+    out.t.resize(out.rect.pixel_count());
+    out.object.resize(out.rect.pixel_count());
     const kernels::KernelTable& table = kernel_table(resolve_isa(isa));
     const TileGrid grid(out.rect, options);
     run_with_threads(options.threads, [&] {

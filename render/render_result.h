@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/aligned.h"
 #include "core/pixel_rect.h"
 #include "render/image/image.h"
 #include "render/render_options.h"
@@ -15,10 +16,11 @@ namespace octray {
 // first): the first hits the AOVs read, traced by either path. object is the hit's
 // Scene::objects index, or -1 (t = +inf) for a miss or a camera sample with no ray (a
 // fisheye pixel outside its image circle).
+// Sized without being written (UninitializedVector): the tracer writes every pixel.
 struct FirstHits {
     PixelRect rect;
-    std::vector<float> t;
-    std::vector<std::int32_t> object;
+    UninitializedVector<float> t;
+    UninitializedVector<std::int32_t> object;
 };
 
 struct RenderResult {

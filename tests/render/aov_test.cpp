@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -158,8 +159,21 @@ TEST(Aov, FromThePacketPathsFirstHitsTheSameBits) {
                 options.crop = PixelRect{3, 2, 37, 21};
                 const PreparedScene prepared(scene, accel);
                 const Image scalar = compute_aovs(scene, options, all);
-                const Image packet =
-                    compute_aovs(scene, options, all, trace_first_hits(prepared, options));
+                const FirstHits hits = trace_first_hits(prepared, options);
+                const Image packet = compute_aovs(scene, options, all, hits);
+                // A miss (or no ray) is object -1 at t = +inf; a hit is in front.
+                std::size_t misses = 0;
+                for (std::size_t k = 0; k < hits.t.size(); ++k) {
+                    if (hits.object[k] < 0) {
+                        ++misses;
+                        EXPECT_EQ(hits.t[k], std::numeric_limits<float>::infinity()) << k;
+                    } else {
+                        EXPECT_GT(hits.t[k], 0.0f) << k;
+                    }
+                }
+                if (camera == CameraType::fisheye) {
+                    EXPECT_GT(misses, 0u);
+                }
                 EXPECT_TRUE(same(scalar, packet))
                     << spec << ", camera " << static_cast<int>(camera) << ", accel "
                     << accel_name(accel);
@@ -180,6 +194,23 @@ TEST(Aov, FromThePacketPathsFirstHitsTheSameBits) {
     crop.crop = PixelRect{0, 0, 4, 4};
     EXPECT_THROW(compute_aovs(scene, crop, all, trace_first_hits(PreparedScene(scene), {})),
                  std::invalid_argument);
+}
+
+// trace_first_hits sizes its arrays without filling them: every tile writes its pixels'
+// misses first. A fisheye's corners have no camera ray, so only that write gives them
+// object -1 and t = +inf (a first allocation this large is fresh, zeroed memory).
+TEST(Aov, FirstHitsOfPixelsWithoutARayAreMisses) {
+    Scene scene = make_builtin_scene("whitted,width=256,height=256");
+    scene.camera.type = CameraType::fisheye;
+    scene.camera.fov = 180.0f;
+    const FirstHits hits = trace_first_hits(PreparedScene(scene), {});
+    ASSERT_EQ(hits.t.size(), 256u * 256u);
+    for (const std::size_t corner : {std::size_t{0}, std::size_t{255}, std::size_t{255 * 256},
+                                     std::size_t{256 * 256 - 1}}) {
+        EXPECT_EQ(hits.object[corner], -1) << corner;
+        EXPECT_EQ(hits.t[corner], std::numeric_limits<float>::infinity()) << corner;
+    }
+    EXPECT_GE(hits.object[128 * 256 + 128], 0);  // the centre sees the scene
 }
 
 TEST(Aov, ChannelsInTheExrHaveTheirPixelTypes) {
