@@ -90,7 +90,7 @@ Image aovs_from(const Scene& scene, const RenderOptions& options, AovSet set,
     if (set.depth) names.push_back("Z");
     if (set.normal) names.insert(names.end(), {"N.X", "N.Y", "N.Z"});
     if (set.albedo) names.insert(names.end(), {"albedo.R", "albedo.G", "albedo.B"});
-    // The channels' storage is sized, not filled: the rows below write every pixel, a
+    // The channels' storage is sized, not filled: the rows below write every pixel once, a
     // miss's values included, on every thread (a zero fill first, on one thread, took
     // 64 MB at 1920x1080 and its first touch before them).
     Image out;
@@ -128,33 +128,33 @@ Image aovs_from(const Scene& scene, const RenderOptions& options, AovSet set,
                 for (int i = rect.x0; i < rect.x1; ++i) {
                     const std::size_t k =
                         static_cast<std::size_t>(j - rect.y0) * rect.width() + (i - rect.x0);
-                    // A miss's values first: depth +inf, normal and albedo 0, id 0.
-                    if (set.depth) depth[k] = std::numeric_limits<float>::infinity();
-                    if (set.normal) normal[0][k] = normal[1][k] = normal[2][k] = 0.0f;
-                    if (set.albedo) albedo[0][k] = albedo[1][k] = albedo[2][k] = 0.0f;
-                    if (set.id) id[k] = 0;
-                    // Sample 0's camera ray; a fisheye pixel outside the image circle has
-                    // none and keeps the miss values.
+                    // Sample 0's camera ray (a fisheye pixel outside the image circle has
+                    // none) and its hit.
                     const std::optional<Ray> ray = tracer.camera_ray(i, j, 0, options.frame);
-                    if (!ray) continue;
                     std::optional<SurfaceHit> hit;
-                    if (hits == nullptr)
-                        hit = tracer.intersect(*ray);
-                    else if (hits->object[k] >= 0)
-                        hit = tracer.surface_hit(*ray, hits->t[k],
-                                                 static_cast<std::uint32_t>(hits->object[k]));
-                    if (!hit) continue;
-                    if (set.depth) depth[k] = hit->t;
+                    if (ray) {
+                        if (hits == nullptr)
+                            hit = tracer.intersect(*ray);
+                        else if (hits->object[k] >= 0)
+                            hit = tracer.surface_hit(
+                                *ray, hits->t[k], static_cast<std::uint32_t>(hits->object[k]));
+                    }
+                    // Each pixel written once, a miss (or no ray) as depth +inf, normal and
+                    // albedo 0, id 0.
+                    if (set.depth)
+                        depth[k] = hit ? hit->t : std::numeric_limits<float>::infinity();
                     if (set.normal) {  // the normal shading uses: facing the incoming ray
-                        const Vec3 v = dot(hit->normal, ray->direction) > 0.0f ? -hit->normal
-                                                                               : hit->normal;
+                        Vec3 v{0.0f, 0.0f, 0.0f};
+                        if (hit)
+                            v = dot(hit->normal, ray->direction) > 0.0f ? -hit->normal
+                                                                        : hit->normal;
                         normal[0][k] = v.x, normal[1][k] = v.y, normal[2][k] = v.z;
                     }
                     if (set.albedo) {
-                        const Rgb c = tracer.surface_color(*hit);
+                        const Rgb c = hit ? tracer.surface_color(*hit) : Rgb(0.0f, 0.0f, 0.0f);
                         albedo[0][k] = c.r, albedo[1][k] = c.g, albedo[2][k] = c.b;
                     }
-                    if (set.id) id[k] = hit->object + 1;
+                    if (set.id) id[k] = hit ? hit->object + 1 : 0;
                 }
         });
     };

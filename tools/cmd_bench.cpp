@@ -10,7 +10,6 @@
 #include <string>
 
 #include "bench/bench_runner.h"
-#include "kernels/dispatch.h"
 #include "tools/bench_arguments.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"

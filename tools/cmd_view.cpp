@@ -5,7 +5,6 @@
 #include <memory>
 #include <string>
 
-#include "kernels/dispatch.h"
 #include "scene/max_depth.h"
 #include "tools/cli_checks.h"
 #include "tools/commands.h"

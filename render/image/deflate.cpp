@@ -41,10 +41,6 @@ std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out
     return libdeflate_zlib_compress(compressor(level), in, size, out, capacity);
 }
 
-std::size_t zlib_compress_bound(int level, std::size_t size) {
-    return libdeflate_zlib_compress_bound(compressor(level), size);
-}
-
 std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size) {
     return libdeflate_adler32(adler, data, size);
 }

@@ -16,9 +16,6 @@ namespace octray::detail {
 std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out,
                           std::size_t capacity);
 
-// The most bytes zlib_compress can need for `size` bytes at `level`.
-std::size_t zlib_compress_bound(int level, std::size_t size);
-
 // ---- Bands of one DEFLATE stream, compressed in parallel (deflate_runs.cpp) --------------
 // libdeflate compresses a buffer into one whole stream, so one PNG's pixels would be
 // compressed on one thread. deflate_band compresses a band of them into raw DEFLATE blocks

@@ -657,15 +657,13 @@ void write_exr(const std::string& path, const ExrSources& sources) {
             facts.push_back({c.samples->name, c.samples->format, c.samples->samples.size()});
         }
         check_exr_layout(sources.display_window, sources.data_window, facts);
-        if (!packs_chunks_itself(sources.compression)) {
-            // OpenEXR packs these: the image is made, converted, and written as it is.
-            write_exr(path, exr_image_of(sources));
-            return;
-        }
-    } catch (const IoError&) {
-        throw;
     } catch (const std::exception& e) {
         throw IoError("cannot write " + path + ": " + e.what());
+    }
+    if (!packs_chunks_itself(sources.compression)) {
+        // OpenEXR packs these: the image is made, converted, and written as it is.
+        write_exr(path, exr_image_of(sources));
+        return;
     }
     write_file_atomically(path, [&](const std::string& tmp) {
         const ChunkEncoder encoder(sources.channels, sources.data_window, sources.compression);

@@ -60,7 +60,9 @@ struct ExrWriteOptions {
 // kept; the compression and `attributes` set. Throws std::invalid_argument for a channel
 // that is not float32.
 // `spare`: channels of an image already written, whose storage the channels take in turn
-// (make_channel), so that a frame loop converts each frame into the same memory.
+// (make_channel), for a caller that converts frame after frame into the same memory.
+// (octray's own writers no longer make this image for ZIP, ZIPS or uncompressed files:
+// exr_sources below.)
 Image make_exr_image(const Image& render, const ExrWriteOptions& options,
                      const ExrAttributes& attributes = {},
                      std::vector<ImageChannel> spare = {});
