@@ -7,7 +7,7 @@
 # slurm-client and munge let tests/farm/slurm.sh run a single-node Slurm (it starts the
 # daemons itself, from a temporary folder; installing them starts nothing here).
 # python3-matplotlib draws bench/plot.py's charts; groff-base checks the man pages.
-# libdeflate-dev compresses the ZIP chunks of the EXRs and the PNGs octray writes.
+# libisal-dev (ISA-L's igzip) compresses the ZIP chunks of the EXRs octray writes.
 # libcpp-httplib-dev is the HTTP server of `octray view` (libjpeg62-turbo-dev its picture
 # stream's JPEG); chromium, chromium-driver and python3-selenium drive its page headless
 # in tests/view/browser_test.py.
@@ -19,7 +19,7 @@ packages=(
     dpkg-dev xz-utils
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libsimdjson-dev
-    libpng-dev libdeflate-dev libembree-dev libssl-dev
+    libpng-dev libisal-dev libembree-dev libssl-dev
     slurmctld slurmd slurm-client munge
     python3-matplotlib groff-base
     libcpp-httplib-dev libjpeg62-turbo-dev chromium chromium-driver python3-selenium

@@ -1,48 +1,89 @@
-// zlib streams by libdeflate, and the checksums of zlib streams and PNG chunks (deflate.h).
+// zlib streams by ISA-L's igzip, and the checksums of zlib streams and PNG chunks
+// (deflate.h).
 
 #include "render/image/deflate.h"
 
-#include <libdeflate.h>
+#include <isa-l/crc.h>
+#include <isa-l/igzip_lib.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <memory>
-#include <new>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace octray::detail {
 namespace {
 
-struct FreeCompressor {
-    void operator()(libdeflate_compressor* c) const { libdeflate_free_compressor(c); }
+// This thread's stream state and the tables of each level, made on first use: the state is
+// about 100 KB of history and hash heads, a level's buffer a few hundred KB, too much to
+// make per chunk or to put on a worker's stack.
+struct Igzip {
+    isal_zstream stream;
+    std::array<std::vector<std::uint8_t>, 4> level_buffers;  // levels 1 ... 3
 };
-using Compressor = std::unique_ptr<libdeflate_compressor, FreeCompressor>;
 
-// This thread's compressor for `level`, made on first use: one costs a few hundred KB of
-// tables, too much to make per chunk.
-libdeflate_compressor* compressor(int level) {
-    if (level < 1 || level > 12)
-        throw std::invalid_argument("deflate level " + std::to_string(level) +
-                                    " is outside 1 ... 12");
-    thread_local std::array<Compressor, 13> compressors;
-    Compressor& c = compressors[static_cast<std::size_t>(level)];
-    if (!c) {
-        c.reset(libdeflate_alloc_compressor(level));
-        if (!c) throw std::bad_alloc();
+Igzip& igzip() {
+    thread_local const std::unique_ptr<Igzip> state = std::make_unique<Igzip>();
+    return *state;
+}
+
+std::size_t level_buffer_size(int level) {
+    switch (level) {
+        case 1:
+            return ISAL_DEF_LVL1_DEFAULT;
+        case 2:
+            return ISAL_DEF_LVL2_DEFAULT;
+        case 3:
+            return ISAL_DEF_LVL3_DEFAULT;
+        default:
+            return ISAL_DEF_LVL0_DEFAULT;
     }
-    return c.get();
 }
 
 }  // namespace
 
 std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out,
                           std::size_t capacity) {
-    return libdeflate_zlib_compress(compressor(level), in, size, out, capacity);
+    if (level < 0 || level > 3)
+        throw std::invalid_argument("deflate level " + std::to_string(level) +
+                                    " is outside 0 ... 3");
+    Igzip& state = igzip();
+    isal_zstream& s = state.stream;
+    isal_deflate_stateless_init(&s);
+    s.level = static_cast<std::uint32_t>(level);
+    if (level > 0) {
+        std::vector<std::uint8_t>& buffer =
+            state.level_buffers[static_cast<std::size_t>(level)];
+        if (buffer.empty()) buffer.resize(level_buffer_size(level));
+        s.level_buf = buffer.data();
+        s.level_buf_size = static_cast<std::uint32_t>(buffer.size());
+    }
+    s.gzip_flag = IGZIP_ZLIB;
+    s.end_of_stream = 1;
+    s.flush = NO_FLUSH;
+    // One call takes at most 4 GiB in and out (the fields are 32 bits); a chunk or band
+    // octray compresses is far smaller.
+    if (size > UINT32_MAX)
+        throw std::length_error("zlib_compress: " + std::to_string(size) +
+                                " bytes exceed one call's 4 GiB");
+    s.next_in = static_cast<std::uint8_t*>(const_cast<void*>(in));
+    s.avail_in = static_cast<std::uint32_t>(size);
+    s.next_out = static_cast<std::uint8_t*>(out);
+    s.avail_out = static_cast<std::uint32_t>(std::min<std::size_t>(capacity, UINT32_MAX));
+    const int status = isal_deflate_stateless(&s);
+    if (status == STATELESS_OVERFLOW) return 0;  // it does not fit in `capacity`
+    if (status != COMP_OK)
+        throw std::runtime_error("zlib_compress: igzip failed with status " +
+                                 std::to_string(status));
+    return s.total_out;
 }
 
 std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size) {
-    return libdeflate_adler32(adler, data, size);
+    return isal_adler32(adler, static_cast<const unsigned char*>(data), size);
 }
 
 std::uint32_t adler32_combine(std::uint32_t first, std::uint32_t second,
@@ -52,7 +93,7 @@ std::uint32_t adler32_combine(std::uint32_t first, std::uint32_t second,
 }
 
 std::uint32_t crc32(std::uint32_t crc, const void* data, std::size_t size) {
-    return libdeflate_crc32(crc, data, size);
+    return crc32_gzip_refl(crc, static_cast<const unsigned char*>(data), size);
 }
 
 }  // namespace octray::detail

@@ -1,23 +1,25 @@
 #pragma once
-// zlib streams (RFC 1950) made by libdeflate, for the files octray compresses itself: the
-// ZIP and ZIPS chunks of its EXRs (exr_write.cpp) and the pixel data of its PNGs
-// (png.cpp). libdeflate compresses a whole buffer at once, faster than zlib at the same
-// size (the level each writer uses, and why: render/image/README.md, "Compression").
+// zlib streams (RFC 1950) made by ISA-L's igzip, for the ZIP and ZIPS chunks of the EXRs
+// octray writes (exr_write.cpp), and octray's own DEFLATE bands for the pixel data of its
+// PNGs (png.cpp). igzip compresses a whole buffer at once, three to four times as fast as
+// libdeflate's fastest levels, files about a tenth larger (the level each writer uses, and
+// why: render/image/README.md, "Compression").
 
 #include <cstddef>
 #include <cstdint>
 
 namespace octray::detail {
 
-// Compresses in[0, size) at `level` (1 fastest ... 12 smallest) into out[0, capacity) as
-// one zlib stream and returns its length; 0 when it does not fit in `capacity`, so that a
-// caller who gives capacity = size - 1 learns that the data does not compress. Each
-// thread keeps one compressor per level for the life of the thread.
+// Compresses in[0, size) at igzip's `level` (0 fastest ... 3 smallest) into out[0,
+// capacity) as one zlib stream and returns its length; 0 when it does not fit in
+// `capacity`, so that a caller who gives capacity = size - 1 learns that the data does not
+// compress. Each thread keeps its stream state and each level's tables for the life of the
+// thread.
 std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out,
                           std::size_t capacity);
 
 // ---- Bands of one DEFLATE stream, compressed in parallel (deflate_runs.cpp) --------------
-// libdeflate compresses a buffer into one whole stream, so one PNG's pixels would be
+// zlib_compress makes one whole stream of a buffer, so one PNG's pixels would be
 // compressed on one thread. deflate_band compresses a band of them into raw DEFLATE blocks
 // (RFC 1951) that end on a byte boundary, so that bands compressed on their own, in order,
 // make one stream: literals, runs of a repeated byte (matches at distance 1, as zlib's
@@ -37,13 +39,14 @@ std::size_t deflate_band(const std::uint8_t* in, std::size_t size, std::size_t r
 
 // ---- Checksums (deflate.cpp) --------------------------------------------------------------
 // Adler-32 (a zlib stream's checksum) of data[0, size), continuing from `adler` (1 to
-// start), by libdeflate; and the Adler-32 of A followed by B from A's, B's and B's length,
+// start), by igzip; and the Adler-32 of A followed by B from A's, B's and B's length,
 // by zlib (what joins the bands' sums).
 std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size);
 std::uint32_t adler32_combine(std::uint32_t first, std::uint32_t second,
                               std::size_t second_size);
 
-// CRC-32 (the PNG chunk's) of data[0, size), continuing from `crc` (0 to start).
+// CRC-32 (the PNG chunk's) of data[0, size), continuing from `crc` (0 to start), by
+// ISA-L.
 std::uint32_t crc32(std::uint32_t crc, const void* data, std::size_t size);
 
 }  // namespace octray::detail

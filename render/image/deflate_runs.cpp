@@ -8,8 +8,8 @@
 // finder would find (a flat area filters to zeros), and finding them needs no hash table:
 // one pass compares each byte with those 1 and `repeat` before it, 32 at a time. What it
 // misses are repeats at other distances (a texture, identical objects), which a general
-// LZ77 matcher such as libdeflate's finds (render/image/README.md, "Compression"). Three
-// passes over a band: the matches, the histogram, then the codes.
+// LZ77 matcher such as igzip's or libdeflate's finds (render/image/README.md, "Compression").
+// Three passes over a band: the matches, the histogram, then the codes.
 
 #include <emmintrin.h>
 

@@ -233,15 +233,16 @@ void write_exr_with_openexr(const std::string& path, const Image& image,
 //
 // Uncompressed, ZIPS and ZIP files (ZIP is octray's default) are written here: OpenEXR
 // 3.1 deflates each chunk with zlib on its thread pool, which cost more than the trace of
-// a 1280x720 frame; libdeflate's level 2 makes zlib streams of the same chunks about
-// twice as fast as zlib's level 4, about as small (render/image/README.md, "Compression").
+// a 1280x720 frame; ISA-L's igzip at level 1 makes zlib streams of the same chunks five to
+// ten times as fast as zlib's level 4, about a tenth larger (render/image/README.md,
+// "Compression").
 // OpenEXR still writes the magic number, version and header; the file reads back through
 // any OpenEXR reader (the tests read every compression back, and compare the uncompressed
 // file with OpenEXR's byte for byte).
 
-// libdeflate's level for ZIP and ZIPS chunks (see above): level 2 compressed the chunks of
-// three of four frames faster than level 1, and all four 2-4 % smaller.
-constexpr int kZipLevel = 2;
+// igzip's level for ZIP and ZIPS chunks (see above): level 0 made files 15-30 % larger
+// than level 1 for a fifth less time, levels 2 and 3 were no smaller and slower.
+constexpr int kZipLevel = 1;
 
 bool packs_chunks_itself(ExrCompression compression) {
     return compression == ExrCompression::none || compression == ExrCompression::zips ||

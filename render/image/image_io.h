@@ -153,7 +153,7 @@ int exr_thread_count();
 
 namespace detail {
 // write_exr packs and compresses the chunks of uncompressed, ZIPS and ZIP files itself
-// (libdeflate, in parallel) and leaves the other compressions to OpenEXR. For the tests
+// (ISA-L's igzip, in parallel) and leaves the other compressions to OpenEXR. For the tests
 // that hold the first to OpenEXR's writer: `image` written by OpenEXR's OutputFile, with
 // the same header, not atomically.
 void write_exr_by_openexr(const std::string& path, const Image& image);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "render/image/deflate.h"
@@ -163,6 +164,63 @@ TEST(Adler32, CombinedSumsAreTheSumOfTheWhole) {
             << "cut at " << cut;
     }
     EXPECT_EQ(detail::adler32(1, in.data(), 0), 1u);
+}
+
+// The checksums are ISA-L's; a PNG reader checks zlib's: the same sums, whole and
+// continued piece by piece (a PNG chunk's CRC runs over its type, then its data).
+TEST(Checksums, AreZlibsWholeAndInPieces) {
+    Bytes in(100003);
+    std::uint32_t state = 5;
+    for (std::uint8_t& b : in) b = static_cast<std::uint8_t>(next_random(state) >> 24);
+    for (std::size_t cut : {std::size_t{0}, std::size_t{1}, std::size_t{4}, std::size_t{63},
+                            std::size_t{65537}, in.size()}) {
+        SCOPED_TRACE("cut at " + std::to_string(cut));
+        const uLong zlib_crc = ::crc32(0, in.data(), static_cast<uInt>(in.size()));
+        const uLong zlib_adler = ::adler32(1, in.data(), static_cast<uInt>(in.size()));
+        EXPECT_EQ(
+            detail::crc32(detail::crc32(0, in.data(), cut), in.data() + cut, in.size() - cut),
+            zlib_crc);
+        EXPECT_EQ(detail::adler32(detail::adler32(1, in.data(), cut), in.data() + cut,
+                                  in.size() - cut),
+                  zlib_adler);
+    }
+    EXPECT_EQ(detail::crc32(0, in.data(), 0), 0u);
+}
+
+// zlib_compress (the EXR's ZIP chunks): a whole zlib stream zlib reads back, at every level,
+// for empty, tiny, picture-like and random input; 0 when the stream does not fit.
+TEST(ZlibCompress, StreamsReadBackByZlibAtEveryLevel) {
+    Bytes picture;
+    std::uint32_t state = 9;
+    for (int row = 0; row < 200; ++row)
+        for (int x = 0; x < 1000; ++x)
+            picture.push_back(row / 40 % 2 == 0
+                                  ? static_cast<std::uint8_t>(128 + x / 100 % 3)
+                                  : static_cast<std::uint8_t>(next_random(state) >> 29));
+    Bytes noise(70000);
+    for (std::uint8_t& b : noise) b = static_cast<std::uint8_t>(next_random(state) >> 24);
+    const std::vector<std::pair<std::string, Bytes>> inputs = {
+        {"empty", {}}, {"one byte", {42}}, {"picture-like", picture}, {"noise", noise}};
+    for (int level = 0; level <= 3; ++level)
+        for (const auto& [what, in] : inputs) {
+            SCOPED_TRACE(what + " at level " + std::to_string(level));
+            Bytes out(in.size() + 1024);
+            const std::size_t size =
+                detail::zlib_compress(level, in.data(), in.size(), out.data(), out.size());
+            ASSERT_GT(size, 0u);
+            out.resize(size);
+            EXPECT_TRUE(inflate(out, in.size()) == in);
+            if (what == "picture-like") {
+                EXPECT_LT(size, in.size() / 4);
+            }
+        }
+    // Noise does not compress: in size - 1 bytes it does not fit, and the caller stores it.
+    Bytes out(noise.size() - 1);
+    EXPECT_EQ(detail::zlib_compress(1, noise.data(), noise.size(), out.data(), out.size()), 0u);
+    EXPECT_THROW(detail::zlib_compress(4, noise.data(), noise.size(), out.data(), out.size()),
+                 std::invalid_argument);
+    EXPECT_THROW(detail::zlib_compress(-1, noise.data(), noise.size(), out.data(), out.size()),
+                 std::invalid_argument);
 }
 
 }  // namespace
