@@ -158,8 +158,8 @@ nlohmann::json save_view(ViewSession& session, const SaveSettings& settings,
     result.rays = frame->rays;
     result.seconds = frame->render_seconds;
     const ExrAttributes attributes = batch::render_exr_attributes(
-        identity, posed, animation_frame, result, path_label(frame->path, frame->isa),
-        posed.image.spp, std::string());
+        identity, posed, posed.camera, animation_frame, result,
+        path_label(frame->path, frame->isa), posed.image.spp, std::string());
     write_exr((directory / name).string(), result.image, ExrWriteOptions{}, attributes);
 
     std::string command = "octray render " + shell_word(identity.spec) + " --width " +

@@ -87,6 +87,15 @@ void add_camera_attributes(ExrAttributes& attributes, const Scene& scene) {
         attributes.matrices.emplace_back("worldToNDC", *ndc);
 }
 
+void add_camera_attributes(ExrAttributes& attributes, const Scene& scene,
+                           const Camera& camera) {
+    // The matrices read the camera and the picture's size alone: a scene of those.
+    Scene view;
+    view.image = scene.image;
+    view.camera = camera;
+    add_camera_attributes(attributes, view);
+}
+
 Vec3 transform_point(const Matrix44& m, Vec3 p) {
     float out[4];
     for (int c = 0; c < 4; ++c)

@@ -27,8 +27,10 @@ Matrix44 world_to_camera(const Scene& scene);
 // projective matrix: nullopt.
 std::optional<Matrix44> world_to_ndc(const Scene& scene);
 
-// Adds worldToCamera and, where the camera has one, worldToNDC to `attributes`.
+// Adds worldToCamera and, where the camera has one, worldToNDC to `attributes`: of the
+// scene's camera, or of `camera` on the scene's picture.
 void add_camera_attributes(ExrAttributes& attributes, const Scene& scene);
+void add_camera_attributes(ExrAttributes& attributes, const Scene& scene, const Camera& camera);
 
 // p * M for a point (w = 1), divided by the resulting w: Imath's multVecMatrix.
 Vec3 transform_point(const Matrix44& m, Vec3 p);

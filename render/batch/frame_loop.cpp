@@ -157,11 +157,11 @@ class BatchRunner {
     void finish_pending();
 
   private:
-    ExrAttributes attributes(const BatchInput& scene, const Scene& posed, int frame,
-                             const RenderResult& result, int samples_so_far) const;
-    FrameFiles files(const BatchInput& scene, const BatchJob& job, const Scene& posed,
-                     const RenderResult& result, const std::shared_ptr<const Image>& aovs,
-                     int samples_so_far);
+    ExrAttributes attributes(const BatchInput& scene, const FrameRenderer::Pose& pose,
+                             int frame, const RenderResult& result, int samples_so_far) const;
+    FrameFiles files(const BatchInput& scene, const BatchJob& job,
+                     const FrameRenderer::Pose& pose, const RenderResult& result,
+                     const std::shared_ptr<const Image>& aovs, int samples_so_far);
     void finish(const FrameResult& out, std::uint64_t work);
     void write_behind(PendingWrite& p);
 
@@ -186,9 +186,10 @@ class BatchRunner {
 
 }  // namespace
 
-ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed, int frame,
-                                    const RenderResult& result, const std::string& path_label,
-                                    int samples_so_far, const std::string& owner) {
+ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed,
+                                    const Camera& camera, int frame, const RenderResult& result,
+                                    const std::string& path_label, int samples_so_far,
+                                    const std::string& owner) {
     const auto [date, utc_offset] = capture_date();
     ExrAttributes a;
     a.strings = {
@@ -220,7 +221,7 @@ ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed,
         {"octray.rays.refracted", static_cast<double>(result.rays.refracted)},
         {"octray.rays.total", static_cast<double>(result.rays.total())},
     };
-    add_camera_attributes(a, posed);
+    add_camera_attributes(a, posed, camera);
     const double fps = scene.scene.animation ? scene.scene.animation->fps : kStillFps;
     a.rationals = {{"framesPerSecond", exr_rational(fps)}};
     return a;
@@ -228,14 +229,15 @@ ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed,
 
 namespace {
 
-ExrAttributes BatchRunner::attributes(const BatchInput& scene, const Scene& posed, int frame,
-                                      const RenderResult& result, int samples_so_far) const {
-    return render_exr_attributes(scene, posed, frame, result, render_path_label(settings_),
-                                 samples_so_far, owner_);
+ExrAttributes BatchRunner::attributes(const BatchInput& scene, const FrameRenderer::Pose& pose,
+                                      int frame, const RenderResult& result,
+                                      int samples_so_far) const {
+    return render_exr_attributes(scene, pose.scene, pose.camera, frame, result,
+                                 render_path_label(settings_), samples_so_far, owner_);
 }
 
-FrameFiles BatchRunner::files(const BatchInput& scene, const BatchJob& job, const Scene& posed,
-                              const RenderResult& result,
+FrameFiles BatchRunner::files(const BatchInput& scene, const BatchJob& job,
+                              const FrameRenderer::Pose& pose, const RenderResult& result,
                               const std::shared_ptr<const Image>& aovs, int samples_so_far) {
     FrameFiles f;
     if (settings_.png_output) {
@@ -245,7 +247,7 @@ FrameFiles BatchRunner::files(const BatchInput& scene, const BatchJob& job, cons
     f.exr_path = job.output;
     f.png_path = job.png;
     f.exr_options = settings_.exr;
-    f.exr_attributes = attributes(scene, posed, job.frame, result, samples_so_far);
+    f.exr_attributes = attributes(scene, pose, job.frame, result, samples_so_far);
     if (!aovs->channels.empty()) f.aovs = aovs;
     return f;
 }
@@ -391,7 +393,8 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
             renderer_index_ = job.scene;
         }
         FrameRenderer::Timing prepared;
-        const Scene& posed = renderer_->prepare(job.frame, &prepared);
+        const FrameRenderer::Pose pose = renderer_->prepare(job.frame, &prepared);
+        const Scene& posed = pose.scene;
         out.report.compile_seconds = prepared.compile_seconds;
         out.report.bvh_seconds = prepared.bvh_seconds;  // or the spheres' update and refit
         out.report.prepare_seconds = prepared.seconds();
@@ -418,7 +421,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         double write_seconds = 0.0;
         const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
             const auto write_started = Clock::now();
-            FrameFiles f = files(scene, job, posed, r, aovs, samples_so_far);
+            FrameFiles f = files(scene, job, pose, r, aovs, samples_so_far);
             f.write(r.image);
             write_seconds +=
                 std::chrono::duration<double>(Clock::now() - write_started).count();
@@ -448,7 +451,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         if (settings_.write_behind && !settings_.progressive) {
             auto p = std::make_unique<PendingWrite>();
             const auto write_started = Clock::now();
-            p->files = files(scene, job, posed, result, aovs, posed.image.spp);
+            p->files = files(scene, job, pose, result, aovs, posed.image.spp);
             p->seconds = std::chrono::duration<double>(Clock::now() - write_started).count();
             p->pixels = std::move(result.image);
             out.report.write_seconds = write_seconds;

@@ -43,13 +43,14 @@ struct BatchSettings {
 std::string render_path_label(const BatchSettings& settings);
 
 // The header attributes `octray render` writes with frame `frame` of `scene` (posed as
-// `posed`: its camera, spp and depth): software, capture date, the scene's spec and
-// SHA-256, `path_label` (render_path_label), seed, spp, depth, frame and time, the ray
+// `posed`: its spp and depth; seen through `camera`): software, capture date, the scene's spec
+// and SHA-256, `path_label` (render_path_label), seed, spp, depth, frame and time, the ray
 // counts and render time of `result`, the camera matrices and the frame rate; and for an
 // unfinished progressive image (samples_so_far < the spp) the samples so far and `owner`.
-ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed, int frame,
-                                    const RenderResult& result, const std::string& path_label,
-                                    int samples_so_far, const std::string& owner);
+ExrAttributes render_exr_attributes(const BatchInput& scene, const Scene& posed,
+                                    const Camera& camera, int frame, const RenderResult& result,
+                                    const std::string& path_label, int samples_so_far,
+                                    const std::string& owner);
 
 // Renders every job in order on at most settings.render.threads threads (0: every core)
 // and returns the summary. Each frame is reported to the observer once, in job order; with

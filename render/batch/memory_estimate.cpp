@@ -74,8 +74,9 @@ constexpr std::uint64_t kBvhPageRounding = 8 * (std::uint64_t{2} << 20);
 // each), counted as one node per sphere.
 constexpr std::uint64_t kReferenceBvhBytesPerSphere = 40 + 4 + 32;
 
-// render/batch/frame_loop.cpp: each frame renders a posed copy of the scene (scene_at_frame)
-// while the batch keeps the loaded one.
+// render/frame_renderer.cpp: an animated scene's frames render a posed copy of the scene
+// while the batch keeps the loaded one (a still, and a camera-only animation on the simd
+// path without AOVs, make no copy: counted all the same).
 constexpr std::uint64_t kAuthoredCopies = 2;
 
 // render/packet_renderer.cpp TileScratch, in its layout (render/tile_layout.h). A tile

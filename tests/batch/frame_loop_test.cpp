@@ -27,6 +27,8 @@
 #include <vector>
 
 #include "kernels/dispatch.h"
+#include "render/aov.h"
+#include "render/batch/camera_matrices.h"
 #include "render/batch/claim_owner.h"
 #include "render/batch/observer.h"
 #include "render/batch/plan.h"
@@ -391,10 +393,13 @@ TEST_F(FrameLoopTest, AnAnimationOfMovingSpheresIsRefitAndEachFrameIsTheSameBits
 // Prepare once (frame_loop.cpp): a camera-only animation on the simd path compiles the
 // scene and builds its BVH for its first frame only, and every frame is, bit for bit, the
 // frame rendered on its own (the scene posed at that frame, compiled and built afresh).
+// The scene is not copied for such a pose (frame_renderer.cpp): each file's camera
+// matrices and AOVs are still the frame's own.
 TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBits) {
     load_grid_scene("orbit", R"({"frames": 3, "camera": [
         {"frame": 0, "eye": [0, 3, 12]}, {"frame": 2, "eye": [9, 5, 7], "fov": 40}]})",
                     "o");
+    settings_.render.aovs = AovSet{.depth = true, .normal = true};
 
     RecordingObserver observer;
     const BatchSummary summary = run(observer);
@@ -407,6 +412,25 @@ TEST_F(FrameLoopTest, ACameraOnlyAnimationIsPreparedOnceAndEachFrameIsTheSameBit
         EXPECT_EQ(observer.finished[f].bvh_seconds, 0.0) << "frame " << f;
     }
     expect_frames_as_rendered_alone("o", 3);
+    for (int f = 0; f < 3; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        const Scene posed = scene_at_frame(scenes_[0].scene, f);
+        const std::string file = (dir_ / ("o." + std::to_string(f) + ".exr")).string();
+        const ExrAttributes attributes = read_exr_attributes(file);
+        ASSERT_FALSE(attributes.matrices.empty());
+        EXPECT_EQ(attributes.matrices[0].first, "worldToCamera");
+        EXPECT_EQ(attributes.matrices[0].second, world_to_camera(posed));
+        RenderOptions options;
+        options.frame = static_cast<std::uint32_t>(f);
+        const Image alone = compute_aovs(posed, options, settings_.render.aovs);
+        const Image image = read_image(file);
+        for (const char* name : {"Z", "N.X", "N.Y", "N.Z"}) {
+            ASSERT_GE(image.channel_index(name), 0) << name;
+            const ImageChannel& got = image.channels[image.channel_index(name)];
+            const ImageChannel& want = alone.channels[alone.channel_index(name)];
+            EXPECT_TRUE(got.samples == want.samples) << name;
+        }
+    }
 }
 
 // The observer's events of `frames` frames: each started and finished once, every
