@@ -109,7 +109,6 @@ CompiledScene compile_scene(const Scene& scene) {
     CompiledScene out;
     out.background = scene.background;
     out.ambient = scene.ambient;
-    out.epsilon = self_intersection_epsilon(scene);
     out.max_depth = scene.render.max_depth;
     out.spp = scene.image.spp;
     out.seed = scene.render.seed;
@@ -160,8 +159,12 @@ CompiledScene compile_scene(const Scene& scene) {
         size_for(*v, o.count, o.padded_count, 0.0f);
 
     // Every entry below the counts, each array's own and (for an object) the other kind's
-    // zeros: a sphere has no normal or tangents, a plane no center.
+    // zeros: a sphere has no normal or tangents, a plane no center. The spheres' box (the
+    // self-intersection epsilon follows it) in the same pass: min and max give the same
+    // box in any order.
+    std::vector<SphereBox> block_boxes(blocks);
     tbb::parallel_for(std::uint32_t{0}, blocks, [&](std::uint32_t block) {
+        SphereBox box;
         std::uint32_t pi = planes_before[block];
         std::uint32_t si = block * kBlock - pi;
         const std::uint32_t end = std::min(objects, (block + 1) * kBlock);
@@ -190,13 +193,18 @@ CompiledScene compile_scene(const Scene& scene) {
                 s.material[si] = obj.material;
                 s.object[si] = k;
                 write_sphere(out, si, k, obj);
+                box.add(obj);
                 ++si;
                 record[kRecordNx] = record[kRecordNy] = record[kRecordNz] = 0.0f;
                 o.t1x[k] = o.t1y[k] = o.t1z[k] = 0.0f;
                 o.t2x[k] = o.t2y[k] = o.t2z[k] = 0.0f;
             }
         }
+        block_boxes[block] = box;
     });
+    SphereBox box;
+    for (const SphereBox& b : block_boxes) box = SphereBox::unite(box, b);
+    out.epsilon = self_intersection_epsilon(scene, box);
 
     // Materials.
     CompiledMaterials& m = out.materials;

@@ -77,6 +77,11 @@ void expect_every_entry(std::uint32_t count) {
     }
     ASSERT_EQ(s.count, si);
     ASSERT_EQ(p.count, pi);
+    // The epsilon, from the spheres' box the fill's blocks measured: the whole scene's.
+    EXPECT_EQ(c.epsilon, self_intersection_epsilon(scene));
+    Scene fixed = scene;
+    fixed.render.epsilon = 0.125f;
+    EXPECT_EQ(compile_scene(fixed).epsilon, 0.125f);
     // The padding: geometry that no ray hits, no object, no material, no checker.
     ASSERT_EQ(o.record.size(), std::size_t{o.padded_count} * kObjectRecordFloats);
     for (std::uint32_t k = count; k < o.padded_count; ++k) {
