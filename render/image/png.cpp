@@ -27,6 +27,7 @@
 #include "render/image/deflate.h"
 #include "render/image/image.h"
 #include "render/image/image_io.h"
+#include "render/image/srgb_table.h"
 
 namespace octray {
 namespace {
@@ -246,77 +247,68 @@ std::uint8_t srgb8_by_formula(float linear) {
     return static_cast<std::uint8_t>(std::lround(srgb_encode(clamped) * 255.0f));
 }
 
-namespace {
+namespace detail {
 
-// threshold[v] (v = 1 ... 255): the smallest float that srgb8_formula maps to v or more.
-// The formula never decreases as its argument grows, so the byte of x is the number of
-// thresholds at or below x. Each is found by bisection over the bit patterns of the
-// floats in [0, 1], which are ordered as their values. To find a byte without a search,
-// the floats of (0, 1) are cut into buckets by their top 16 bits (1/128 of a power of two
-// each): bucket_start holds the byte at each bucket's first float, and within a bucket the
-// byte steps up at most once (the OETF's slope times a bucket's width stays below one
-// step, which the constructor checks), which one comparison finds.
-struct SrgbTable {
-    static constexpr std::uint32_t kOneBits = 0x3F800000u;  // 1.0f
-    float threshold[257];                                   // [256]: +inf, a sentinel
-    std::uint8_t bucket_start[(kOneBits >> 16) + 1];
-    SrgbTable() {
-        threshold[0] = -std::numeric_limits<float>::infinity();
-        threshold[256] = std::numeric_limits<float>::infinity();
-        for (int v = 1; v < 256; ++v) {
-            std::uint32_t lo = 0, hi = kOneBits;  // formula(lo) < v <= formula(hi)
-            while (hi - lo > 1) {
-                const std::uint32_t mid = lo + (hi - lo) / 2;
-                (srgb8_by_formula(std::bit_cast<float>(mid)) >= v ? hi : lo) = mid;
-            }
-            threshold[v] = std::bit_cast<float>(hi);
+SrgbTable::SrgbTable() {
+    threshold[0] = -std::numeric_limits<float>::infinity();
+    threshold[256] = std::numeric_limits<float>::infinity();
+    for (int v = 1; v < 256; ++v) {
+        std::uint32_t lo = 0, hi = kOneBits;  // formula(lo) < v <= formula(hi)
+        while (hi - lo > 1) {
+            const std::uint32_t mid = lo + (hi - lo) / 2;
+            (srgb8_by_formula(std::bit_cast<float>(mid)) >= v ? hi : lo) = mid;
         }
-        // The byte of a bucket's first float is the number of thresholds at or below it.
-        int v = 0;
-        for (std::uint32_t b = 0; b <= (kOneBits >> 16); ++b) {
-            const float first = std::bit_cast<float>(b << 16);
-            while (v < 255 && threshold[v + 1] <= first) ++v;
-            bucket_start[b] = static_cast<std::uint8_t>(v);
-        }
-        // Within a bucket the byte steps up at most once (so srgb8_in compares once): the
-        // next bucket's first byte is at most one above this one's.
-        for (std::uint32_t b = 0; b < (kOneBits >> 16); ++b)
-            if (bucket_start[b + 1] > bucket_start[b] + 1)
-                throw std::logic_error("srgb8: a bucket of the sRGB table holds two steps");
+        threshold[v] = std::bit_cast<float>(hi);
     }
-};
+    // The byte of a bucket's first float is the number of thresholds at or below it.
+    int v = 0;
+    for (std::uint32_t b = 0; b <= (kOneBits >> 16); ++b) {
+        const float first = std::bit_cast<float>(b << 16);
+        while (v < 255 && threshold[v + 1] <= first) ++v;
+        bucket_start[b] = static_cast<std::uint8_t>(v);
+    }
+    // Within a bucket the byte steps up at most once (so srgb8_in compares once): the
+    // next bucket's first byte is at most one above this one's.
+    for (std::uint32_t b = 0; b < (kOneBits >> 16); ++b)
+        if (bucket_start[b + 1] > bucket_start[b] + 1)
+            throw std::logic_error("srgb8: a bucket of the sRGB table holds two steps");
+}
 
 const SrgbTable& srgb_table() {
     static const SrgbTable table;
     return table;
 }
 
-inline std::uint8_t srgb8_in(const SrgbTable& table, float linear) {
-    // Clamped to [0, 1] without branches (NaN fails the first comparison and becomes 0);
-    // 1.0's bucket starts at 255, whose next threshold is +inf.
-    float x = linear > 0.0f ? linear : 0.0f;
-    x = x < 1.0f ? x : 1.0f;
-    const int v = table.bucket_start[std::bit_cast<std::uint32_t>(x) >> 16];
-    return static_cast<std::uint8_t>(v + (x >= table.threshold[v + 1] ? 1 : 0));
+bool srgb8_use_avx2() {
+    static const bool use = __builtin_cpu_supports("avx2") != 0;  // and the OS's AVX state
+    return use;
 }
 
-}  // namespace
-
-std::uint8_t srgb8(float linear) { return srgb8_in(srgb_table(), linear); }
-
-void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint8_t* out) {
-    const SrgbTable& table = srgb_table();
-    for (std::size_t i = 0; i < count; ++i) out[i] = srgb8_in(table, linear[i] * scale);
-}
-
-void srgb8_interleaved(const float* r, const float* g, const float* b, std::size_t count,
-                       float scale, std::uint8_t* out) {
+void srgb8_interleaved_scalar(const float* r, const float* g, const float* b, std::size_t count,
+                              float scale, std::uint8_t* out) {
     const SrgbTable& table = srgb_table();
     for (std::size_t i = 0; i < count; ++i) {
         out[3 * i] = srgb8_in(table, r[i] * scale);
         out[3 * i + 1] = srgb8_in(table, g[i] * scale);
         out[3 * i + 2] = srgb8_in(table, b[i] * scale);
     }
+}
+
+}  // namespace detail
+
+std::uint8_t srgb8(float linear) { return detail::srgb8_in(detail::srgb_table(), linear); }
+
+void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint8_t* out) {
+    const detail::SrgbTable& table = detail::srgb_table();
+    for (std::size_t i = 0; i < count; ++i) out[i] = detail::srgb8_in(table, linear[i] * scale);
+}
+
+void srgb8_interleaved(const float* r, const float* g, const float* b, std::size_t count,
+                       float scale, std::uint8_t* out) {
+    if (detail::srgb8_use_avx2())
+        detail::srgb8_interleaved_avx2(r, g, b, count, scale, out);
+    else
+        detail::srgb8_interleaved_scalar(r, g, b, count, scale, out);
 }
 
 namespace {

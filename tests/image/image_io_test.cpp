@@ -25,12 +25,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "render/image/srgb_table.h"
 
 namespace octray {
 namespace {
@@ -730,7 +733,8 @@ TEST(Srgb8, TheTableGivesTheFormulasByteForEveryFloat) {
 // srgb8_interleaved (three planes into one row of bytes, as the preview and the viewer's
 // pictures make them) gives srgb8's byte of each sample times the scale: every 997th float's
 // bits (NaNs, infinities, negatives and denormals included) and every float within 4 ulps of a
-// step, in planes of several lengths.
+// step, in planes of several lengths (around the AVX2 build's blocks of 8 and its 10-pixel
+// tail), from both builds.
 TEST(Srgb8, InterleavedPlanesGiveSrgb8sBytes) {
     std::vector<float> values;
     for (std::uint64_t bits = 0; bits <= 0xFFFFFFFFu; bits += 997)
@@ -743,24 +747,37 @@ TEST(Srgb8, InterleavedPlanesGiveSrgb8sBytes) {
                 values.push_back(std::bit_cast<float>(s));
         last = v;
     }
-    for (const float scale : {1.0f, 0.5f, 4.0f}) {
-        for (std::size_t count : {values.size() / 3, std::size_t{7}, std::size_t{13}}) {
-            const float* r = values.data();
-            const float* g = values.data() + values.size() / 3;
-            const float* b = values.data() + 2 * (values.size() / 3);
-            std::vector<std::uint8_t> out(3 * count + 1, 77);
-            srgb8_interleaved(r, g, b, count, scale, out.data());
-            std::size_t mismatches = 0;
-            for (std::size_t i = 0; i < count; ++i)
-                for (const auto& [plane, k] :
-                     {std::pair{r, 0}, std::pair{g, 1}, std::pair{b, 2}})
-                    if (out[3 * i + k] != srgb8(plane[i] * scale) && ++mismatches <= 5)
-                        ADD_FAILURE() << "scale " << scale << ", sample " << i << " of plane "
-                                      << k << ": " << plane[i];
-            EXPECT_EQ(mismatches, 0u);
-            EXPECT_EQ(out[3 * count], 77) << "nothing written past the last pixel";
+    // The product's choice, and each build (the AVX2 one where the CPU has it).
+    using Build =
+        void (*)(const float*, const float*, const float*, std::size_t, float, std::uint8_t*);
+    std::vector<std::pair<std::string, Build>> builds = {
+        {"srgb8_interleaved", srgb8_interleaved}, {"scalar", detail::srgb8_interleaved_scalar}};
+    if (detail::srgb8_use_avx2())
+        builds.emplace_back("avx2", detail::srgb8_interleaved_avx2);
+    else
+        std::cout << "[  SKIPPED ] the AVX2 build: this CPU has no AVX2\n";
+    for (const auto& [name, build] : builds)
+        for (const float scale : {1.0f, 0.5f, 4.0f}) {
+            for (std::size_t count :
+                 {values.size() / 3, std::size_t{7}, std::size_t{8}, std::size_t{9},
+                  std::size_t{10}, std::size_t{13}, std::size_t{18}, std::size_t{19}}) {
+                SCOPED_TRACE(name + ", " + std::to_string(count) + " pixels");
+                const float* r = values.data() + 1;  // not 32-byte aligned
+                const float* g = values.data() + values.size() / 3;
+                const float* b = values.data() + 2 * (values.size() / 3);
+                std::vector<std::uint8_t> out(3 * count + 1, 77);
+                build(r, g, b, count, scale, out.data());
+                std::size_t mismatches = 0;
+                for (std::size_t i = 0; i < count; ++i)
+                    for (const auto& [plane, k] :
+                         {std::pair{r, 0}, std::pair{g, 1}, std::pair{b, 2}})
+                        if (out[3 * i + k] != srgb8(plane[i] * scale) && ++mismatches <= 5)
+                            ADD_FAILURE() << "scale " << scale << ", sample " << i
+                                          << " of plane " << k << ": " << plane[i];
+                EXPECT_EQ(mismatches, 0u);
+                EXPECT_EQ(out[3 * count], 77) << "nothing written past the last pixel";
+            }
         }
-    }
 }
 
 }  // namespace
