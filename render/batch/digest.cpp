@@ -1,32 +1,37 @@
 #include "render/batch/digest.h"
 
-#include <openssl/evp.h>
-
-#include <stdexcept>
+// libcrypto's own SHA-256 functions, not its EVP interface: OpenSSL 3 deprecates them, but
+// the first EVP digest of a process loads the providers and reads openssl.cnf, 0.8 ms of
+// every `octray render` (an empty program hashing "abc" through EVP took 2.2 ms, through
+// SHA256_Update 1.3 ms; both hash 120 MB in 60 ms with the SHA instructions). The
+// functions are what EVP calls for SHA-256 underneath.
+#define OPENSSL_SUPPRESS_DEPRECATED
+#include <openssl/sha.h>
 
 namespace octray::batch {
 
-Sha256::Sha256() : ctx_(EVP_MD_CTX_new(), &EVP_MD_CTX_free) {
-    if (!ctx_ || EVP_DigestInit_ex(ctx_.get(), EVP_sha256(), nullptr) != 1)
-        throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestInit_ex failed");
-}
+struct Sha256::State {
+    SHA256_CTX ctx;
+};
+
+Sha256::Sha256() : state_(std::make_unique<State>()) { SHA256_Init(&state_->ctx); }
+Sha256::~Sha256() = default;
+Sha256::Sha256(Sha256&&) noexcept = default;
+Sha256& Sha256::operator=(Sha256&&) noexcept = default;
 
 void Sha256::update(std::string_view bytes) {
-    if (EVP_DigestUpdate(ctx_.get(), bytes.data(), bytes.size()) != 1)
-        throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestUpdate failed");
+    SHA256_Update(&state_->ctx, bytes.data(), bytes.size());
 }
 
 std::string Sha256::hex_digest() {
-    unsigned char digest[EVP_MAX_MD_SIZE];
-    unsigned int size = 0;
-    if (EVP_DigestFinal_ex(ctx_.get(), digest, &size) != 1)
-        throw std::runtime_error("SHA-256: OpenSSL's EVP_DigestFinal_ex failed");
+    unsigned char digest[SHA256_DIGEST_LENGTH];
+    SHA256_Final(digest, &state_->ctx);
     static constexpr char kHex[] = "0123456789abcdef";
     std::string out;
-    out.reserve(2 * size);
-    for (unsigned int i = 0; i < size; ++i) {
-        out += kHex[digest[i] >> 4];
-        out += kHex[digest[i] & 15];
+    out.reserve(2 * SHA256_DIGEST_LENGTH);
+    for (const unsigned char byte : digest) {
+        out += kHex[byte >> 4];
+        out += kHex[byte & 15];
     }
     return out;
 }

@@ -9,22 +9,22 @@
 #include <string>
 #include <string_view>
 
-struct evp_md_ctx_st;
-
 namespace octray::batch {
 
 class Sha256 {
   public:
-    Sha256();  // throws std::runtime_error if libcrypto cannot start a digest
-    Sha256(Sha256&&) noexcept = default;
-    Sha256& operator=(Sha256&&) noexcept = default;
+    Sha256();
+    ~Sha256();
+    Sha256(Sha256&&) noexcept;
+    Sha256& operator=(Sha256&&) noexcept;
 
     void update(std::string_view bytes);
     // The digest as 64 lowercase hex digits. Call once.
     std::string hex_digest();
 
   private:
-    std::unique_ptr<evp_md_ctx_st, void (*)(evp_md_ctx_st*)> ctx_;
+    struct State;  // libcrypto's SHA256_CTX
+    std::unique_ptr<State> state_;
 };
 
 // The digest of `bytes` as 64 lowercase hex digits.
