@@ -99,6 +99,10 @@ struct BvhStacks {
     std::uint16_t packet_mask[kBvhStackSize];  // lanes, one bit each
     std::uint32_t ray_node[kBvhStackSize];
     std::uint32_t ray_node_b[kBvhStackSize];  // a second ray's (bvh_closest_rays)
+    // The sphere (BVH index) that last occluded a lane of a packet, or kBvhEmpty: the
+    // next packet of shadow rays tests it first (bvh_occluded_packet). Valid for the
+    // SceneView of the stacks' caller only.
+    std::uint32_t occluder = kBvhEmpty;
 };
 
 // The widening of every box for rays from `o` (the margin derived above).

@@ -269,9 +269,17 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
     using FN = xsimd::batch<float, Arch>;          // a node's children
     using F = xsimd::batch<float, RayArch<Arch>>;  // the packet's rays
     constexpr std::uint32_t K = kTraversalWidth / F::size;
-    const PacketFrustum<FN> fr = packet_frustum<FN, F>(p, live);
     std::uint32_t done = 0, sp = 0;
-    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint16_t>(live);
+    // The sphere that occluded the packet before first: neighbouring shadow rays are
+    // often blocked by the same sphere, and a lane it occludes needs no traversal. Any
+    // occluder answers a lane, so the answer is the same whichever is found.
+    if (st.occluder != kBvhEmpty) {
+        done = packet_occluding_sphere(s, st.occluder, PacketRays<F, K>(p)) & live;
+        if (done == live) return done;
+        if (done == 0) st.occluder = kBvhEmpty;
+    }
+    const PacketFrustum<FN> fr = packet_frustum<FN, F>(p, live & ~done);
+    st.packet_node[sp] = 0, st.packet_mask[sp++] = static_cast<std::uint16_t>(live & ~done);
     while (sp > 0 && done != live) {
         --sp;
         const std::uint32_t node = st.packet_node[sp], mask = st.packet_mask[sp] & ~done;
@@ -290,8 +298,11 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
         }
         const PacketRays<F, K> r(p);  // best_t: each lane's t_max
         const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
-        for (std::uint32_t i = first; i < end && (done & mask) != mask; ++i)
-            done |= packet_occluding_sphere(s, i, r) & mask;
+        for (std::uint32_t i = first; i < end && (done & mask) != mask; ++i) {
+            const std::uint32_t bits = packet_occluding_sphere(s, i, r) & mask;
+            done |= bits;
+            if (__builtin_popcount(bits) >= 4) st.occluder = i;
+        }
     }
     return done;
 }
