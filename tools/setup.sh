@@ -8,8 +8,8 @@
 # daemons itself, from a temporary folder; installing them starts nothing here).
 # python3-matplotlib draws bench/plot.py's charts; groff-base checks the man pages.
 # libisal-dev (ISA-L's igzip) compresses the ZIP chunks of the EXRs octray writes.
-# libcpp-httplib-dev is the HTTP server of `octray view` (libjpeg62-turbo-dev its picture
-# stream's JPEG); chromium, chromium-driver and python3-selenium drive its page headless
+# libcpp-httplib-dev is the HTTP server of `octray view` (it brings libssl-dev, whose
+# headers its own include; libjpeg62-turbo-dev is its picture stream's JPEG); chromium, chromium-driver and python3-selenium drive its page headless
 # in tests/view/browser_test.py.
 set -euo pipefail
 
@@ -19,7 +19,7 @@ packages=(
     dpkg-dev xz-utils
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libsimdjson-dev
-    libpng-dev libisal-dev libembree-dev libssl-dev
+    libpng-dev libisal-dev libembree-dev
     slurmctld slurmd slurm-client munge
     python3-matplotlib groff-base
     libcpp-httplib-dev libjpeg62-turbo-dev chromium chromium-driver python3-selenium
