@@ -1,5 +1,4 @@
-// zlib streams by ISA-L's igzip, and the checksums of zlib streams and PNG chunks
-// (deflate.h).
+// DEFLATE by ISA-L's igzip, and the checksums of zlib streams and PNG chunks (deflate.h).
 
 #include "render/image/deflate.h"
 
@@ -46,11 +45,23 @@ std::size_t level_buffer_size(int level) {
 
 }  // namespace
 
-std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out,
-                          std::size_t capacity) {
+namespace {
+
+// One call of isal_deflate_stateless at `level` on this thread's state: in[0, size) into
+// out[0, capacity) as a zlib stream (IGZIP_ZLIB) or raw DEFLATE blocks (IGZIP_DEFLATE),
+// ended (end_of_stream) or byte-aligned and independent of what follows (FULL_FLUSH).
+// Returns the length written, or 0 when it does not fit in `capacity`.
+std::size_t igzip_stateless(int level, std::uint16_t format, bool end_of_stream, const void* in,
+                            std::size_t size, void* out, std::size_t capacity,
+                            const char* caller) {
     if (level < 0 || level > 3)
-        throw std::invalid_argument("deflate level " + std::to_string(level) +
-                                    " is outside 0 ... 3");
+        throw std::invalid_argument(std::string(caller) + ": deflate level " +
+                                    std::to_string(level) + " is outside 0 ... 3");
+    // One call takes at most 4 GiB in and out (the fields are 32 bits); a chunk or band
+    // octray compresses is far smaller.
+    if (size > UINT32_MAX)
+        throw std::length_error(std::string(caller) + ": " + std::to_string(size) +
+                                " bytes exceed one call's 4 GiB");
     Igzip& state = igzip();
     isal_zstream& s = state.stream;
     isal_deflate_stateless_init(&s);
@@ -62,14 +73,9 @@ std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out
         s.level_buf = buffer.data();
         s.level_buf_size = static_cast<std::uint32_t>(buffer.size());
     }
-    s.gzip_flag = IGZIP_ZLIB;
-    s.end_of_stream = 1;
-    s.flush = NO_FLUSH;
-    // One call takes at most 4 GiB in and out (the fields are 32 bits); a chunk or band
-    // octray compresses is far smaller.
-    if (size > UINT32_MAX)
-        throw std::length_error("zlib_compress: " + std::to_string(size) +
-                                " bytes exceed one call's 4 GiB");
+    s.gzip_flag = format;
+    s.end_of_stream = end_of_stream ? 1 : 0;
+    s.flush = end_of_stream ? NO_FLUSH : FULL_FLUSH;
     s.next_in = static_cast<std::uint8_t*>(const_cast<void*>(in));
     s.avail_in = static_cast<std::uint32_t>(size);
     s.next_out = static_cast<std::uint8_t*>(out);
@@ -77,9 +83,32 @@ std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out
     const int status = isal_deflate_stateless(&s);
     if (status == STATELESS_OVERFLOW) return 0;  // it does not fit in `capacity`
     if (status != COMP_OK)
-        throw std::runtime_error("zlib_compress: igzip failed with status " +
+        throw std::runtime_error(std::string(caller) + ": igzip failed with status " +
                                  std::to_string(status));
     return s.total_out;
+}
+
+}  // namespace
+
+std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out,
+                          std::size_t capacity) {
+    return igzip_stateless(level, IGZIP_ZLIB, true, in, size, out, capacity, "zlib_compress");
+}
+
+std::size_t deflate_band_bound(std::size_t size) {
+    // Stored: 5 bytes a block of at most 65535, the empty stored block of a flush, and
+    // room for igzip's own header and the bits before a flush.
+    return size + 5 * (size / 65535 + 2) + 64;
+}
+
+std::size_t deflate_band(int level, const std::uint8_t* in, std::size_t size, bool last,
+                         std::uint8_t* out) {
+    const std::size_t written = igzip_stateless(level, IGZIP_DEFLATE, last, in, size, out,
+                                                deflate_band_bound(size), "deflate_band");
+    if (written == 0)
+        throw std::logic_error("deflate_band: " + std::to_string(size) +
+                               " bytes did not fit in deflate_band_bound's room");
+    return written;
 }
 
 std::uint32_t adler32(std::uint32_t adler, const void* data, std::size_t size) {

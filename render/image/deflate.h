@@ -1,9 +1,9 @@
 #pragma once
-// zlib streams (RFC 1950) made by ISA-L's igzip, for the ZIP and ZIPS chunks of the EXRs
-// octray writes (exr_write.cpp), and octray's own DEFLATE bands for the pixel data of its
-// PNGs (png.cpp). igzip compresses a whole buffer at once, three to four times as fast as
-// libdeflate's fastest levels, files about a tenth larger (the level each writer uses, and
-// why: render/image/README.md, "Compression").
+// DEFLATE by ISA-L's igzip: zlib streams (RFC 1950) for the ZIP and ZIPS chunks of the EXRs
+// octray writes (exr_write.cpp), and bands of one stream for the pixel data of its PNGs
+// (png.cpp). igzip compresses three to four times as fast as libdeflate's fastest levels,
+// files about a tenth larger (the level each writer uses, and why: render/image/README.md,
+// "Compression").
 
 #include <cstddef>
 #include <cstdint>
@@ -18,24 +18,20 @@ namespace octray::detail {
 std::size_t zlib_compress(int level, const void* in, std::size_t size, void* out,
                           std::size_t capacity);
 
-// ---- Bands of one DEFLATE stream, compressed in parallel (deflate_runs.cpp) --------------
+// ---- Bands of one DEFLATE stream, compressed in parallel ---------------------------------
 // zlib_compress makes one whole stream of a buffer, so one PNG's pixels would be
-// compressed on one thread. deflate_band compresses a band of them into raw DEFLATE blocks
-// (RFC 1951) that end on a byte boundary, so that bands compressed on their own, in order,
-// make one stream: literals, runs of a repeated byte (matches at distance 1, as zlib's
-// Z_RLE) and repeats of a pixel's bytes (matches at a pixel's size), one Huffman block per
-// band, or the band stored when that is smaller.
+// compressed on one thread. deflate_band compresses a band of them at igzip's `level` into
+// raw DEFLATE blocks (RFC 1951) that refer to nothing before the band and end on a byte
+// boundary (igzip's full flush: an empty stored block), so that bands compressed on their
+// own, in order, make one stream; `last` marks the band that ends it.
 
-// The room deflate_band needs for `size` bytes (its output is shorter: the writer stores
-// 8 bytes at a time).
+// The room deflate_band needs for `size` bytes: data that does not compress is stored.
 std::size_t deflate_band_bound(std::size_t size);
 
 // Compresses in[0, size) into out (deflate_band_bound(size) bytes) and returns the length
-// written. Matches are at distance 1 and at `repeat` (1 ... 4: a pixel's bytes; 1 for runs
-// alone). `last` marks the stream's final band (it ends the stream; the others end with
-// an empty stored block, as zlib's Z_SYNC_FLUSH). References stay inside the band.
-std::size_t deflate_band(const std::uint8_t* in, std::size_t size, std::size_t repeat,
-                         bool last, std::uint8_t* out);
+// written.
+std::size_t deflate_band(int level, const std::uint8_t* in, std::size_t size, bool last,
+                         std::uint8_t* out);
 
 // ---- Checksums (deflate.cpp) --------------------------------------------------------------
 // Adler-32 (a zlib stream's checksum) of data[0, size), continuing from `adler` (1 to

@@ -62,16 +62,17 @@ void on_png_warning(png_structp, png_const_charp) {}
 // octray encodes the PNGs it writes itself: a PNG octray writes is wanted soon rather than
 // small. Every row but the first is filtered with one filter (each byte minus the byte
 // above it, Up), and the rows are cut into bands of about kBandBytes that are made,
-// filtered and compressed on all threads at once (deflate_band: literals, runs and pixel
-// repeats, each band ending on a byte boundary), then joined into the one zlib stream a
-// PNG holds. Against the one libdeflate stream (level 2, SUB) it replaced: a third to a
-// half of the time on one thread, and all threads; files 1-44 % larger (render/image/
-// README.md, "Compression"). libpng reads them back in the tests.
+// filtered and compressed on all threads at once (deflate_band: igzip, each band ending
+// on a byte boundary), then joined into the one zlib stream a PNG holds. The choices and
+// their measurements: render/image/README.md, "Compression". libpng reads them back in
+// the tests.
 
-// Filtered bytes per band: enough to keep the Huffman header's cost (~100 bytes) small and
-// every thread busy, few enough that the code follows what the image does (bands of 64 KB
-// made a smaller whitted preview than bands of 256 KB or one band).
-constexpr std::size_t kBandBytes = std::size_t{64} << 10;
+// Filtered bytes per band: enough that igzip's work per call (its hash table, a Huffman
+// header) stays small, few enough to keep every thread busy (a 1280x720 preview makes 22
+// bands; bands of 64 KB took 20-30 % longer, of 256 KB 5-10 % less, files within 1 %).
+constexpr std::size_t kBandBytes = std::size_t{128} << 10;
+// igzip's level for the bands: 1 (0 made files 20-40 % larger).
+constexpr int kPngLevel = 1;
 
 // How the file says its pixels are sRGB: the sRGB chunk alone (the heatmap), or with the
 // gAMA and cHRM chunks that stand in for it in older viewers (the render preview).
@@ -156,8 +157,7 @@ std::string encode_png(int width, int height, const Row& row, SrgbChunks chunks)
                 PngBand& band = bands[b];
                 band.filtered = filtered.size();
                 band.stream.resize(detail::deflate_band_bound(filtered.size()));
-                // Matches at distance 3 as well as 1: a pixel's 3 bytes repeated.
-                band.size = detail::deflate_band(filtered.data(), filtered.size(), 3,
+                band.size = detail::deflate_band(kPngLevel, filtered.data(), filtered.size(),
                                                  b + 1 == band_count, band.stream.data());
                 band.adler = detail::adler32(1, filtered.data(), filtered.size());
             }
