@@ -44,7 +44,7 @@ FrameRenderer::Pose FrameRenderer::prepare(int frame, Timing* timing) {
             if (camera_only_) prepared_->set_camera(camera_);
             t.compile_seconds = prepared_->compile_seconds();
             t.bvh_seconds = prepared_->bvh_seconds();
-        } else if (!source_.animation || source_.animation->objects.empty()) {
+        } else if (!source_.animation || camera_only_) {
             prepared_->set_camera(camera_);
         } else {
             t.bvh_seconds = prepared_->update(*pose).seconds;

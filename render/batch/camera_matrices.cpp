@@ -41,16 +41,7 @@ Matrix44 world_to_camera(const CameraFrame& f) {
     return m;
 }
 
-}  // namespace
-
-Matrix44 world_to_camera(const Scene& scene) {
-    return world_to_camera(
-        make_camera_frame(scene.camera, scene.image.width, scene.image.height));
-}
-
-std::optional<Matrix44> world_to_ndc(const Scene& scene) {
-    const CameraFrame f =
-        make_camera_frame(scene.camera, scene.image.width, scene.image.height);
+std::optional<Matrix44> world_to_ndc(const CameraFrame& f) {
     Matrix44 p{};  // camera space -> NDC
     switch (f.type) {
         case CameraType::pinhole:
@@ -81,19 +72,32 @@ std::optional<Matrix44> world_to_ndc(const Scene& scene) {
     return multiply(world_to_camera(f), p);
 }
 
-void add_camera_attributes(ExrAttributes& attributes, const Scene& scene) {
-    attributes.matrices.emplace_back("worldToCamera", world_to_camera(scene));
-    if (const std::optional<Matrix44> ndc = world_to_ndc(scene))
+void add_camera_attributes(ExrAttributes& attributes, const CameraFrame& f) {
+    attributes.matrices.emplace_back("worldToCamera", world_to_camera(f));
+    if (const std::optional<Matrix44> ndc = world_to_ndc(f))
         attributes.matrices.emplace_back("worldToNDC", *ndc);
+}
+
+CameraFrame camera_frame_of(const Scene& scene) {
+    return make_camera_frame(scene.camera, scene.image.width, scene.image.height);
+}
+
+}  // namespace
+
+Matrix44 world_to_camera(const Scene& scene) { return world_to_camera(camera_frame_of(scene)); }
+
+std::optional<Matrix44> world_to_ndc(const Scene& scene) {
+    return world_to_ndc(camera_frame_of(scene));
+}
+
+void add_camera_attributes(ExrAttributes& attributes, const Scene& scene) {
+    add_camera_attributes(attributes, camera_frame_of(scene));
 }
 
 void add_camera_attributes(ExrAttributes& attributes, const Scene& scene,
                            const Camera& camera) {
-    // The matrices read the camera and the picture's size alone: a scene of those.
-    Scene view;
-    view.image = scene.image;
-    view.camera = camera;
-    add_camera_attributes(attributes, view);
+    add_camera_attributes(attributes,
+                          make_camera_frame(camera, scene.image.width, scene.image.height));
 }
 
 Vec3 transform_point(const Matrix44& m, Vec3 p) {

@@ -120,11 +120,9 @@ void write_png_preview(const std::string& path, const Image& render);
 // OETF's power (the tests hold the two equal).
 std::uint8_t srgb8(float linear);
 std::uint8_t srgb8_by_formula(float linear);
-// srgb8(linear[i] * scale) for i < count, into out[i]: the same bytes, the table looked up
-// once for the whole run (`octray view` tone-maps a 1280x720 picture per camera move).
-void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint8_t* out);
-// The same bytes of three planes, interleaved: out[3 i + c] = srgb8(plane c's [i] * scale)
-// for r, g, b: a render's rows (planar float32) as a PNG or JPEG row.
+// srgb8's bytes of three planes, interleaved: out[3 i + c] = srgb8(plane c's [i] * scale)
+// for r, g, b: a render's rows (planar float32) as a PNG or JPEG row (`octray view`
+// tone-maps a 1280x720 picture per camera move this way).
 void srgb8_interleaved(const float* r, const float* g, const float* b, std::size_t count,
                        float scale, std::uint8_t* out);
 

@@ -298,11 +298,6 @@ void srgb8_interleaved_scalar(const float* r, const float* g, const float* b, st
 
 std::uint8_t srgb8(float linear) { return detail::srgb8_in(detail::srgb_table(), linear); }
 
-void srgb8_scaled(const float* linear, std::size_t count, float scale, std::uint8_t* out) {
-    const detail::SrgbTable& table = detail::srgb_table();
-    for (std::size_t i = 0; i < count; ++i) out[i] = detail::srgb8_in(table, linear[i] * scale);
-}
-
 void srgb8_interleaved(const float* r, const float* g, const float* b, std::size_t count,
                        float scale, std::uint8_t* out) {
     if (detail::srgb8_use_avx2())
