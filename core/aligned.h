@@ -57,6 +57,24 @@ inline void offer_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::siz
 #endif
 }
 
+// Maps the whole 4 KiB pages inside [p, p + bytes) writable without writing them
+// (MADV_POPULATE_WRITE): their contents stay as they are, and a page already mapped is
+// passed over. The kernel still zeroes each fresh page, but on the calling thread, which
+// takes that work off a thread about to fill the storage: the frame's pages are mapped on
+// the render's threads (render/packet_renderer.cpp), a large scene's objects on the
+// thread the file's hash leaves idle while the parse fills them (scene/load_fast.cpp).
+// Advice only: a kernel before Linux 5.14 refuses it, and the first write maps each page
+// as before.
+inline void populate_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+    constexpr std::size_t kPage = 4096;
+    const std::size_t begin = (reinterpret_cast<std::size_t>(p) + kPage - 1) & ~(kPage - 1);
+    const std::size_t end = (reinterpret_cast<std::size_t>(p) + bytes) & ~(kPage - 1);
+    if (end > begin)
+        (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+#endif
+}
+
 // The unsized form: clang declares sized deallocation only with -fsized-deallocation.
 inline void free_aligned(void* p, std::size_t bytes, Pages pages = Pages::normal) noexcept {
     ::operator delete(p, storage_alignment(bytes, pages));

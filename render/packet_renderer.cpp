@@ -4,10 +4,6 @@
 
 #include "render/packet_renderer.h"
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 #include <emmintrin.h>
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/enumerable_thread_specific.h>
@@ -196,14 +192,12 @@ TileScratch& scratch_for_thread() {
 }
 
 // Maps the fresh pages of a render's frame before its tiles write them, 2 MiB per task on
-// the render's threads: one madvise(MADV_POPULATE_WRITE) per 2 MiB instead of a page
-// fault per 4 KiB page. The kernel still zeroes every page; a 1920x1080 frame (25 MB)
-// took 7-10 ms this way against 10-14 ms of faults (docs/performance-log.md, "Division-free
-// rejection in the BVH leaves, render_tile's loops, the first frame"). Advice only: a kernel
-// before Linux 5.14 refuses it, and the tiles' first touch maps the pages as before.
+// the render's threads: one madvise(MADV_POPULATE_WRITE) per 2 MiB (populate_pages)
+// instead of a page fault per 4 KiB page. The kernel still zeroes every page; a 1920x1080
+// frame (25 MB) took 7-10 ms this way against 10-14 ms of faults (docs/performance-log.md,
+// "Division-free rejection in the BVH leaves, render_tile's loops, the first frame").
 void populate_frame(Image& image) {
-#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
-    constexpr std::size_t kPage = 4096, kChunk = std::size_t{2} << 20;
+    constexpr std::uintptr_t kPage = 4096, kChunk = kHugePageBytes;
     struct Range {
         std::uintptr_t begin, end;
     };
@@ -216,12 +210,9 @@ void populate_frame(Image& image) {
             chunks.push_back({b, std::min(end, b + kChunk)});
     }
     tbb::parallel_for(std::size_t{0}, chunks.size(), [&](std::size_t c) {
-        (void)madvise(reinterpret_cast<void*>(chunks[c].begin), chunks[c].end - chunks[c].begin,
-                      MADV_POPULATE_WRITE);
+        populate_pages(reinterpret_cast<void*>(chunks[c].begin),
+                       chunks[c].end - chunks[c].begin);
     });
-#else
-    (void)image;
-#endif
 }
 
 // The rays of `rays` from `first` on: a chunk of a stream (first: a whole packet).

@@ -16,6 +16,7 @@
 // and build the same scene.
 
 #include <simdjson.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
@@ -280,6 +281,15 @@ void read_objects(od::value& v, Scene& scene, Materials& materials,
     uses.reserve(count);
     // 90 MB for a million spheres: 45 page faults instead of 22,000 (core/aligned.h).
     offer_huge_pages(scene.objects.data(), count * sizeof(Object));
+    // Their pages mapped by another thread while this one parses: the file's hash, on the
+    // other thread of the load (render/batch/plan.cpp), ends long before the parse, and
+    // the kernel zeroing the objects' pages was about half of the parse's time on
+    // random:1048576 (docs/performance-log.md, "The objects' pages mapped beside the
+    // parse"). With one thread the task runs at the wait, over pages already mapped.
+    tbb::task_group populate;
+    populate.run([objects = scene.objects.data(), bytes = count * sizeof(Object)] {
+        populate_pages(objects, bytes);
+    });
     for (auto element : take(v.get_array())) {
         od::value o = take(std::move(element));
         KeySet seen(keys);
@@ -334,6 +344,7 @@ void read_objects(od::value& v, Scene& scene, Materials& materials,
         scene.objects.push_back(std::move(obj));
         uses.push_back(use);
     }
+    populate.wait();  // (a Decline thrown above waits in task_group's destructor)
 }
 
 void resolve_materials(Scene& scene, const Materials& materials,
