@@ -266,13 +266,9 @@ void run_render(const RenderArguments& args) {
             memory.scene_file_bytes = size != file_sizes.end() ? size->second : 0;
             // Writing a frame while the next renders holds a second frame: within the
             // limit, or the frames are written one after another instead.
-            if (memory.write_behind) {
-                memory.write_behind =
-                    batch::estimate_render_memory(scene.scene, memory).total <= memory_limit;
-                write_behind = memory.write_behind;
-            }
             try {
-                batch::check_memory_limit(scene.scene, memory_limit, memory);
+                batch::fit_memory_limit(scene.scene, memory_limit, memory);
+                write_behind = write_behind && memory.write_behind;
             } catch (const SceneError& e) {
                 throw UsageError(e.what() + limit_note());
             }

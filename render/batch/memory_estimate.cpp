@@ -265,9 +265,10 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
     return e;
 }
 
-void check_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
-                        const RenderMemoryParams& params) {
-    const RenderMemoryEstimate e = estimate_render_memory(scene, params);
+namespace {
+
+void check_estimate(const Scene& scene, std::uint64_t limit_bytes,
+                    const RenderMemoryEstimate& e) {
     if (e.total <= limit_bytes) return;
     throw SceneError(scene.source, "image",
                      "a " + std::to_string(scene.image.width) + " x " +
@@ -275,6 +276,24 @@ void check_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
                          std::to_string(scene.image.spp) + " spp needs " + e.describe() +
                          "; expected at most the memory limit of " + gib(limit_bytes) + " (" +
                          std::to_string(limit_bytes) + " bytes)");
+}
+
+}  // namespace
+
+void check_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
+                        const RenderMemoryParams& params) {
+    check_estimate(scene, limit_bytes, estimate_render_memory(scene, params));
+}
+
+RenderMemoryEstimate fit_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
+                                      RenderMemoryParams& params) {
+    RenderMemoryEstimate e = estimate_render_memory(scene, params);
+    if (params.write_behind && e.total > limit_bytes) {
+        params.write_behind = false;
+        e = estimate_render_memory(scene, params);
+    }
+    check_estimate(scene, limit_bytes, e);
+    return e;
 }
 
 RenderMemoryEstimate estimate_load_memory(std::uint64_t file_bytes) {

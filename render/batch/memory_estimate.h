@@ -78,6 +78,14 @@ RenderMemoryEstimate estimate_render_memory(const Scene& scene,
 void check_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
                         const RenderMemoryParams& params = {});
 
+// `octray render`'s check: the estimate of `scene` under `params`, where a frame written
+// behind the next (params.write_behind) is kept only if both frames fit `limit_bytes`
+// (else params.write_behind comes back false: the frames are written one after another),
+// and check_memory_limit's error when even one frame does not fit. The scene's objects
+// are counted once where the first estimate fits (2 ms for a million).
+RenderMemoryEstimate fit_memory_limit(const Scene& scene, std::uint64_t limit_bytes,
+                                      RenderMemoryParams& params);
+
 // What loading a scene file of `file_bytes` bytes takes (its text, its JSON tree, the
 // scene built from it and the process), known from the file's size before a byte of it is
 // parsed.

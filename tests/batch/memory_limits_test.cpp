@@ -171,6 +171,46 @@ TEST(MemoryLimit, RefusesUpFrontWithTheEstimateInTheMessage) {
     EXPECT_THROW(check_memory_limit(s, e.total - 1, p), SceneError);
 }
 
+// `octray render`'s check: a limit that holds two frames keeps the frame written behind
+// the next; one that holds a single frame writes them one after another; one below that
+// refuses the render with check_memory_limit's message. Every bound is inclusive.
+TEST(MemoryLimit, WriteBehindIsKeptOnlyWhereBothFramesFit) {
+    Scene s = image_scene(1920, 1080);
+    s.source = "anim.json";
+    RenderMemoryParams p;
+    p.threads = 2;
+    p.png_preview = true;
+    const RenderMemoryEstimate one = estimate_render_memory(s, p);
+    p.write_behind = true;
+    const RenderMemoryEstimate two = estimate_render_memory(s, p);
+    ASSERT_GT(two.total, one.total);
+
+    for (const std::uint64_t limit : {two.total, two.total + kGiB}) {
+        RenderMemoryParams fit = p;
+        EXPECT_EQ(fit_memory_limit(s, limit, fit).total, two.total) << limit;
+        EXPECT_TRUE(fit.write_behind) << limit;
+    }
+    for (const std::uint64_t limit : {two.total - 1, one.total}) {
+        RenderMemoryParams fit = p;
+        EXPECT_EQ(fit_memory_limit(s, limit, fit).total, one.total) << limit;
+        EXPECT_FALSE(fit.write_behind) << limit;
+    }
+    RenderMemoryParams fit = p;
+    try {
+        fit_memory_limit(s, one.total - 1, fit);
+        FAIL() << "one frame fits in less than its estimate?";
+    } catch (const SceneError& err) {
+        EXPECT_EQ(err.file(), "anim.json");
+        EXPECT_NE(std::string(err.what()).find(one.describe()), std::string::npos)
+            << err.what();
+    }
+    // Without write behind asked for, the limit only decides whether the render fits.
+    RenderMemoryParams alone = p;
+    alone.write_behind = false;
+    EXPECT_EQ(fit_memory_limit(s, one.total, alone).total, one.total);
+    EXPECT_FALSE(alone.write_behind);
+}
+
 TEST(MemoryLimit, HugeSppIsBoundedByTheTileChunks) {
     // A small image with (default, 32 x 32) tiles of 10^6 samples each: the packet path
     // traces them a chunk at a time (render/README.md, "Bounded memory"), so its scratch is
