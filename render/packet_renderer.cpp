@@ -745,7 +745,7 @@ PreparedScene::PreparedScene(const Scene& scene, Accel accel, int threads)
 
 void PreparedScene::build() {
     run_with_threads(threads_, [&] { bvh_ = build_sphere_bvh(compiled_.spheres); });
-    built_cost_ = sphere_bvh_cost(bvh_);
+    built_cost_ = -1.0;    // measured by the first update of this tree, before its refit
     leaf_sphere_.clear();  // found by the first refit of this tree
 }
 
@@ -753,6 +753,7 @@ PreparedScene::Update PreparedScene::update(const Scene& posed) {
     const auto start = std::chrono::steady_clock::now();
     Update u;
     set_camera(posed.camera);
+    if (use_bvh_ && built_cost_ < 0.0) built_cost_ = sphere_bvh_cost(bvh_);
     if (use_bvh_ && leaf_sphere_.empty()) {
         // Leaf slot i holds the sphere of file index bvh_.object[i]: its compiled index.
         std::vector<std::uint32_t> compiled_index(compiled_.objects.count, 0);

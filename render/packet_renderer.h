@@ -85,13 +85,16 @@ class PreparedScene {
     double bvh_seconds() const { return use_bvh_ ? bvh_.build_seconds : 0.0; }
 
   private:
-    void build();  // bvh_ from compiled_, its cost and leaf_sphere_
+    void build();  // bvh_ from compiled_ (its cost and leaf_sphere_ left to update())
 
     CompiledScene compiled_;
     bool use_bvh_ = false;
     int threads_ = 0;
     SphereBvh bvh_;
-    double built_cost_ = 0.0;                 // sphere_bvh_cost when last built
+    // sphere_bvh_cost when last built, measured by the first update() of the tree (a
+    // serial pass over every node, which a still or a camera-only animation never needs);
+    // negative until then.
+    double built_cost_ = -1.0;
     std::vector<std::uint32_t> leaf_sphere_;  // leaf slot -> compiled sphere (the first
                                               // refit of a tree finds it)
 };
