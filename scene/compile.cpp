@@ -128,15 +128,27 @@ CompiledScene compile_scene(const Scene& scene) {
     constexpr std::uint32_t kBlock = 1u << 14;
     const std::uint32_t blocks = (objects + kBlock - 1) / kBlock;
     std::vector<std::uint32_t> planes_before(blocks + 1, 0);
+    std::vector<std::uint8_t> block_checkers(blocks,
+                                             0);  // not vector<bool>: written in parallel
     tbb::parallel_for(std::uint32_t{0}, blocks, [&](std::uint32_t block) {
         std::uint32_t planes = 0;
+        bool checkers = false;
         const std::uint32_t end = std::min(objects, (block + 1) * kBlock);
-        for (std::uint32_t k = block * kBlock; k < end; ++k)
-            planes += scene.objects[k].type == ObjectType::plane;
+        for (std::uint32_t k = block * kBlock; k < end; ++k) {
+            const Object& obj = scene.objects[k];
+            const bool plane = obj.type == ObjectType::plane;
+            planes += plane;
+            checkers = checkers || (plane && scene.materials[obj.material].material.checker);
+        }
         planes_before[block + 1] = planes;
+        block_checkers[block] = checkers;
     });
     for (std::uint32_t block = 0; block < blocks; ++block)
         planes_before[block + 1] += planes_before[block];
+    // Shading reads the tangent columns only where a lane hit a checkered plane: without
+    // one they stay empty (random:1048576: 24 MB of zeros, written and faulted in, gone).
+    const bool checker_planes =
+        std::find(block_checkers.begin(), block_checkers.end(), 1) != block_checkers.end();
 
     s.count = objects - planes_before[blocks];
     s.padded_count = padded(s.count);
@@ -155,8 +167,9 @@ CompiledScene compile_scene(const Scene& scene) {
     o.padded_count = padded(o.count);
     size_for(o.record, o.count * kObjectRecordFloats, o.padded_count * kObjectRecordFloats,
              0.0f);  // padding: a sphere at the origin of material 0 (no hit carries its id)
-    for (auto* v : {&o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
-        size_for(*v, o.count, o.padded_count, 0.0f);
+    if (checker_planes)
+        for (auto* v : {&o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
+            size_for(*v, o.count, o.padded_count, 0.0f);
 
     // Every entry below the counts, each array's own and (for an object) the other kind's
     // zeros: a sphere has no normal or tangents, a plane no center. The spheres' box (the
@@ -183,12 +196,14 @@ CompiledScene compile_scene(const Scene& scene) {
                 p.material[pi] = obj.material;
                 p.object[pi] = k;
                 ++pi;
-                const TangentBasis tb = checker_basis(obj.normal);
                 record[kRecordCx] = record[kRecordCy] = record[kRecordCz] = 0.0f;
                 record[kRecordNx] = obj.normal.x, record[kRecordNy] = obj.normal.y;
                 record[kRecordNz] = obj.normal.z;
-                o.t1x[k] = tb.t1.x, o.t1y[k] = tb.t1.y, o.t1z[k] = tb.t1.z;
-                o.t2x[k] = tb.t2.x, o.t2y[k] = tb.t2.y, o.t2z[k] = tb.t2.z;
+                if (checker_planes) {
+                    const TangentBasis tb = checker_basis(obj.normal);
+                    o.t1x[k] = tb.t1.x, o.t1y[k] = tb.t1.y, o.t1z[k] = tb.t1.z;
+                    o.t2x[k] = tb.t2.x, o.t2y[k] = tb.t2.y, o.t2z[k] = tb.t2.z;
+                }
             } else {
                 s.material[si] = obj.material;
                 s.object[si] = k;
@@ -196,8 +211,10 @@ CompiledScene compile_scene(const Scene& scene) {
                 box.add(obj);
                 ++si;
                 record[kRecordNx] = record[kRecordNy] = record[kRecordNz] = 0.0f;
-                o.t1x[k] = o.t1y[k] = o.t1z[k] = 0.0f;
-                o.t2x[k] = o.t2y[k] = o.t2z[k] = 0.0f;
+                if (checker_planes) {
+                    o.t1x[k] = o.t1y[k] = o.t1z[k] = 0.0f;
+                    o.t2x[k] = o.t2y[k] = o.t2z[k] = 0.0f;
+                }
             }
         }
         block_boxes[block] = box;

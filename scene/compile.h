@@ -62,8 +62,10 @@ struct CompiledPlanes {
 struct CompiledObjects {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;
-    GeometryArray<float> record;                        // padded_count records
-    GeometryArray<float> t1x, t1y, t1z, t2x, t2y, t2z;  // checker tangent basis (planes)
+    GeometryArray<float> record;  // padded_count records
+    // The checker's tangent basis (planes; 0 for spheres), only in a scene with a checkered
+    // plane: empty otherwise, as no shading reads it.
+    GeometryArray<float> t1x, t1y, t1z, t2x, t2y, t2z;
 
     const float* record_of(std::uint32_t k) const {
         return record.data() + std::size_t{k} * kObjectRecordFloats;

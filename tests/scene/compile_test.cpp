@@ -42,6 +42,11 @@ void expect_every_entry(std::uint32_t count) {
     const CompiledSpheres& s = c.spheres;
     const CompiledPlanes& p = c.planes;
     ASSERT_EQ(o.count, count);
+    // The tangent columns exist in a scene with a checkered plane (the fourth object on),
+    // and only there: shading reads them only for a lane that hit one.
+    const bool checker_planes = count > 3;
+    for (const auto* a : {&o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
+        ASSERT_EQ(a->size(), checker_planes ? o.padded_count : 0u);
     std::uint32_t si = 0, pi = 0;
     for (std::uint32_t k = 0; k < count; ++k) {
         const Object& obj = scene.objects[k];
@@ -52,9 +57,15 @@ void expect_every_entry(std::uint32_t count) {
         if (plane) {
             ASSERT_EQ(o.center(k), (Vec3{0, 0, 0})) << k;  // a plane has no center
             ASSERT_EQ(o.normal(k), obj.normal) << k;
-            const TangentBasis tb = checker_basis(obj.normal);
-            ASSERT_EQ(o.t1x[k], tb.t1.x) << k;
-            ASSERT_EQ(o.t2z[k], tb.t2.z) << k;
+            if (checker_planes) {
+                const TangentBasis tb = checker_basis(obj.normal);
+                ASSERT_EQ(o.t1x[k], tb.t1.x) << k;
+                ASSERT_EQ(o.t1y[k], tb.t1.y) << k;
+                ASSERT_EQ(o.t1z[k], tb.t1.z) << k;
+                ASSERT_EQ(o.t2x[k], tb.t2.x) << k;
+                ASSERT_EQ(o.t2y[k], tb.t2.y) << k;
+                ASSERT_EQ(o.t2z[k], tb.t2.z) << k;
+            }
             ASSERT_EQ(p.object[pi], k);
             ASSERT_EQ(p.material[pi], obj.material);
             ASSERT_EQ(p.ny[pi], obj.normal.y);
@@ -63,8 +74,10 @@ void expect_every_entry(std::uint32_t count) {
         } else {
             ASSERT_EQ(o.center(k), obj.center) << k;
             ASSERT_EQ(o.normal(k), (Vec3{0, 0, 0})) << k;  // a sphere has no normal
-            for (const auto* a : {&o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
-                ASSERT_EQ((*a)[k], 0.0f) << k;  // nor tangents
+            if (checker_planes) {
+                for (const auto* a : {&o.t1x, &o.t1y, &o.t1z, &o.t2x, &o.t2y, &o.t2z})
+                    ASSERT_EQ((*a)[k], 0.0f) << k;  // nor tangents
+            }
             ASSERT_EQ(s.object[si], k);
             ASSERT_EQ(s.material[si], obj.material);
             ASSERT_EQ(s.cx[si], obj.center.x);
@@ -87,7 +100,9 @@ void expect_every_entry(std::uint32_t count) {
     for (std::uint32_t k = count; k < o.padded_count; ++k) {
         for (std::uint32_t f = 0; f < kObjectRecordFloats; ++f)
             EXPECT_EQ(o.record_of(k)[f], 0.0f);  // a sphere at the origin, material 0
-        EXPECT_EQ(o.t2z[k], 0.0f);
+        if (checker_planes) {
+            EXPECT_EQ(o.t2z[k], 0.0f);
+        }
     }
     for (std::uint32_t i = s.count; i < s.padded_count; ++i) {
         EXPECT_TRUE(std::isnan(s.cx[i]) && std::isnan(s.r2[i]) && std::isnan(s.radius[i]));
@@ -102,8 +117,31 @@ void expect_every_entry(std::uint32_t count) {
 
 TEST(CompileScene, EveryEntryOfEveryArrayIsWritten) {
     expect_every_entry(1);
+    expect_every_entry(3);
+    expect_every_entry(4);  // the first plane, checkered
     expect_every_entry(21);
     expect_every_entry(40001);  // three blocks of the parallel fill, the last one short
+}
+
+// Planes without a checker, and spheres with one (a checker colours planes only), need no
+// tangent basis.
+TEST(CompileScene, NoTangentColumnsWithoutACheckeredPlane) {
+    Scene s = testing::empty_scene();
+    Material checkered;
+    checkered.checker = Checker{Rgb(0.1f), 2.0f};
+    const std::uint32_t checker = testing::add_material(s, checkered);
+    testing::add_plane(s, {0, -1, 0}, {0, 1, 0}, 0);
+    testing::add_sphere(s, {0, 0, -3}, 1.0f, checker);
+    const CompiledScene c = compile_scene(s);
+    EXPECT_FALSE(c.objects.checker(0));
+    for (const auto* a : {&c.objects.t1x, &c.objects.t1y, &c.objects.t1z, &c.objects.t2x,
+                          &c.objects.t2y, &c.objects.t2z})
+        EXPECT_TRUE(a->empty());
+    s.objects[0].material = checker;
+    const CompiledScene with = compile_scene(s);
+    EXPECT_TRUE(with.objects.checker(0));
+    ASSERT_EQ(with.objects.t1x.size(), with.objects.padded_count);
+    EXPECT_EQ(with.objects.t2y[0], checker_basis(s.objects[0].normal).t2.y);
 }
 
 }  // namespace
