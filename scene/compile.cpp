@@ -154,13 +154,11 @@ CompiledScene compile_scene(const Scene& scene) {
     s.padded_count = padded(s.count);
     for (auto* v : {&s.cx, &s.cy, &s.cz, &s.r2, &s.radius})
         size_for(*v, s.count, s.padded_count, kNaN);
-    size_for(s.material, s.count, s.padded_count, 0u);
     size_for(s.object, s.count, s.padded_count, std::numeric_limits<std::uint32_t>::max());
 
     p.count = planes_before[blocks];
     p.padded_count = padded(p.count);
     for (auto* v : {&p.nx, &p.ny, &p.nz, &p.d}) size_for(*v, p.count, p.padded_count, kNaN);
-    size_for(p.material, p.count, p.padded_count, 0u);
     size_for(p.object, p.count, p.padded_count, std::numeric_limits<std::uint32_t>::max());
 
     o.count = objects;
@@ -193,7 +191,6 @@ CompiledScene compile_scene(const Scene& scene) {
             if (plane) {
                 p.nx[pi] = obj.normal.x, p.ny[pi] = obj.normal.y, p.nz[pi] = obj.normal.z;
                 p.d[pi] = dot(obj.point, obj.normal);
-                p.material[pi] = obj.material;
                 p.object[pi] = k;
                 ++pi;
                 record[kRecordCx] = record[kRecordCy] = record[kRecordCz] = 0.0f;
@@ -205,7 +202,6 @@ CompiledScene compile_scene(const Scene& scene) {
                     o.t2x[k] = tb.t2.x, o.t2y[k] = tb.t2.y, o.t2z[k] = tb.t2.z;
                 }
             } else {
-                s.material[si] = obj.material;
                 s.object[si] = k;
                 write_sphere(out, si, k, obj);
                 box.add(obj);

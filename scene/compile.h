@@ -39,8 +39,8 @@ struct CompiledSpheres {
     std::uint32_t padded_count = 0;
     GeometryArray<float> cx, cy, cz;
     GeometryArray<float> r2;      // radius * radius, as the reference computes it
-    GeometryArray<float> radius;  // for the BVH builder's boxes and the Embree baseline
-    GeometryArray<std::uint32_t> material, object;
+    GeometryArray<float> radius;  // for the Embree baseline (octray's kernels take r2)
+    GeometryArray<std::uint32_t> object;
 };
 
 // Planes in file order (among planes): N normalised on load, d = P0.N.
@@ -48,7 +48,7 @@ struct CompiledPlanes {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;
     GeometryArray<float> nx, ny, nz, d;
-    GeometryArray<std::uint32_t> material, object;
+    GeometryArray<std::uint32_t> object;
 };
 
 // Everything shading needs per object, indexed by the object's index in the file (the id

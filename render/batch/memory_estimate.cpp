@@ -53,9 +53,11 @@ constexpr std::uint64_t kAovDepthBytes = 4, kAovNormalBytes = 12, kAovAlbedoByte
                         kAovIdBytes = 4;
 
 // scene/compile.h, per entry (arrays are padded to kCompiledPadding = 8 entries):
-constexpr std::uint64_t kCompiledSphereBytes = 7 * 4;     // cx cy cz r2 radius material object
-constexpr std::uint64_t kCompiledPlaneBytes = 6 * 4;      // nx ny nz d material object
-constexpr std::uint64_t kCompiledObjectBytes = 14 * 4;    // an 8-float record, 6 columns
+constexpr std::uint64_t kCompiledSphereBytes = 6 * 4;  // cx cy cz r2 radius object
+constexpr std::uint64_t kCompiledPlaneBytes = 5 * 4;   // nx ny nz d object
+// An 8-float record and 6 tangent columns (counted always: the columns exist only with a
+// checkered plane, which the estimate does not look for).
+constexpr std::uint64_t kCompiledObjectBytes = 14 * 4;
 constexpr std::uint64_t kCompiledMaterialBytes = 16 * 4;  // CompiledMaterials' 16 columns
 constexpr std::uint64_t kCompiledLightBytes = 11 * 4;     // CompiledLights' 11 columns
 constexpr std::uint64_t kPadding = 8;

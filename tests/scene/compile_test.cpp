@@ -67,7 +67,6 @@ void expect_every_entry(std::uint32_t count) {
                 ASSERT_EQ(o.t2z[k], tb.t2.z) << k;
             }
             ASSERT_EQ(p.object[pi], k);
-            ASSERT_EQ(p.material[pi], obj.material);
             ASSERT_EQ(p.ny[pi], obj.normal.y);
             ASSERT_EQ(p.d[pi], dot(obj.point, obj.normal));
             ++pi;
@@ -79,7 +78,6 @@ void expect_every_entry(std::uint32_t count) {
                     ASSERT_EQ((*a)[k], 0.0f) << k;  // nor tangents
             }
             ASSERT_EQ(s.object[si], k);
-            ASSERT_EQ(s.material[si], obj.material);
             ASSERT_EQ(s.cx[si], obj.center.x);
             ASSERT_EQ(s.cy[si], obj.center.y);
             ASSERT_EQ(s.cz[si], obj.center.z);
@@ -107,7 +105,6 @@ void expect_every_entry(std::uint32_t count) {
     for (std::uint32_t i = s.count; i < s.padded_count; ++i) {
         EXPECT_TRUE(std::isnan(s.cx[i]) && std::isnan(s.r2[i]) && std::isnan(s.radius[i]));
         EXPECT_EQ(s.object[i], std::numeric_limits<std::uint32_t>::max());
-        EXPECT_EQ(s.material[i], 0u);
     }
     for (std::uint32_t i = p.count; i < p.padded_count; ++i) {
         EXPECT_TRUE(std::isnan(p.nx[i]) && std::isnan(p.d[i]));
