@@ -177,7 +177,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         std::vector<std::int32_t> objects(s.count);
         for (std::uint32_t i = 0; i < s.count; ++i) {
             v[4 * i + 0] = s.cx[i], v[4 * i + 1] = s.cy[i], v[4 * i + 2] = s.cz[i];
-            v[4 * i + 3] = s.radius[i];
+            v[4 * i + 3] = scene.objects[s.object[i]].radius;
             objects[i] = static_cast<std::int32_t>(s.object[i]);
         }
         im.attach(im.scene, g, std::move(objects), Impl::Kind::buffers);
@@ -196,7 +196,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, const CompiledScene& compiled, int 
         // The scene's size: the diagonal of the spheres' bounding box (at least 1).
         Vec3 lo{kInfinity, kInfinity, kInfinity}, hi = -lo;
         for (std::uint32_t i = 0; i < s.count; ++i) {
-            const Vec3 c{s.cx[i], s.cy[i], s.cz[i]}, r{s.radius[i], s.radius[i], s.radius[i]};
+            const float radius = scene.objects[s.object[i]].radius;
+            const Vec3 c{s.cx[i], s.cy[i], s.cz[i]}, r{radius, radius, radius};
             lo = min(lo, c - r), hi = max(hi, c + r);
         }
         const float extent = s.count > 0 ? length(hi - lo) : 0.0f;

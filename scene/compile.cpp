@@ -72,7 +72,6 @@ void write_sphere(CompiledScene& out, std::uint32_t si, std::uint32_t k, const O
     CompiledSpheres& s = out.spheres;
     s.cx[si] = obj.center.x, s.cy[si] = obj.center.y, s.cz[si] = obj.center.z;
     s.r2[si] = obj.radius * obj.radius;
-    s.radius[si] = obj.radius;
     float* record = out.objects.record.data() + std::size_t{k} * kObjectRecordFloats;
     record[kRecordCx] = obj.center.x, record[kRecordCy] = obj.center.y;
     record[kRecordCz] = obj.center.z;
@@ -152,8 +151,7 @@ CompiledScene compile_scene(const Scene& scene) {
 
     s.count = objects - planes_before[blocks];
     s.padded_count = padded(s.count);
-    for (auto* v : {&s.cx, &s.cy, &s.cz, &s.r2, &s.radius})
-        size_for(*v, s.count, s.padded_count, kNaN);
+    for (auto* v : {&s.cx, &s.cy, &s.cz, &s.r2}) size_for(*v, s.count, s.padded_count, kNaN);
     size_for(s.object, s.count, s.padded_count, std::numeric_limits<std::uint32_t>::max());
 
     p.count = planes_before[blocks];

@@ -38,8 +38,7 @@ struct CompiledSpheres {
     std::uint32_t count = 0;
     std::uint32_t padded_count = 0;
     GeometryArray<float> cx, cy, cz;
-    GeometryArray<float> r2;      // radius * radius, as the reference computes it
-    GeometryArray<float> radius;  // for the Embree baseline (octray's kernels take r2)
+    GeometryArray<float> r2;  // radius * radius, as the reference computes it
     GeometryArray<std::uint32_t> object;
 };
 

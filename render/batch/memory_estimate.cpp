@@ -53,7 +53,7 @@ constexpr std::uint64_t kAovDepthBytes = 4, kAovNormalBytes = 12, kAovAlbedoByte
                         kAovIdBytes = 4;
 
 // scene/compile.h, per entry (arrays are padded to kCompiledPadding = 8 entries):
-constexpr std::uint64_t kCompiledSphereBytes = 6 * 4;  // cx cy cz r2 radius object
+constexpr std::uint64_t kCompiledSphereBytes = 5 * 4;  // cx cy cz r2 object
 constexpr std::uint64_t kCompiledPlaneBytes = 5 * 4;   // nx ny nz d object
 // An 8-float record and 6 tangent columns (counted always: the columns exist only with a
 // checkered plane, which the estimate does not look for).

@@ -81,7 +81,6 @@ void expect_every_entry(std::uint32_t count) {
             ASSERT_EQ(s.cx[si], obj.center.x);
             ASSERT_EQ(s.cy[si], obj.center.y);
             ASSERT_EQ(s.cz[si], obj.center.z);
-            ASSERT_EQ(s.radius[si], obj.radius);
             ASSERT_EQ(s.r2[si], obj.radius * obj.radius);
             ++si;
         }
@@ -103,7 +102,7 @@ void expect_every_entry(std::uint32_t count) {
         }
     }
     for (std::uint32_t i = s.count; i < s.padded_count; ++i) {
-        EXPECT_TRUE(std::isnan(s.cx[i]) && std::isnan(s.r2[i]) && std::isnan(s.radius[i]));
+        EXPECT_TRUE(std::isnan(s.cx[i]) && std::isnan(s.r2[i]));
         EXPECT_EQ(s.object[i], std::numeric_limits<std::uint32_t>::max());
     }
     for (std::uint32_t i = p.count; i < p.padded_count; ++i) {

@@ -121,7 +121,7 @@ std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_
             // hits missed the exact box, by at most 0.08 u|O'|; the widening is 96 u D.
             const auto i = static_cast<std::uint32_t>(rng() % c.spheres.count);
             const Vec3 center{c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
-            const float radius = c.spheres.radius[i];
+            const float radius = std::sqrt(c.spheres.r2[i]);
             const float distance = radius * std::pow(10.0f, 1.0f + 4.0f * u01(rng));
             const float u = 0x1.0p-24f, slack = 8.0f * u * distance;
             const auto axis = static_cast<int>(rng() % 3);
@@ -147,7 +147,7 @@ std::vector<Ray> test_rays(const CompiledScene& c, std::mt19937& rng, std::size_
             // grazing rays whose hits only exact arithmetic decides.
             const auto i = static_cast<std::uint32_t>(rng() % c.spheres.count);
             const Vec3 center{c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
-            const float radius = c.spheres.radius[i];
+            const float radius = std::sqrt(c.spheres.r2[i]);
             const float distance = std::pow(10.0f, 3.0f * u01(rng));
             const Vec3 from = normalize(Vec3{unit(rng), unit(rng), unit(rng)});
             const float fuzz = 1e-3f * distance * u01(rng);
@@ -308,7 +308,7 @@ std::vector<Ray> beam_test_rays(const CompiledScene& c, std::mt19937& rng, int g
             // pyramid's face is the grazing plane.
             const auto i = static_cast<std::uint32_t>(rng() % c.spheres.count);
             const Vec3 center{c.spheres.cx[i], c.spheres.cy[i], c.spheres.cz[i]};
-            const float r = c.spheres.radius[i];
+            const float r = std::sqrt(c.spheres.r2[i]);
             const float distance = r * std::pow(10.0f, 1.0f + 5.0f * u01(rng));
             axis = normalize(Vec3{unit(rng), unit(rng), unit(rng)});
             const float comp[3] = {std::fabs(axis.x), std::fabs(axis.y), std::fabs(axis.z)};
