@@ -1,6 +1,8 @@
 // The `octray` application: its commands and what they share (tools/commands.h).
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <memory>
@@ -11,6 +13,7 @@
 #include "core/version.h"
 #include "render/image/image_io.h"
 #include "scene/scene_error.h"
+#include "tools/cli_checks.h"
 #include "tools/commands.h"
 
 namespace octray::tools {
@@ -25,6 +28,23 @@ std::string exit_code_help() {
            "  3  scene error: the scene file or built-in spec cannot be loaded or is invalid\n"
            "  4  I/O error: an output file cannot be written (nothing partial is left),\n"
            "     or standard output cannot be (a closed pipe: EPIPE, not death by SIGPIPE)\n";
+}
+
+void end_command(int status) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+    throw CommandExit{status};
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer) || __has_feature(leak_sanitizer)
+    throw CommandExit{status};
+#endif
+#endif
+    // As after any command (octray_main): a standard output that could not be written is
+    // an I/O error.
+    status = finish_standard_output(status);
+    std::cerr.flush();
+    std::fflush(nullptr);
+    std::_Exit(status);
 }
 
 std::string help_hint(const std::string& command) {

@@ -287,12 +287,16 @@ void run_render(const RenderArguments& args) {
         std::printf("shard    %d/%d: %zu of %zu frames\n", shard.index, shard.count,
                     jobs.size(), planned);
 
-    InterruptGuard interrupt;  // Ctrl-C and SIGTERM set the flag the frame loop polls
-    ProgressReporter reporter(*progress, args.stats);
-    const batch::BatchSummary summary =
-        batch::run_batch(scenes, jobs, settings, reporter, &InterruptGuard::flag());
-    const int status = exit_status(summary);
-    if (status != kExitSuccess) throw CommandExit{status};
+    int status = kExitSuccess;
+    {
+        InterruptGuard interrupt;  // Ctrl-C and SIGTERM set the flag the frame loop polls
+        ProgressReporter reporter(*progress, args.stats);
+        status = exit_status(
+            batch::run_batch(scenes, jobs, settings, reporter, &InterruptGuard::flag()));
+    }
+    // Every frame is on disk (or reported failed) and the summary printed: the scenes are
+    // not freed one object at a time.
+    end_command(status);
 }
 
 }  // namespace
