@@ -155,6 +155,12 @@ class BatchRunner {
     bool run(std::size_t index, const BatchJob& job);
     // Waits for the frame being written behind, if any, and reports it.
     void finish_pending();
+    // Frees the prepared scene (compiled arrays, BVH) and the spare frame: after the last
+    // frame, while its files are written behind, rather than after them.
+    void release_renderer() {
+        renderer_.reset();
+        spare_frame_ = Image();
+    }
 
   private:
     ExrAttributes attributes(const BatchInput& scene, const FrameRenderer::Pose& pose,
@@ -546,6 +552,9 @@ BatchSummary run_batch(const std::vector<BatchInput>& scenes, const std::vector<
                 break;
             }
         }
+        // The last frame is written behind while its scene's memory goes back: freeing a
+        // million spheres' BVH and arrays took 3-8 ms, the last write 3-6 ms.
+        runner.release_renderer();
         runner.finish_pending();
     }
     summary.interrupted = cancelled();
