@@ -127,8 +127,9 @@ CompiledScene compile_scene(const Scene& scene) {
     constexpr std::uint32_t kBlock = 1u << 14;
     const std::uint32_t blocks = (objects + kBlock - 1) / kBlock;
     std::vector<std::uint32_t> planes_before(blocks + 1, 0);
-    std::vector<std::uint8_t> block_checkers(blocks,
-                                             0);  // not vector<bool>: written in parallel
+    // Whether each block holds a checkered plane (bytes, not vector<bool>: written in
+    // parallel).
+    std::vector<std::uint8_t> block_checkers(blocks, 0);
     tbb::parallel_for(std::uint32_t{0}, blocks, [&](std::uint32_t block) {
         std::uint32_t planes = 0;
         bool checkers = false;

@@ -8,7 +8,6 @@
 #endif
 
 #include <cstdint>
-#include <cstring>
 #include <vector>
 
 namespace octray {
