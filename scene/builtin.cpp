@@ -234,6 +234,22 @@ Scene make_whitted() {
 // ---------------------------------------------------------------------------------------
 // random:N — exactly as docs/scene-format.md specifies it.
 
+// Room for `count` objects, its pages mapped on every thread (huge where the kernel gives
+// them: core/aligned.h), so that the objects a generator then constructs one after another
+// fault none: random:1048576 was generated in 41 ms, its page faults most of it.
+void reserve_mapped(std::vector<Object>& objects, std::uint64_t count) {
+    objects.reserve(count);
+    auto* const storage = reinterpret_cast<unsigned char*>(objects.data());
+    const std::uint64_t bytes = count * sizeof(Object);
+    offer_huge_pages(storage, bytes);
+    constexpr std::uint64_t kBytesPerTask = std::uint64_t{2} << 20;
+    tbb::parallel_for(std::uint64_t{0}, (bytes + kBytesPerTask - 1) / kBytesPerTask,
+                      [&](std::uint64_t k) {
+                          const std::uint64_t at = k * kBytesPerTask;
+                          populate_pages(storage + at, std::min(kBytesPerTask, bytes - at));
+                      });
+}
+
 Scene make_random(std::uint64_t count, std::uint64_t seed) {
     Scene s;
     s.image = {1920, 1080, 1};
@@ -253,20 +269,7 @@ Scene make_random(std::uint64_t count, std::uint64_t seed) {
     // radius = 0.6 N^(-1/3): the spheres fill about the same fraction of the cube for any N.
     const auto radius =
         static_cast<float>(0.6 * std::pow(static_cast<double>(count), -1.0 / 3.0));
-    // The objects' pages mapped on every thread first (huge where the kernel gives them:
-    // core/aligned.h), so that the copies below, made one after another, fault none:
-    // random:1048576 was generated in 41 ms, the copies' page faults most of it.
-    s.objects.reserve(count);
-    Object* const storage = s.objects.data();
-    offer_huge_pages(storage, count * sizeof(Object));
-    constexpr std::uint64_t kPagesPerTask = std::uint64_t{2} << 20;
-    const std::uint64_t bytes = count * sizeof(Object);
-    tbb::parallel_for(std::uint64_t{0}, (bytes + kPagesPerTask - 1) / kPagesPerTask,
-                      [&](std::uint64_t k) {
-                          const std::uint64_t at = k * kPagesPerTask;
-                          populate_pages(reinterpret_cast<unsigned char*>(storage) + at,
-                                         std::min(kPagesPerTask, bytes - at));
-                      });
+    reserve_mapped(s.objects, count);
     s.objects.resize(count, make_sphere({}, radius, material));
     // Blocks of spheres in parallel, each from the generator skipped to its first sphere
     // (three draws per sphere): the same scene for any thread count.
@@ -406,6 +409,7 @@ Scene make_sphereflake(int levels) {
     const std::uint32_t flake_id = add_material(s, "flake", flake);
 
     // The floor touches the bottom of the root sphere (radius 0.5 at the origin).
+    reserve_mapped(s.objects, 1 + flake_size(levels));
     s.objects.push_back(make_plane({0.0f, 0.0f, -0.5f}, {0.0f, 0.0f, 1.0f}, floor_id, "floor"));
     s.objects.resize(1 + flake_size(levels));
     add_flake(s.objects, 1, child_directions(), Dir{0.0, 0.0, 0.0}, 0.5, Dir{0.0, 0.0, 1.0},
