@@ -88,6 +88,32 @@ TEST(SceneValidate, ReportsJsonLikePaths) {
     expect_invalid(s, "objects", {"bounding box overflows float range"});
 }
 
+// The objects are checked on every core: of several invalid objects, the first in file
+// order is the one reported, however the blocks fall; where objects are named (a map of
+// names, checked in order), a name used twice before an invalid object is reported first,
+// and an invalid object before a name used twice.
+TEST(SceneValidate, ReportsTheFirstInvalidObjectOfAMillion) {
+    Scene s = valid_scene();
+    s.objects.resize(1u << 20, s.objects[0]);
+    for (Object& o : s.objects) o.name.clear();
+    s.objects[900000].radius = -1.0f;
+    s.objects[700001].center.z = std::numeric_limits<float>::quiet_NaN();
+    s.objects[16384].material = 99;
+    expect_invalid(s, "objects[16384].material", {"found 99"});
+    s.objects[16384].material = 0;
+    expect_invalid(s, "objects[700001].center", {"expected finite coordinates", "nan"});
+    s.objects[700001].center.z = 0.0f;
+    expect_invalid(s, "objects[900000].radius", {"expected a radius > 0, found -1"});
+    s.objects[900000].radius = 1.0f;
+    EXPECT_NO_THROW(validate_scene(s));
+
+    s.objects[500000].name = s.objects[800000].name = "twin";
+    s.objects[900000].radius = -1.0f;
+    expect_invalid(s, "objects[800000].name", {"unique object name", "objects[500000]"});
+    s.objects[600000].radius = 0.0f;
+    expect_invalid(s, "objects[600000].radius", {"expected a radius > 0, found 0"});
+}
+
 // Issue 38: a camera far from the origin was refused as "up vector is parallel to the view
 // direction"; the cause is that the view vector's length overflows float.
 TEST(SceneValidate, CameraFarAwaySaysItsLengthOverflowsFloat) {
