@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/aligned.h"
+#include "core/populate.h"
 #include "core/random.h"
 #include "kernels/dispatch.h"
 #include "render/crop.h"
@@ -191,28 +192,14 @@ TileScratch& scratch_for_thread() {
     return scratch;
 }
 
-// Maps the fresh pages of a render's frame before its tiles write them, 2 MiB per task on
-// the render's threads: one madvise(MADV_POPULATE_WRITE) per 2 MiB (populate_pages)
-// instead of a page fault per 4 KiB page. The kernel still zeroes every page; a 1920x1080
-// frame (25 MB) took 7-10 ms this way against 10-14 ms of faults (docs/performance-log.md,
+// Maps the fresh pages of a render's frame before its tiles write them, on the render's
+// threads (populate_pages_parallel): one madvise(MADV_POPULATE_WRITE) per 2 MiB instead of
+// a page fault per 4 KiB page. The kernel still zeroes every page; a 1920x1080 frame (25
+// MB) took 7-10 ms this way against 10-14 ms of faults (docs/performance-log.md,
 // "Division-free rejection in the BVH leaves, render_tile's loops, the first frame").
 void populate_frame(Image& image) {
-    constexpr std::uintptr_t kPage = 4096, kChunk = kHugePageBytes;
-    struct Range {
-        std::uintptr_t begin, end;
-    };
-    std::vector<Range> chunks;
-    for (ImageChannel& channel : image.channels) {
-        const auto at = reinterpret_cast<std::uintptr_t>(channel.samples.data());
-        const std::uintptr_t begin = (at + kPage - 1) & ~(kPage - 1);
-        const std::uintptr_t end = (at + channel.samples.size()) & ~(kPage - 1);
-        for (std::uintptr_t b = begin; b < end; b += kChunk)
-            chunks.push_back({b, std::min(end, b + kChunk)});
-    }
-    tbb::parallel_for(std::size_t{0}, chunks.size(), [&](std::size_t c) {
-        populate_pages(reinterpret_cast<void*>(chunks[c].begin),
-                       chunks[c].end - chunks[c].begin);
-    });
+    for (ImageChannel& channel : image.channels)
+        populate_pages_parallel(channel.samples.data(), channel.samples.size());
 }
 
 // The rays of `rays` from `first` on: a chunk of a stream (first: a whole packet).

@@ -7,7 +7,6 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
-#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -22,6 +21,7 @@
 #include <vector>
 
 #include "core/aligned.h"
+#include "core/populate.h"
 #include "core/random.h"
 #include "scene/json_rules.h"
 #include "scene/load.h"
@@ -242,12 +242,7 @@ void reserve_mapped(std::vector<Object>& objects, std::uint64_t count) {
     auto* const storage = reinterpret_cast<unsigned char*>(objects.data());
     const std::uint64_t bytes = count * sizeof(Object);
     offer_huge_pages(storage, bytes);
-    constexpr std::uint64_t kBytesPerTask = std::uint64_t{2} << 20;
-    tbb::parallel_for(std::uint64_t{0}, (bytes + kBytesPerTask - 1) / kBytesPerTask,
-                      [&](std::uint64_t k) {
-                          const std::uint64_t at = k * kBytesPerTask;
-                          populate_pages(storage + at, std::min(kBytesPerTask, bytes - at));
-                      });
+    populate_pages_parallel(storage, bytes);
 }
 
 Scene make_random(std::uint64_t count, std::uint64_t seed) {

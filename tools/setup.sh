@@ -7,7 +7,8 @@
 # slurm-client and munge let tests/farm/slurm.sh run a single-node Slurm (it starts the
 # daemons itself, from a temporary folder; installing them starts nothing here).
 # python3-matplotlib draws bench/plot.py's charts; groff-base checks the man pages.
-# libisal-dev (ISA-L's igzip) compresses the ZIP chunks of the EXRs octray writes.
+# libisal-dev (ISA-L's igzip) compresses the ZIP chunks of the EXRs octray writes;
+# zlib1g-dev (which libpng-dev brings too) checks and joins their checksums.
 # libcpp-httplib-dev is the HTTP server of `octray view` (it brings libssl-dev, whose
 # headers its own include; libjpeg62-turbo-dev is its picture stream's JPEG); chromium, chromium-driver and python3-selenium drive its page headless
 # in tests/view/browser_test.py.
@@ -19,7 +20,7 @@ packages=(
     dpkg-dev xz-utils
     libxsimd-dev libopenexr-dev libimath-dev openexr libtbb-dev
     libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libsimdjson-dev
-    libpng-dev libisal-dev libembree-dev
+    libpng-dev zlib1g-dev libisal-dev libembree-dev
     slurmctld slurmd slurm-client munge
     python3-matplotlib groff-base
     libcpp-httplib-dev libjpeg62-turbo-dev chromium chromium-driver python3-selenium

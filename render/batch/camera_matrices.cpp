@@ -90,10 +90,6 @@ std::optional<Matrix44> world_to_ndc(const Scene& scene) {
     return world_to_ndc(camera_frame_of(scene));
 }
 
-void add_camera_attributes(ExrAttributes& attributes, const Scene& scene) {
-    add_camera_attributes(attributes, camera_frame_of(scene));
-}
-
 void add_camera_attributes(ExrAttributes& attributes, const Scene& scene,
                            const Camera& camera) {
     add_camera_attributes(attributes,

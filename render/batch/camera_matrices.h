@@ -27,9 +27,8 @@ Matrix44 world_to_camera(const Scene& scene);
 // projective matrix: nullopt.
 std::optional<Matrix44> world_to_ndc(const Scene& scene);
 
-// Adds worldToCamera and, where the camera has one, worldToNDC to `attributes`: of the
-// scene's camera, or of `camera` on the scene's picture.
-void add_camera_attributes(ExrAttributes& attributes, const Scene& scene);
+// Adds worldToCamera and, where the camera has one, worldToNDC to `attributes`: of `camera`
+// on the scene's picture (its own camera: scene.camera; an animation's frame: that frame's).
 void add_camera_attributes(ExrAttributes& attributes, const Scene& scene, const Camera& camera);
 
 // p * M for a point (w = 1), divided by the resulting w: Imath's multVecMatrix.

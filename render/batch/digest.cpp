@@ -3,9 +3,9 @@
 
 #include "render/batch/digest.h"
 
-#include <cpuid.h>
-
 #include <cstring>
+
+#include "core/cpu_features.h"
 
 namespace octray::batch {
 namespace detail {
@@ -25,14 +25,6 @@ const std::uint32_t kSha256Round[64] = {
 namespace {
 
 constexpr std::uint32_t rotr(std::uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
-
-bool cpu_has_sha_extensions() {
-    unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
-    if (__get_cpuid(1, &eax, &ebx, &ecx, &edx) == 0) return false;
-    const bool ssse3 = (ecx & bit_SSSE3) != 0, sse41 = (ecx & bit_SSE4_1) != 0;
-    if (__get_cpuid_count(7, 0, &eax, &ebx, &ecx, &edx) == 0) return false;
-    return ssse3 && sse41 && (ebx & bit_SHA) != 0;
-}
 
 }  // namespace
 
@@ -63,10 +55,7 @@ void sha256_blocks_portable(std::uint32_t state[8], const unsigned char* data,
     }
 }
 
-bool sha256_use_shani() {
-    static const bool use = cpu_has_sha_extensions();
-    return use;
-}
+bool sha256_use_shani() { return cpu_features().sha; }
 
 }  // namespace detail
 

@@ -43,10 +43,6 @@ std::size_t level_buffer_size(int level) {
     }
 }
 
-}  // namespace
-
-namespace {
-
 // One call of isal_deflate_stateless at `level` on this thread's state: in[0, size) into
 // out[0, capacity) as a zlib stream (IGZIP_ZLIB) or raw DEFLATE blocks (IGZIP_DEFLATE),
 // ended (end_of_stream) or byte-aligned and independent of what follows (FULL_FLUSH).

@@ -24,6 +24,7 @@
 #include <system_error>
 #include <vector>
 
+#include "core/cpu_features.h"
 #include "render/image/deflate.h"
 #include "render/image/image.h"
 #include "render/image/image_io.h"
@@ -279,10 +280,7 @@ const SrgbTable& srgb_table() {
     return table;
 }
 
-bool srgb8_use_avx2() {
-    static const bool use = __builtin_cpu_supports("avx2") != 0;  // and the OS's AVX state
-    return use;
-}
+bool srgb8_use_avx2() { return cpu_features().avx2; }
 
 void srgb8_interleaved_scalar(const float* r, const float* g, const float* b, std::size_t count,
                               float scale, std::uint8_t* out) {

@@ -29,7 +29,7 @@ Image render_part(const Scene& scene, std::optional<PixelRect> crop, bool float3
     ExrAttributes attributes;
     attributes.strings.emplace_back("software", "octray test");
     attributes.rationals.emplace_back("framesPerSecond", ExrRational{24, 1});
-    add_camera_attributes(attributes, scene);
+    add_camera_attributes(attributes, scene, scene.camera);
     Image exr =
         make_exr_image(result.image, ExrWriteOptions{float32, ExrCompression::zip}, attributes);
     append_aov_channels(exr, compute_aovs(scene, options, AovSet{true, true, true, true}),

@@ -221,10 +221,10 @@ TEST(CameraMatrices, ProjectThePixelsOwnRays) {
     const Scene fisheye = testing::golden_scene("fisheye", 16, 16);
     EXPECT_FALSE(batch::world_to_ndc(fisheye));
     ExrAttributes attributes;
-    batch::add_camera_attributes(attributes, fisheye);
+    batch::add_camera_attributes(attributes, fisheye, fisheye.camera);
     ASSERT_EQ(attributes.matrices.size(), 1u);
     EXPECT_EQ(attributes.matrices[0].first, "worldToCamera");
-    batch::add_camera_attributes(attributes, pinhole);
+    batch::add_camera_attributes(attributes, pinhole, pinhole.camera);
     ASSERT_EQ(attributes.matrices.size(), 3u);
     EXPECT_EQ(attributes.matrices[2].first, "worldToNDC");
 }

@@ -46,7 +46,7 @@ class AssembleCliTest : public ::testing::Test {
         RenderOptions options;
         options.crop = crop;
         ExrAttributes attributes;
-        batch::add_camera_attributes(attributes, scene_);
+        batch::add_camera_attributes(attributes, scene_, scene_.camera);
         attributes.ints.emplace_back("octray:frame", 3);
         const RenderResult result = render_packet(scene_, options);
         Image exr = make_exr_image(result.image, ExrWriteOptions{float32, ExrCompression::zip},
