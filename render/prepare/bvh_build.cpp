@@ -153,21 +153,29 @@ class Collapser {
         const auto child = [&](std::uint32_t s, std::uint32_t cb, std::uint32_t ce,
                                bool is_leaf) {
             Child c{s, cb, ce, 0, 0, {}, {}, 0.0f};
-            if (is_leaf) {
-                // A leaf's box: its spheres' (as the builder bounded the range).
-                Box box;
-                for (std::uint32_t i = cb; i < ce; ++i) box.grow(refs_[i].box);
+            if (is_leaf && ce - cb == 1) {
+                // A leaf of one sphere: its box.
+                const Box& box = refs_[cb].box;
                 for (int a = 0; a < 3; ++a) c.lo[a] = box.lo_at(a), c.hi[a] = box.hi_at(a);
+            } else if (is_leaf) {
+                // A larger leaf's box, as the builder bounded its spheres, in the slot the
+                // leaf leaves unused (bvh_sah.h): read in place of its spheres' boxes, which
+                // lie elsewhere in memory (most of the collapse's time went into those
+                // reads).
+                const BinaryNode& bn = binary_[s];
+                for (int a = 0; a < 3; ++a) c.lo[a] = bn.lo[a], c.hi[a] = bn.hi[a];
             } else {
                 const BinaryNode& bn = binary_[s];
                 c.mid = bn.mid & kBinaryMidMask;
                 c.leaves = bn.mid & (kBinaryLeftLeaf | kBinaryRightLeaf);
                 for (int a = 0; a < 3; ++a) c.lo[a] = bn.lo[a], c.hi[a] = bn.hi[a];
-                // An inner node's right child lies past its left subtree, far away in
-                // memory for a large one: fetched now, it is there when the node is opened.
-                if ((c.leaves & kBinaryRightLeaf) == 0)
-                    _mm_prefetch(reinterpret_cast<const char*>(&binary_[c.right_slot()]),
-                                 _MM_HINT_T0);
+                // An inner node's right child (its node, or a leaf's box) lies past its
+                // left subtree, far away in memory for a large one: fetched now, it is
+                // there when the node is opened.
+                const bool single = (c.leaves & kBinaryRightLeaf) != 0 && ce - c.mid == 1;
+                _mm_prefetch(single ? reinterpret_cast<const char*>(&refs_[c.mid])
+                                    : reinterpret_cast<const char*>(&binary_[c.right_slot()]),
+                             _MM_HINT_T0);
             }
             const float dx = c.hi[0] - c.lo[0], dy = c.hi[1] - c.lo[1], dz = c.hi[2] - c.lo[2];
             c.area = dx * dy + dy * dz + dz * dx;

@@ -371,6 +371,18 @@ class Builder {
     bool build(const RangeBounds& rb, std::uint32_t n) { return !build(0, 0, n, rb, 0); }
 
   private:
+    // A leaf of n spheres with this box. It has no node, but a leaf of two or more
+    // spheres owns at least one unused slot: its box goes there, as the collapse's
+    // (render/prepare/bvh_build.cpp) to read in place of the spheres' boxes. Returns true.
+    bool leaf(std::uint32_t slot, std::uint32_t n, const Box& box) {
+        if (n >= 2) {
+            BinaryNode& node = nodes_[slot];
+            for (int a = 0; a < 3; ++a) node.lo[a] = box.lo_at(a), node.hi[a] = box.hi_at(a);
+            node.mid = 0;
+        }
+        return true;
+    }
+
     // Builds the subtree of spheres [b, e) into slots [slot, slot + (e - b) - 1); returns
     // whether it is a leaf (and then writes no node).
     bool build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
@@ -378,7 +390,8 @@ class Builder {
         const std::uint32_t n = e - b;
         // A split costs at least one traversal step, more than testing this many spheres:
         // the SAH would choose the leaf, so the binning is skipped.
-        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost) return true;
+        if (static_cast<float>(n) * kIntersectionCost <= kTraversalCost)
+            return leaf(slot, n, rb.box);
 
         std::uint32_t mid = 0;
         RangeBounds left, right;
@@ -393,7 +406,7 @@ class Builder {
                 split.axis < 0 ? kInf
                 : area > 0.0f  ? kTraversalCost + kIntersectionCost * split.cost / area
                                : kTraversalCost + kIntersectionCost * static_cast<float>(n);
-            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return true;
+            if (n <= kMaxLeafSize && leaf_cost <= split_cost) return leaf(slot, n, rb.box);
             if (split.axis >= 0) {
                 mid = partition(refs_, b, e, m, split.axis, split.bin, left.centers,
                                 right.centers);
@@ -401,7 +414,7 @@ class Builder {
                 right.box = split.right;
             }
         } else if (n <= kMaxLeafSize) {
-            return true;
+            return leaf(slot, n, rb.box);
         }
         // Every center in one bin (coincident spheres) or too deep: the middle index.
         if (mid <= b || mid >= e) {

@@ -84,10 +84,12 @@ struct RangeBounds {
 };
 
 // An inner node of the binary tree: its box and where its right child's spheres begin
-// (mid, in the low bits), with a bit for each child that is a leaf. Leaves have no node:
-// a leaf's box is its spheres' (at most kMaxLeafSize of them, in leaf order in `refs`), so
-// the collapse makes it from them, and a subtree of n spheres needs n - 1 slots, not
-// 2n - 1 (half the memory to fault in and clear).
+// (mid, in the low bits), with a bit for each child that is a leaf. Leaves have no node of
+// their own, so a subtree of n spheres needs n - 1 slots, not 2n - 1 (half the memory to
+// fault in and clear). A leaf of k >= 2 spheres still owns k - 1 slots it does not use: its
+// box goes in the first (mid 0), where the collapse reads it next to its parent's node
+// instead of from its spheres' references elsewhere in memory; a leaf of one sphere has no
+// slot, and its box is its sphere's.
 // No initialisers: the slot array is allocated untouched and filled by the build tasks.
 struct BinaryNode {
     float lo[3], hi[3];

@@ -172,6 +172,37 @@ TEST(SphereBvh, InvariantsOfALargeTree) {
     EXPECT_GT(bvh.nodes.size(), 256u);
 }
 
+// Every box is tight: exactly the union of the rounded boxes of the spheres under it, which
+// is what refitting the tree to the same spheres computes (refit_sphere_bvh). The 8-wide
+// collapse takes a leaf's box from where the binary build left it (the leaf's unused slot),
+// not from its spheres: a box left stale or taken from the wrong slot differs here, where
+// the containment checks above pass any box that is merely too large.
+void check_tight_boxes(const NamedScene& ns) {
+    SCOPED_TRACE(ns.name);
+    const CompiledScene c = compile_scene(ns.scene);
+    const SphereBvh built = build_sphere_bvh(c.spheres);
+    std::vector<std::uint32_t> compiled_index(c.objects.count, 0);
+    for (std::uint32_t s = 0; s < c.spheres.count; ++s) compiled_index[c.spheres.object[s]] = s;
+    std::vector<std::uint32_t> leaf_sphere(built.sphere_count);
+    for (std::uint32_t i = 0; i < built.sphere_count; ++i)
+        leaf_sphere[i] = compiled_index[built.object[i]];
+    SphereBvh refitted = built;
+    refit_sphere_bvh(refitted, c.spheres, leaf_sphere);
+    ASSERT_EQ(built.nodes.size(), refitted.nodes.size());
+    for (std::size_t k = 0; k < built.nodes.size(); ++k)
+        ASSERT_EQ(0, std::memcmp(&built.nodes[k], &refitted.nodes[k], sizeof(BvhNode8)))
+            << "node " << k;
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_EQ(built.lo[a], refitted.lo[a]);
+        EXPECT_EQ(built.hi[a], refitted.hi[a]);
+    }
+}
+
+TEST(SphereBvh, BoxesAreTheUnionsOfTheirSpheres) {
+    for (const NamedScene& ns : test_scenes()) check_tight_boxes(ns);
+    check_tight_boxes(large_scene());
+}
+
 // The tree splits space, not the input order: on spheres spread uniformly in a cube, a
 // leaf's box is a small part of the root's. A leaf of about five neighbouring spheres
 // spans a few thousandths of the root's surface area (0.15 % here); five spheres taken in
