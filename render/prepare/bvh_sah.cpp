@@ -6,7 +6,8 @@
 // the tree. Binning reduces boxes with min/max and counts with integer sums (both exact,
 // so any TBB split gives the same bins); a partition is one serial pass over its range; each
 // binary subtree over primitives [b, e) writes the node slots [s, s + (e - b) - 1) of a
-// preallocated array (inner nodes only; left child at s + 1, right child at s + mid - b),
+// preallocated array (inner nodes, and a leaf's box in its first slot; left child at s + 1,
+// right child at s + mid - b),
 // so no slot depends on which thread got there first. Partitions reorder a node's own range in
 // place, which no other task touches meanwhile.
 
@@ -384,7 +385,7 @@ class Builder {
     }
 
     // Builds the subtree of spheres [b, e) into slots [slot, slot + (e - b) - 1); returns
-    // whether it is a leaf (and then writes no node).
+    // whether it is a leaf (and then writes no node, only its box: leaf()).
     bool build(std::uint32_t slot, std::uint32_t b, std::uint32_t e, const RangeBounds& rb,
                std::uint32_t depth) {
         const std::uint32_t n = e - b;
