@@ -3,9 +3,10 @@
 // kernels (whose ISA is chosen through xsimd: kernels/dispatch.h), read from CPUID once per
 // process; for the VEX-encoded ones, also whether the OS saves the YMM registers (XCR0).
 // One reading for every such choice: the preview's sRGB gathers (render/image/png.cpp), the
-// float-to-half conversion (render/image/half_bits.cpp) and the scene digest
-// (render/batch/digest.cpp). __builtin_cpu_supports would do, but clang 14 (the asan
-// preset's compiler) knows neither "f16c" nor "sha".
+// float-to-half conversion (render/image/half_bits.cpp), the scene digest
+// (render/batch/digest.cpp) and the BVH builder's AVX binning (render/prepare/bvh_sah.cpp).
+// __builtin_cpu_supports would do, but clang 14 (the asan preset's compiler) knows neither
+// "f16c" nor "sha".
 
 #include <cpuid.h>
 

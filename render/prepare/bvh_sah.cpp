@@ -22,7 +22,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "kernels/dispatch.h"
+#include "core/cpu_features.h"
 
 namespace octray::bvh_sah {
 namespace {
@@ -180,11 +180,9 @@ struct BinsAvx {
     }
 };
 
-// Whether this CPU bins with AVX (asked once).
-bool avx_binning() {
-    static const bool avx = isa_supported(Isa::avx2);
-    return avx;
-}
+// Whether this CPU bins with AVX (core/cpu_features.h: the one reading behind octray's
+// hand-written intrinsics outside the kernels).
+bool avx_binning() { return cpu_features().avx2; }
 
 __attribute__((target("avx2"))) void bin_serial_avx(const PrimRef* refs, std::uint32_t b,
                                                     std::uint32_t e, const BinMapping& m,
