@@ -261,17 +261,20 @@ SrgbTable::SrgbTable() {
         }
         threshold[v] = std::bit_cast<float>(hi);
     }
-    // The byte of a bucket's first float is the number of thresholds at or below it.
+    // The byte of a bucket's first float is the number of thresholds at or below it; the
+    // next threshold steps up inside the bucket where its top 16 bits are the bucket's.
     int v = 0;
-    for (std::uint32_t b = 0; b <= (kOneBits >> 16); ++b) {
+    for (std::uint32_t b = 0; b < kBuckets; ++b) {
         const float first = std::bit_cast<float>(b << 16);
         while (v < 255 && threshold[v + 1] <= first) ++v;
-        bucket_start[b] = static_cast<std::uint8_t>(v);
+        const std::uint32_t next = std::bit_cast<std::uint32_t>(threshold[v + 1]);
+        const std::uint32_t step = v < 255 && next >> 16 == b ? next & 0xFFFFu : kNoStep;
+        bucket_word[b] = static_cast<std::uint32_t>(v) << 17 | step;
     }
     // Within a bucket the byte steps up at most once (so srgb8_in compares once): the
-    // next bucket's first byte is at most one above this one's.
-    for (std::uint32_t b = 0; b < (kOneBits >> 16); ++b)
-        if (bucket_start[b + 1] > bucket_start[b] + 1)
+    // byte at the next bucket's first float is at most one above this one's.
+    for (std::uint32_t b = 0; b + 1 < kBuckets; ++b)
+        if ((bucket_word[b + 1] >> 17) > (bucket_word[b] >> 17) + 1)
             throw std::logic_error("srgb8: a bucket of the sRGB table holds two steps");
 }
 

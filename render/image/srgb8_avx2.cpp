@@ -1,9 +1,8 @@
 // The AVX2 build of srgb8_interleaved (render/image/srgb_table.h), compiled with -mavx2
 // (render/image/CMakeLists.txt) and called only where the CPU has it. Eight pixels at a
-// time: each channel's byte found as srgb8_in finds it, with two gathers (the bucket's
-// first byte, then the threshold above it), and the three channels' bytes interleaved by
-// one shuffle. It calls no inline code shared with baseline translation units but the
-// scalar build, for the last pixels.
+// time: each channel's byte found as srgb8_in finds it, with one gather (the bucket's
+// word), and the three channels' bytes interleaved by one shuffle. It calls no inline code
+// shared with baseline translation units but the scalar build, for the last pixels.
 
 #include <immintrin.h>
 
@@ -17,16 +16,15 @@ __m256i srgb8_lanes(const SrgbTable& table, const float* linear, __m256 scale) {
     const __m256 x0 = _mm256_mul_ps(_mm256_loadu_ps(linear), scale);
     // max returns its second operand for a NaN (and for -0 against +0): 0, as srgb8_in's
     // comparison gives; then at most 1.
-    const __m256 x =
-        _mm256_min_ps(_mm256_max_ps(x0, _mm256_setzero_ps()), _mm256_set1_ps(1.0f));
-    const __m256i bucket = _mm256_srli_epi32(_mm256_castps_si256(x), 16);
-    const __m256i start = _mm256_and_si256(
-        _mm256_i32gather_epi32(reinterpret_cast<const int*>(table.bucket_start), bucket, 1),
-        _mm256_set1_epi32(0xFF));
-    const __m256 above = _mm256_i32gather_ps(table.threshold + 1, start, 4);
-    // x >= the next threshold: all ones (-1) in that lane, so subtracting adds 1.
-    const __m256 step = _mm256_cmp_ps(x, above, _CMP_GE_OQ);
-    return _mm256_sub_epi32(start, _mm256_castps_si256(step));
+    const __m256i bits = _mm256_castps_si256(
+        _mm256_min_ps(_mm256_max_ps(x0, _mm256_setzero_ps()), _mm256_set1_ps(1.0f)));
+    const __m256i word = _mm256_i32gather_epi32(reinterpret_cast<const int*>(table.bucket_word),
+                                                _mm256_srli_epi32(bits, 16), 4);
+    // -1 where the float lies below its bucket's step (both operands below 2^17).
+    const __m256i below = _mm256_cmpgt_epi32(_mm256_and_si256(word, _mm256_set1_epi32(0x1FFFF)),
+                                             _mm256_and_si256(bits, _mm256_set1_epi32(0xFFFF)));
+    return _mm256_add_epi32(_mm256_srli_epi32(word, 17),
+                            _mm256_add_epi32(below, _mm256_set1_epi32(1)));
 }
 
 }  // namespace

@@ -14,17 +14,21 @@ namespace octray::detail {
 // The formula never decreases as its argument grows, so the byte of x is the number of
 // thresholds at or below x. Each is found by bisection over the bit patterns of the
 // floats in [0, 1], which are ordered as their values. To find a byte without a search,
-// the floats of (0, 1) are cut into buckets by their top 16 bits (1/128 of a power of two
-// each): bucket_start holds the byte at each bucket's first float, and within a bucket the
-// byte steps up at most once (the OETF's slope times a bucket's width stays below one
-// step, which the constructor checks), which one comparison finds.
-// bucket_start has 3 bytes more than buckets: the AVX2 build gathers 4 bytes from each
-// bucket's and keeps the first.
+// the floats of [0, 1] are cut into buckets by their top 16 bits (1/128 of a power of two
+// each), and within a bucket the byte steps up at most once (the OETF's slope times a
+// bucket's width stays below one step, which the constructor checks). A bucket's word
+// holds the byte at its first float (bits 17 and up) and where in the bucket the byte
+// steps up (bits 0 ... 16): the low 16 bits of that threshold, whose top 16 bits are the
+// bucket's own, or 0x10000, above every float of the bucket, where it does not. A float's
+// byte is then one lookup and one comparison of its low 16 bits (srgb8_in); the AVX2
+// build gathers one word per sample, where a table of first bytes and one of thresholds
+// took two gathers, the second waiting on the first.
 struct SrgbTable {
     static constexpr std::uint32_t kOneBits = 0x3F800000u;  // 1.0f
     static constexpr std::uint32_t kBuckets = (kOneBits >> 16) + 1;
-    float threshold[257];  // [256]: +inf, a sentinel
-    std::uint8_t bucket_start[kBuckets + 3] = {};
+    static constexpr std::uint32_t kNoStep = 0x10000u;
+    float threshold[257];  // [0]: -inf, [256]: +inf, sentinels
+    std::uint32_t bucket_word[kBuckets];
     SrgbTable();  // checks its own bucket rule: throws std::logic_error if broken
 };
 
@@ -33,11 +37,12 @@ const SrgbTable& srgb_table();
 
 inline std::uint8_t srgb8_in(const SrgbTable& table, float linear) {
     // Clamped to [0, 1] without branches (NaN fails the first comparison and becomes 0);
-    // 1.0's bucket starts at 255, whose next threshold is +inf.
+    // 1.0's bucket starts at 255 and steps nowhere.
     float x = linear > 0.0f ? linear : 0.0f;
     x = x < 1.0f ? x : 1.0f;
-    const int v = table.bucket_start[std::bit_cast<std::uint32_t>(x) >> 16];
-    return static_cast<std::uint8_t>(v + (x >= table.threshold[v + 1] ? 1 : 0));
+    const std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
+    const std::uint32_t word = table.bucket_word[bits >> 16];
+    return static_cast<std::uint8_t>((word >> 17) + ((bits & 0xFFFFu) >= (word & 0x1FFFFu)));
 }
 
 // Whether srgb8_interleaved uses the AVX2 build on this CPU.
