@@ -379,8 +379,9 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
                 }
             }
         }
-        remove_stale_temporaries(job.output);
-        if (!job.png.empty()) remove_stale_temporaries(job.png);
+        remove_stale_temporaries(job.png.empty()
+                                     ? std::vector<std::string>{job.output}
+                                     : std::vector<std::string>{job.output, job.png});
         {
             const std::lock_guard lock(report_mutex_);  // the writer may be reporting
             observer_.frame_started(index, scene.name, job.frame, work, scene.scene.image.spp);

@@ -1,17 +1,21 @@
 // write_file_atomically() and remove_stale_temporaries() (render/image/image_io.h): how
 // every image file is replaced, whole or not at all.
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 
 #include "render/image/image_io.h"
@@ -123,27 +127,42 @@ void write_file_atomically(const std::string& path,
     }
 }
 
-std::vector<std::string> remove_stale_temporaries(const std::string& target) {
-    const fs::path path(target);
-    fs::path dir = path.parent_path();
-    if (dir.empty()) dir = ".";
-    const std::string prefix = "." + path.filename().string() + ".tmp.";
+std::vector<std::string> remove_stale_temporaries(const std::vector<std::string>& targets) {
+    // Each directory is read once for all of its targets, a name compared without a
+    // path or string made of it: an animation's directory grows by a frame (and a
+    // preview) at a time, and every frame reads it again.
+    std::map<std::string, std::vector<std::string>> prefixes;  // directory -> prefixes
+    for (const std::string& target : targets) {
+        const fs::path path(target);
+        fs::path dir = path.parent_path();
+        if (dir.empty()) dir = ".";
+        prefixes[dir.string()].push_back("." + path.filename().string() + ".tmp.");
+    }
     std::vector<std::string> removed;
-    std::error_code error;
-    for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
-        const std::string name = it->path().filename().string();
-        if (name.compare(0, prefix.size(), prefix) != 0) continue;
-        const std::string file = it->path().string();
-        // O_NONBLOCK: a FIFO planted under such a name must not block the open.
-        int fd = ::open(file.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-        if (fd < 0) fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-        if (fd < 0) continue;
-        // The lock is free only when no writer holds it: its writer is gone. (Names are
-        // never reused, so if the writer renamed it away meanwhile, the unlink finds
-        // nothing.)
-        if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::unlink(file.c_str()) == 0)
-            removed.push_back(file);
-        ::close(fd);
+    for (const auto& [dir, names] : prefixes) {
+        DIR* stream = ::opendir(dir.c_str());
+        if (stream == nullptr) continue;
+        while (const dirent* entry = ::readdir(stream)) {
+            const std::string_view name(entry->d_name);
+            if (name.size() < 2 || name[0] != '.' ||
+                std::none_of(names.begin(), names.end(), [&](const std::string& prefix) {
+                    return name.starts_with(prefix);
+                }))
+                continue;
+            const std::string file = (fs::path(dir) / name).string();
+            // O_NONBLOCK: a FIFO planted under such a name must not block the open.
+            int fd = ::open(file.c_str(), O_RDWR | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+            if (fd < 0)
+                fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+            if (fd < 0) continue;
+            // The lock is free only when no writer holds it: its writer is gone. (Names
+            // are never reused, so if the writer renamed it away meanwhile, the unlink
+            // finds nothing.)
+            if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::unlink(file.c_str()) == 0)
+                removed.push_back(file);
+            ::close(fd);
+        }
+        ::closedir(stream);
     }
     return removed;
 }

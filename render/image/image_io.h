@@ -41,12 +41,12 @@ void check_output_target(const std::string& path);
 void write_file_atomically(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write);
 
-// Removes the temporaries ("<dir>/.<name>.tmp.*") that writers of `target` which are gone
-// (killed mid-write) left behind, and returns their paths. A writer holds an flock(2) on
-// its temporary until the rename, so a temporary of a live writer, in this process or any
-// other, is never removed; one whose lock cannot be taken (a file system without locks)
-// stays too.
-std::vector<std::string> remove_stale_temporaries(const std::string& target);
+// Removes the temporaries ("<dir>/.<name>.tmp.*") that writers of the `targets` which are
+// gone (killed mid-write) left behind, and returns their paths. A writer holds an flock(2)
+// on its temporary until the rename, so a temporary of a live writer, in this process or
+// any other, is never removed; one whose lock cannot be taken (a file system without
+// locks) stays too. Each directory is read once.
+std::vector<std::string> remove_stale_temporaries(const std::vector<std::string>& targets);
 
 struct ExrWriteOptions {
     bool float32 = false;  // 32-bit float channels instead of half

@@ -9,12 +9,15 @@
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
 #include <ImfThreading.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <half.h>
 #include <png.h>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
@@ -432,6 +435,40 @@ TEST_F(ImageIoTest, FailedWriteRemovesTemporaryAndKeepsOldFile) {
     std::stringstream content;
     content << in.rdbuf();
     EXPECT_EQ(content.str(), "old");
+}
+
+// The temporaries of every target, in one directory or two, whose writers are gone; a
+// live writer's (it holds the lock), another file's and the targets themselves stay.
+TEST_F(ImageIoTest, StaleTemporariesOfEveryTargetAreRemoved) {
+    fs::create_directory(dir_ / "previews");
+    const auto touch = [](const fs::path& p) { std::ofstream(p) << "x"; };
+    const std::vector<fs::path> stale = {dir_ / ".f.0.exr.tmp.1.00000000000000aa",
+                                         dir_ / ".f.0.exr.tmp.2.00000000000000bb",
+                                         dir_ / ".f.0.png.tmp.1.00000000000000ab",
+                                         dir_ / "previews/.p.png.tmp.1.00000000000000cc"};
+    const fs::path live = dir_ / ".f.0.exr.tmp.3.00000000000000dd";
+    const std::vector<fs::path> kept = {dir_ / "f.0.exr",
+                                        dir_ / ".f.1.exr.tmp.1.00000000000000ee",
+                                        dir_ / ".f.0.exr.new.1.00000000000000ff",
+                                        dir_ / "previews/.f.0.exr.tmp.1.0000000000000011"};
+    for (const fs::path& p : stale) touch(p);
+    for (const fs::path& p : kept) touch(p);
+    touch(live);
+    const int fd = ::open(live.c_str(), O_RDWR | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+    std::vector<std::string> removed =
+        remove_stale_temporaries({(dir_ / "f.0.exr").string(), (dir_ / "f.0.png").string(),
+                                  (dir_ / "previews/p.png").string()});
+    ::close(fd);
+    std::sort(removed.begin(), removed.end());
+    std::vector<std::string> expected;
+    for (const fs::path& p : stale) expected.push_back(p.string());
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(removed, expected);
+    for (const fs::path& p : stale) EXPECT_FALSE(fs::exists(p)) << p;
+    for (const fs::path& p : kept) EXPECT_TRUE(fs::exists(p)) << p;
+    EXPECT_TRUE(fs::exists(live)) << "a live writer's temporary was removed";
 }
 
 TEST_F(ImageIoTest, AtomicWriteReplacesExistingFile) {
