@@ -8,6 +8,8 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include "core/thread_check.h"
 #include "core/version.h"
@@ -84,7 +86,7 @@ int run_command(const std::function<void()>& action, const std::string& command,
     }
 }
 
-std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run) {
+std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run, std::string_view only) {
     auto app = std::make_unique<CLI::App>(
         "octray renders Whitted-style ray-traced images (OpenEXR, with PNG previews).",
         "octray");
@@ -102,17 +104,21 @@ std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run) {
         "command.\n\n" +
         exit_code_help());
 
-    add_render_command(*app, run);
-    add_scene_command(*app, run);
-    add_compare_command(*app, run);
-    add_bench_command(*app, run);
-    add_verify_command(*app, run);
-    add_info_command(*app, run);
-    add_assemble_command(*app, run);
-    add_view_command(*app, run);
+    // In the order --help lists them; man and completion last (commands.h).
+    using Add = void (*)(CLI::App&, CommandRunner&);
+    static constexpr std::pair<std::string_view, Add> kCommands[] = {
+        {"render", add_render_command},     {"scene", add_scene_command},
+        {"compare", add_compare_command},   {"bench", add_bench_command},
+        {"verify", add_verify_command},     {"info", add_info_command},
+        {"assemble", add_assemble_command}, {"view", add_view_command}};
+    for (const auto& [name, add] : kCommands) {
+        if (name != only) continue;
+        add(*app, run);
+        return app;
+    }
+    for (const auto& [name, add] : kCommands) add(*app, run);
     add_man_command(*app, run);
     add_completion_command(*app, run);
-
     return app;
 }
 

@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace CLI {
 class App;
@@ -73,9 +74,13 @@ int run_command(const std::function<void()>& action, const std::string& command,
 // command line with the whole application and runs the chosen command; the exit status.
 int octray_main(int argc, char** argv);
 
-// The whole `octray` application, every command registered (with `run`) as main() parses
-// with it; tests walk its options.
-std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run);
+// The `octray` application, its commands registered (with `run`) as main() parses with
+// it; tests walk its options. Every command, or with `only` the name of one (main passes
+// its first argument), that command alone: a command line that starts with a command's
+// name parses within that command, and registering all of them took 0.35 ms of every
+// run (tools/README.md, "Commands in executables of their own"). man and completion,
+// which describe every command, and any other word get every command.
+std::unique_ptr<CLI::App> make_octray_app(CommandRunner& run, std::string_view only = {});
 
 void add_render_command(CLI::App& app, CommandRunner& run);
 void add_scene_command(CLI::App& app, CommandRunner& run);

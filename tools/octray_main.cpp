@@ -92,7 +92,8 @@ int octray_main(int argc, char** argv) {
 
     remember_command_line(argc, argv);  // for the commands in executables of their own
     CommandRunner run;
-    const std::unique_ptr<CLI::App> app_owner = make_octray_app(run);
+    const std::unique_ptr<CLI::App> app_owner =
+        make_octray_app(run, argc > 1 ? std::string_view(argv[1]) : std::string_view());
     CLI::App& app = *app_owner;
 
     std::vector<std::string> args(argv, argv + argc);

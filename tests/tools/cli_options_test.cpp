@@ -283,4 +283,36 @@ TEST_F(CliOptionsTest, TileSizesTakeDecimalDigitsOnly) {
               (std::vector<std::string>{"8x8", "16x4", "4096x1"}));
 }
 
+// main() parses a command line that starts with a command's name with that command alone
+// (make_octray_app's `only`): the same options, help and usage as in the whole
+// application. man and completion, which describe every command, and any other first word
+// get every command.
+TEST(CliApp, ACommandLineThatNamesACommandIsParsedWithThatCommandAlone) {
+    const auto all = [](const CLI::App& app) {
+        return app.get_subcommands([](const CLI::App*) { return true; });
+    };
+    CommandRunner run;
+    const std::unique_ptr<CLI::App> whole = make_octray_app(run);
+    const std::size_t every = all(*whole).size();
+    ASSERT_EQ(every, 10u);
+    for (const CLI::App* command : all(*whole)) {
+        const std::string name = command->get_name();
+        SCOPED_TRACE(name);
+        CommandRunner own_run;
+        const std::unique_ptr<CLI::App> own = make_octray_app(own_run, name);
+        if (name == "man" || name == "completion") {
+            EXPECT_EQ(all(*own).size(), every);
+            continue;
+        }
+        ASSERT_EQ(all(*own).size(), 1u);
+        EXPECT_EQ(all(*own).front()->get_name(), name);
+        EXPECT_EQ(all(*own).front()->help(), command->help());
+        EXPECT_EQ(all(*own).front()->get_options().size(), command->get_options().size());
+    }
+    for (const std::string word : {"", "help", "--help", "-V", "frobnicate", "Render"}) {
+        CommandRunner own_run;
+        EXPECT_EQ(all(*make_octray_app(own_run, word)).size(), every) << word;
+    }
+}
+
 }  // namespace
