@@ -24,12 +24,14 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -452,7 +454,9 @@ class OutputBytes {
 };
 
 // The chunks are encoded in parallel, a group at a time (so that a huge image never holds
-// all of its compressed chunks at once), and written in order between groups; with an
+// all of its compressed chunks at once), and each goes to the file as soon as every chunk
+// before it is there: the writes overlap the encoding of the chunks after them instead of
+// following it, and a written chunk's storage is free for the next one. With an
 // exr_thread_count() of 0 or 1 the calling thread encodes them alone.
 constexpr std::size_t kRawBytesPerGroup = std::size_t{16} << 20;
 
@@ -475,28 +479,50 @@ void write_exr_with_own_chunks(const std::string& path, const ChunkEncoder& enco
     // In the caller's arena, whose threads the frame's other work (its PNG) shares: a
     // task arena of its own here would wait for a worker the PNG holds.
     const bool parallel = Imf::globalThreadCount() > 1;
-    std::vector<SampleBytes> encoded;
     for (int first = 0; first < chunks;) {
         int last = first;
         for (std::size_t bytes = 0;
              last < chunks && (last == first || bytes < kRawBytesPerGroup); ++last)
             bytes += encoder.raw_bytes(last);
-        encoded.resize(static_cast<std::size_t>(last - first));
+        const auto count = static_cast<std::size_t>(last - first);
+        std::vector<SampleBytes> encoded(count);
+        const auto ready = std::make_unique<std::atomic<bool>[]>(count);
+        std::mutex writing;        // held by the thread writing chunks to the file
+        std::atomic<int> next{0};  // the group's next chunk to write (changed under writing)
+        const auto write_chunk = [&](int g) {
+            SampleBytes& data = encoded[static_cast<std::size_t>(g)];
+            const int k = first + g;
+            offsets[static_cast<std::size_t>(k)] = file.position();
+            file.write_le<std::int32_t>(first_line + encoder.first_line(k));
+            file.write_le<std::int32_t>(static_cast<std::int32_t>(data.size()));
+            file.write(data.data(), data.size());
+            data = SampleBytes();
+        };
+        // Writes the encoded chunks from `next` on, in order, unless another thread is
+        // writing (it looks again once it lets go, and the loop below writes what is left).
+        const auto write_ready = [&] {
+            for (;;) {
+                std::unique_lock lock(writing, std::try_to_lock);
+                if (!lock.owns_lock()) return;
+                for (int g = next.load(); g < last - first && ready[g].load(); next = ++g)
+                    write_chunk(g);
+                lock.unlock();
+                const int g = next.load();
+                if (g == last - first || !ready[g].load()) return;
+            }
+        };
         const auto encode_range = [&](const tbb::blocked_range<int>& range) {
-            for (int k = range.begin(); k != range.end(); ++k)
+            for (int k = range.begin(); k != range.end(); ++k) {
                 encoder.encode(k, encoded[static_cast<std::size_t>(k - first)]);
+                ready[k - first].store(true);
+                write_ready();
+            }
         };
         if (parallel)
             tbb::parallel_for(tbb::blocked_range<int>(first, last), encode_range);
         else
             encode_range(tbb::blocked_range<int>(first, last));
-        for (int k = first; k < last; ++k) {
-            const SampleBytes& data = encoded[static_cast<std::size_t>(k - first)];
-            offsets[static_cast<std::size_t>(k)] = file.position();
-            file.write_le<std::int32_t>(first_line + encoder.first_line(k));
-            file.write_le<std::int32_t>(static_cast<std::int32_t>(data.size()));
-            file.write(data.data(), data.size());
-        }
+        for (int g = next.load(); g < last - first; ++g) write_chunk(g);
         first = last;
     }
     file.seek(table_position);
