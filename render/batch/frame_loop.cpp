@@ -2,8 +2,10 @@
 
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_invoke.h>
+#include <oneapi/tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <ctime>
@@ -93,26 +95,38 @@ struct FrameFiles {
     ExrAttributes exr_attributes;
     std::shared_ptr<const Image> aovs;  // null: none
 
-    void write_exr_file(const Image& pixels) const {
+    void write_exr_file(const Image& pixels, const std::function<void()>& on_read) const {
         ExrSources sources = exr_sources(pixels, exr_options, exr_attributes);
         if (aovs)
             append_aov_sources(sources, *aovs,
                                exr_options.float32 ? PixelFormat::float32 : PixelFormat::half);
+        sources.on_read = on_read;
         write_exr(exr_path, sources);
     }
     // Both are written atomically, each on its own; the frame counts as finished only
-    // when both are (resume.h).
-    void write(const Image& pixels) const {
+    // when both are (resume.h). `spent` (the run's last frame, whose storage serves no
+    // next frame; the same image as `pixels`) is freed as soon as both files have read
+    // the pixels, by a task of the arena while the files are finished (closed, renamed):
+    // freeing a 1280x720 frame took 0.9 ms after its files, with the other core idle.
+    void write(const Image& pixels, Image* spent = nullptr) const {
+        std::atomic<int> readers{(exr_path.empty() ? 0 : 1) + (png_path.empty() ? 0 : 1)};
+        tbb::task_group freeing;
+        std::function<void()> on_read;
+        if (spent != nullptr)
+            on_read = [&] {
+                if (--readers == 0) freeing.run([spent] { *spent = Image(); });
+            };
         if (exr_path.empty()) {
-            write_png_preview(png_path, pixels);
+            write_png_preview(png_path, pixels, on_read);
         } else if (png_path.empty()) {
-            write_exr_file(pixels);
+            write_exr_file(pixels, on_read);
         } else {
             // The preview is encoded while the EXR's chunks are compressed: on 2 cores the
             // two files take the time of the longer one.
-            tbb::parallel_invoke([&] { write_exr_file(pixels); },
-                                 [&] { write_png_preview(png_path, pixels); });
+            tbb::parallel_invoke([&] { write_exr_file(pixels, on_read); },
+                                 [&] { write_png_preview(png_path, pixels, on_read); });
         }
+        freeing.wait();  // (a write that throws waits for it in the destructor)
     }
 };
 
@@ -123,7 +137,8 @@ struct PendingWrite {
     std::string claimed;  // its placeholder, released if the write fails
     Clock::time_point started;
     FrameFiles files;
-    Image pixels;  // the render's R, G, B (the preview's source)
+    Image pixels;       // the render's R, G, B (the preview's source)
+    bool last = false;  // the run's last frame: `pixels` go once the files have read them
     double seconds = 0.0;
     std::exception_ptr report_error;  // what reporting it threw, rethrown when joined
     std::thread writer;
@@ -133,9 +148,11 @@ class BatchRunner {
   public:
     using Account = std::function<void(const FrameResult&)>;
 
-    BatchRunner(const std::vector<BatchInput>& scenes, const BatchSettings& settings,
-                BatchObserver& observer, const std::atomic<bool>* cancel, Account account)
+    BatchRunner(const std::vector<BatchInput>& scenes, std::size_t jobs,
+                const BatchSettings& settings, BatchObserver& observer,
+                const std::atomic<bool>* cancel, Account account)
         : scenes_(scenes),
+          jobs_(jobs),
           settings_(settings),
           observer_(observer),
           cancel_(cancel),
@@ -172,6 +189,7 @@ class BatchRunner {
     void write_behind(PendingWrite& p);
 
     const std::vector<BatchInput>& scenes_;
+    std::size_t jobs_;  // the run's job count: job `jobs_` (1-based) is the last
     const BatchSettings& settings_;
     BatchObserver& observer_;
     const std::atomic<bool>* cancel_;
@@ -271,7 +289,7 @@ void BatchRunner::write_behind(PendingWrite& p) {
     const auto write_started = Clock::now();
     std::exception_ptr error;
     try {
-        p.files.write(p.pixels);
+        p.files.write(p.pixels, p.last ? &p.pixels : nullptr);
     } catch (...) {
         error = std::current_exception();
     }
@@ -426,10 +444,11 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
         const auto aovs =
             std::make_shared<const Image>(renderer_->aovs(options, settings_.render.aovs));
         double write_seconds = 0.0;
-        const auto timed_write = [&](const RenderResult& r, int samples_so_far) {
+        const auto timed_write = [&](const RenderResult& r, int samples_so_far,
+                                     Image* spent = nullptr) {
             const auto write_started = Clock::now();
             FrameFiles f = files(scene, job, pose, r, aovs, samples_so_far);
-            f.write(r.image);
+            f.write(r.image, spent);
             write_seconds +=
                 std::chrono::duration<double>(Clock::now() - write_started).count();
         };
@@ -461,6 +480,7 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
             p->files = files(scene, job, pose, result, aovs, posed.image.spp);
             p->seconds = std::chrono::duration<double>(Clock::now() - write_started).count();
             p->pixels = std::move(result.image);
+            p->last = index == jobs_;
             out.report.write_seconds = write_seconds;
             p->result = std::move(out);
             p->work = work;
@@ -470,7 +490,8 @@ bool BatchRunner::run(std::size_t index, const BatchJob& job) {
             pending_ = std::move(p);
             return true;
         }
-        timed_write(result, posed.image.spp);
+        // The run's last frame serves no next one as its storage.
+        timed_write(result, posed.image.spp, index == jobs_ ? &result.image : nullptr);
         spare_frame_ = std::move(result.image);
         out.report.write_seconds = write_seconds;
         out.report.outcome = FrameOutcome::rendered;
@@ -542,7 +563,7 @@ BatchSummary run_batch(const std::vector<BatchInput>& scenes, const std::vector<
     };
     const auto started = Clock::now();
     {
-        BatchRunner runner(scenes, settings, observer, cancel, account);
+        BatchRunner runner(scenes, jobs.size(), settings, observer, cancel, account);
         for (std::size_t k = 0; k < jobs.size(); ++k) {
             if (cancelled()) {
                 summary.not_started = jobs.size() - k;

@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -461,7 +462,8 @@ class OutputBytes {
 constexpr std::size_t kRawBytesPerGroup = std::size_t{16} << 20;
 
 void write_exr_with_own_chunks(const std::string& path, const ChunkEncoder& encoder,
-                               int first_line, const Imf::Header& header) {
+                               int first_line, const Imf::Header& header,
+                               const std::function<void()>& on_read) {
     header.sanityCheck();
     Imf::StdOSStream head;
     MagicAndVersion().write(head, header);
@@ -522,6 +524,8 @@ void write_exr_with_own_chunks(const std::string& path, const ChunkEncoder& enco
             tbb::parallel_for(tbb::blocked_range<int>(first, last), encode_range);
         else
             encode_range(tbb::blocked_range<int>(first, last));
+        // Every chunk encoded: the sources are read no more.
+        if (last == chunks && on_read) on_read();
         for (int g = next.load(); g < last - first; ++g) write_chunk(g);
         first = last;
     }
@@ -534,7 +538,7 @@ void write_exr_file(const std::string& path, const Image& image) {
     const Imf::Header header = make_header(image);
     if (packs_chunks_itself(image.compression)) {
         const ChunkEncoder encoder(sources_of(image), image.data_window, image.compression);
-        write_exr_with_own_chunks(path, encoder, image.data_window.y0, header);
+        write_exr_with_own_chunks(path, encoder, image.data_window.y0, header, {});
     } else {
         write_exr_with_openexr(path, image, header);
     }
@@ -689,12 +693,15 @@ void write_exr(const std::string& path, const ExrSources& sources) {
     }
     if (!packs_chunks_itself(sources.compression)) {
         // OpenEXR packs these: the image is made, converted, and written as it is.
-        write_exr(path, exr_image_of(sources));
+        const Image image = exr_image_of(sources);
+        if (sources.on_read) sources.on_read();
+        write_exr(path, image);
         return;
     }
     write_file_atomically(path, [&](const std::string& tmp) {
         const ChunkEncoder encoder(sources.channels, sources.data_window, sources.compression);
-        write_exr_with_own_chunks(tmp, encoder, sources.data_window.y0, make_header(shape));
+        write_exr_with_own_chunks(tmp, encoder, sources.data_window.y0, make_header(shape),
+                                  sources.on_read);
     });
 }
 

@@ -94,6 +94,10 @@ struct ExrSources {
     ExrCompression compression = ExrCompression::zip;
     ExrAttributes attributes;
     std::vector<ExrChannelSource> channels;
+    // If set, called once as soon as the writer reads the channels' samples no more (the
+    // last chunk encoded), while the file is still being finished: their storage may go
+    // then. Not called where the write fails before that.
+    std::function<void()> on_read;
 };
 
 // The sources of a render's image (float32 R, G, B) as make_exr_image converts it: each
@@ -112,7 +116,10 @@ void write_exr(const std::string& path, const ExrSources& sources);
 
 // An 8-bit sRGB preview of a render's image (float32 R, G, B): linear values clamped to
 // [0, 1], sRGB-encoded. Throws IoError, also for an image that is not a render's.
-void write_png_preview(const std::string& path, const Image& render);
+// `on_read`, if set, is called once as soon as the render's samples are read no more (the
+// PNG's bands encoded), before its file is written; not where the write fails before.
+void write_png_preview(const std::string& path, const Image& render,
+                       const std::function<void()>& on_read = {});
 
 // A linear value clamped to [0, 1] (NaN and negatives to 0) through the sRGB OETF
 // (IEC 61966-2-1), rounded to 8 bits: what the PNG preview stores. Found in a table of the

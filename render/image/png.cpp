@@ -390,7 +390,8 @@ void require_render_image(const std::string& path, const Image& image) {
 
 }  // namespace
 
-void write_png_preview(const std::string& path, const Image& render) {
+void write_png_preview(const std::string& path, const Image& render,
+                       const std::function<void()>& on_read) {
     require_render_image(path, render);
     const std::size_t width = static_cast<std::size_t>(render.width());
     const std::string bytes = encode_png(
@@ -402,6 +403,7 @@ void write_png_preview(const std::string& path, const Image& render) {
             return static_cast<const std::uint8_t*>(scratch);
         },
         SrgbChunks::srgb_gama_chrm);
+    if (on_read) on_read();
     write_file_atomically(path, [&](const std::string& tmp) { write_bytes(tmp, bytes); });
 }
 

@@ -238,6 +238,60 @@ TEST(ExrOwnChunks, AnImageOfSeveralChunkGroupsReadsBack) {
     fs::remove_all(dir);
 }
 
+// on_read (ExrSources, write_png_preview) comes once, as soon as the writer reads the
+// pixels no more: the frame loop frees the run's last frame then, while its files are
+// finished. Pixels overwritten at that moment must not reach the files, whichever way the
+// chunks are packed (octray's own, or OpenEXR's for PIZ) and on any thread count.
+TEST(ExrOwnChunks, OnReadComesOnceWhenThePixelsAreReadNoMore) {
+    const fs::path dir = test_dir();
+    Image render;
+    render.display_window = render.data_window = PixelRect{0, 0, 211, 157};
+    const std::size_t n = render.data_window.pixel_count();
+    std::vector<float> values(n);
+    for (const char* name : {"R", "G", "B"}) {
+        for (std::size_t k = 0; k < n; ++k)
+            values[k] =
+                static_cast<float>((k * static_cast<std::size_t>(name[0])) % 1013) / 997.0f;
+        render.channels.push_back(make_channel(name, PixelFormat::float32, values.data(), n));
+    }
+    const auto spoil = [](Image& image) {
+        for (ImageChannel& c : image.channels)
+            std::fill(c.samples.begin(), c.samples.end(), static_cast<unsigned char>(0x7f));
+    };
+    for (const ExrCompression compression :
+         {ExrCompression::zip, ExrCompression::none, ExrCompression::piz}) {
+        for (const int threads : {0, 2}) {
+            SCOPED_TRACE(std::string(to_string(compression)) + ", " + std::to_string(threads) +
+                         " threads");
+            const int before = exr_thread_count();
+            set_exr_thread_count(threads);
+            write_exr((dir / "reference.exr").string(),
+                      exr_sources(render, {false, compression}));
+            Image copy = render;
+            int calls = 0;
+            ExrSources sources = exr_sources(copy, {false, compression});
+            sources.on_read = [&] {
+                ++calls;
+                spoil(copy);
+            };
+            write_exr((dir / "spoiled.exr").string(), sources);
+            set_exr_thread_count(before);
+            EXPECT_EQ(calls, 1);
+            EXPECT_TRUE(file_bytes(dir / "reference.exr") == file_bytes(dir / "spoiled.exr"));
+        }
+    }
+    write_png_preview((dir / "reference.png").string(), render);
+    Image copy = render;
+    int calls = 0;
+    write_png_preview((dir / "spoiled.png").string(), copy, [&] {
+        ++calls;
+        spoil(copy);
+    });
+    EXPECT_EQ(calls, 1);
+    EXPECT_TRUE(file_bytes(dir / "reference.png") == file_bytes(dir / "spoiled.png"));
+    fs::remove_all(dir);
+}
+
 // A disk that fills up in the middle of an EXR: the message carries the OS's reason.
 // RLIMIT_FSIZE makes write() fail with EFBIG past the limit, for this process only
 // (SIGXFSZ, whose default action would kill the process, is ignored meanwhile). With
