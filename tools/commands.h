@@ -70,8 +70,9 @@ std::string help_hint(const std::string& command);
 int run_command(const std::function<void()>& action, const std::string& command,
                 int usage_status);
 
-// main() of both executables, octray and octray-view (tools/view_launch.h): parses the
-// command line with the whole application and runs the chosen command; the exit status.
+// main() of the executables octray, octray-view and octray-bench (tools/own_executable.h):
+// parses the command line with the application make_octray_app makes for its first word and
+// runs the chosen command; the exit status.
 int octray_main(int argc, char** argv);
 
 // The `octray` application, its commands registered (with `run`) as main() parses with

@@ -1,6 +1,7 @@
 // octray: the command line. Thin by design: parse, call the library, report
-// (tools/octray_main.cpp). `octray view` runs the viewer's executable, octray-view
-// (tools/view_launch.h), so that this one loads no HTTP or TLS library.
+// (tools/octray_main.cpp). `octray view` and `octray bench` run executables of their own,
+// octray-view and octray-bench (tools/own_executable.h), so that this one loads no HTTP or
+// TLS library and no Embree.
 
 #include "tools/commands.h"
 

@@ -144,8 +144,7 @@ std::vector<std::string> remove_stale_temporaries(const std::vector<std::string>
         if (stream == nullptr) continue;
         while (const dirent* entry = ::readdir(stream)) {
             const std::string_view name(entry->d_name);
-            if (name.size() < 2 || name[0] != '.' ||
-                std::none_of(names.begin(), names.end(), [&](const std::string& prefix) {
+            if (std::none_of(names.begin(), names.end(), [&](const std::string& prefix) {
                     return name.starts_with(prefix);
                 }))
                 continue;

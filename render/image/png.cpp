@@ -251,7 +251,7 @@ std::uint8_t srgb8_by_formula(float linear) {
 namespace detail {
 
 SrgbTable::SrgbTable() {
-    threshold[0] = -std::numeric_limits<float>::infinity();
+    float threshold[257];  // [256]: +inf, a sentinel
     threshold[256] = std::numeric_limits<float>::infinity();
     for (int v = 1; v < 256; ++v) {
         std::uint32_t lo = 0, hi = kOneBits;  // formula(lo) < v <= formula(hi)

@@ -10,13 +10,13 @@
 
 namespace octray::detail {
 
-// threshold[v] (v = 1 ... 255): the smallest float that srgb8_formula maps to v or more.
-// The formula never decreases as its argument grows, so the byte of x is the number of
-// thresholds at or below x. Each is found by bisection over the bit patterns of the
-// floats in [0, 1], which are ordered as their values. To find a byte without a search,
-// the floats of [0, 1] are cut into buckets by their top 16 bits (1/128 of a power of two
-// each), and within a bucket the byte steps up at most once (the OETF's slope times a
-// bucket's width stays below one step, which the constructor checks). A bucket's word
+// The byte's thresholds (the constructor's): threshold[v] (v = 1 ... 255) is the smallest
+// float that srgb8_formula maps to v or more. The formula never decreases as its argument
+// grows, so the byte of x is the number of thresholds at or below x. Each is found by bisection
+// over the bit patterns of the floats in [0, 1], which are ordered as their values. To find a
+// byte without a search, the floats of [0, 1] are cut into buckets by their top 16 bits (1/128
+// of a power of two each), and within a bucket the byte steps up at most once (the OETF's slope
+// times a bucket's width stays below one step, which the constructor checks). A bucket's word
 // holds the byte at its first float (bits 17 and up) and where in the bucket the byte
 // steps up (bits 0 ... 16): the low 16 bits of that threshold, whose top 16 bits are the
 // bucket's own, or 0x10000, above every float of the bucket, where it does not. A float's
@@ -27,7 +27,6 @@ struct SrgbTable {
     static constexpr std::uint32_t kOneBits = 0x3F800000u;  // 1.0f
     static constexpr std::uint32_t kBuckets = (kOneBits >> 16) + 1;
     static constexpr std::uint32_t kNoStep = 0x10000u;
-    float threshold[257];  // [0]: -inf, [256]: +inf, sentinels
     std::uint32_t bucket_word[kBuckets];
     SrgbTable();  // checks its own bucket rule: throws std::logic_error if broken
 };
