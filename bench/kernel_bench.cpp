@@ -203,9 +203,11 @@ void compaction(benchmark::State& state, CompactFn packed) {
 
 // ---- Shading -------------------------------------------------------------------------------
 
-// One generation of whitted's primary rays: closest hits once, then shade() timed.
-void shade_packet(benchmark::State& state, Isa isa) {
-    Scene scene = load_scene("whitted,width=64,height=64");
+// One generation of a scene's primary rays: closest hits once, then shade() timed. whitted
+// mixes a plane and spheres of four materials in its packets; random:1024's spheres share
+// one material.
+void shade_packet(benchmark::State& state, const std::string& spec, Isa isa) {
+    Scene scene = load_scene(spec + ",width=64,height=64");
     Workbench w(scene);
     const kernels::KernelTable& k = kernel_table(isa);
     const std::uint32_t n = w.rays.count;
@@ -319,9 +321,12 @@ int main(int argc, char** argv) {
             ->Arg(50)
             ->Arg(90);
     }
-    for (Isa isa : isas)
-        reg(std::string("shade/whitted/packet8-") + isa_name(isa),
-            [isa](benchmark::State& s) { shade_packet(s, isa); });
+    for (const char* spec : {"whitted", "random:1024"})
+        for (Isa isa : isas)
+            reg(std::string("shade/") + spec + "/packet8-" + isa_name(isa),
+                [spec = std::string(spec), isa](benchmark::State& s) {
+                    shade_packet(s, spec, isa);
+                });
     reg("tile16x16/whitted/scalar", [](benchmark::State& s) {
         tile_end_to_end(s, false, Isa::automatic);
     })->UseRealTime();
