@@ -4,10 +4,11 @@
 //
 // The BVH traversal takes 16 rays at a time, one 16-lane register per packet: two of the
 // stream's 8-ray packets share every node visit and every leaf's sphere loads
-// (OCTRAY_TRAVERSAL_ARCH, kernels/bvh/bvh_packet.h), and so does brute force; shading
-// takes 16 rays per register while 16 remain (OCTRAY_SHADE_ARCH, kernels/stream/shading.h).
-// Node tests (8 children) and camera rays stay 8 lanes wide: measured, AVX-512 encodings
-// of the 8-lane kernels gained nothing (docs/performance-log.md).
+// (OCTRAY_TRAVERSAL_ARCH, kernels/bvh/bvh_packet.h), and so do brute force and the beams'
+// slopes; shading and camera rays take 16 rays per register while 16 remain
+// (OCTRAY_SHADE_ARCH, kernels/stream/shading.h, kernels/stream/camera_rays.h). Node tests
+// (8 children) stay 8 lanes wide: measured, AVX-512 encodings of the 8-lane kernels gained
+// nothing (docs/performance-log.md).
 
 #define OCTRAY_KERNEL_NAMESPACE avx512
 #define OCTRAY_TRAVERSAL_ARCH xsimd::avx512f

@@ -54,8 +54,8 @@ namespace octray::kernels::OCTRAY_KERNEL_NAMESPACE {
 // AVX-512 one: xsimd::avx512f) traverses 16 rays at a time, one register per packet: two
 // of the stream's 8-ray packets, adjacent pixels, share every node visit and leaf load,
 // as embree's 16-wide packets do. Its node tests stay 8 lanes wide (the node's 8
-// children, in the kernel's Arch), as does its camera kernel. Without it a
-// traversal packet is the stream's packet, in registers of the kernel's Arch.
+// children, in the kernel's Arch). Without it a traversal packet is the stream's packet,
+// in registers of the kernel's Arch.
 #ifdef OCTRAY_TRAVERSAL_ARCH
 template <class Arch>
 using RayArch = OCTRAY_TRAVERSAL_ARCH;

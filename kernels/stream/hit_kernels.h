@@ -63,7 +63,7 @@ void closest_hit(const SceneView& scene, const RayStream& rays, std::uint32_t co
     for (std::uint32_t group = 0; group < count; group += kBeamRays) {
         // A group of rays from one origin is a beam (bvh_beam.h).
         const std::uint32_t n = count - group < kBeamRays ? count - group : kBeamRays;
-        const bool in_beam = beam_for_group<FN>(s, rays, group, n, count, beam, st);
+        const bool in_beam = beam_for_group<F, FN>(s, rays, group, n, count, beam, st);
         if (!in_beam && s.sphere_count <= s.bvh_brute_force_max_spheres) {
             // A small BVH: rays that form no beam test every sphere (SceneView).
             closest_hit_all<Arch>(s, stream_from(rays, group), n, t_min,
@@ -213,12 +213,13 @@ void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t cou
     BvhPacket p;
     BvhStacks st;
     if (count < kShadowSortMin || s.sphere_count < s.bvh_shadow_sort_min_spheres) {
-        using FN = xsimd::batch<float, Arch>;
+        using F = xsimd::batch<float, RayArch<Arch>>;  // the rays'
+        using FN = xsimd::batch<float, Arch>;          // the node tests'
         Beam beam;
         for (std::uint32_t group = 0; group < count; group += kBeamRays) {
             // Rays towards one point light from one tile are a beam (bvh_beam.h).
             const std::uint32_t n = count - group < kBeamRays ? count - group : kBeamRays;
-            const bool in_beam = beam_for_group<FN>(s, rays, group, n, count, beam, st);
+            const bool in_beam = beam_for_group<F, FN>(s, rays, group, n, count, beam, st);
             for (std::uint32_t base = group; base < group + n; base += kTraversalWidth) {
                 const std::uint32_t live = live_bits(base, count);
                 const std::uint32_t bits =
