@@ -28,14 +28,22 @@ F floor_parity(const F& x) {
     return f - F(2.0f) * xsimd::floor(f * F(0.5f));
 }
 
+// Background along a direction already normalised (reference: ReferenceTracer::background,
+// which normalises first).
+template <class F>
+V3<F> background_unit(const SceneView& s, const V3<F>& unit) {
+    if (s.background == BackgroundKind::constant) return broadcast<F>(s.bg_color);
+    const F t = F(0.5f) * (dot(unit, broadcast<F>(s.bg_up)) + F(1.0f));
+    const V3<F> bottom = broadcast<F>(s.bg_bottom), top = broadcast<F>(s.bg_top);
+    // mix(a, b, t) = a + (b - a) * t
+    return add(bottom, mul(sub(top, bottom), t));
+}
+
 // Background along a direction (reference: ReferenceTracer::background).
 template <class F>
 V3<F> background(const SceneView& s, const V3<F>& direction) {
     if (s.background == BackgroundKind::constant) return broadcast<F>(s.bg_color);
-    const F t = F(0.5f) * (dot(normalize(direction), broadcast<F>(s.bg_up)) + F(1.0f));
-    const V3<F> bottom = broadcast<F>(s.bg_bottom), top = broadcast<F>(s.bg_top);
-    // mix(a, b, t) = a + (b - a) * t
-    return add(bottom, mul(sub(top, bottom), t));
+    return background_unit(s, normalize(direction));
 }
 
 // Shading (reference: ReferenceTracer::shade and trace's miss branch). Per ray of the
@@ -78,16 +86,19 @@ template <class Arch>
     const V3<F> o = load3<F>(rays.ox, rays.oy, rays.oz, base);
     const V3<F> d = load3<F>(rays.dx, rays.dy, rays.dz, base);
     const V3<F> weight = load3<F>(rays.wr, rays.wg, rays.wb, base);
-    // What a miss sees (not needed when every lane hit).
-    const V3<F> sky = all_hit ? V3<F>{zero, zero, zero} : background(s, d);
     if (xsimd::none(hit)) {
-        store3(sky, sc.local_r, sc.local_g, sc.local_b, base);
+        store3(background(s, d), sc.local_r, sc.local_g, sc.local_b, base);
         store3(V3<F>{zero, zero, zero}, sc.tail_reflect_r, sc.tail_reflect_g, sc.tail_reflect_b,
                base);
         store3(V3<F>{zero, zero, zero}, sc.tail_refract_r, sc.tail_refract_g, sc.tail_refract_b,
                base);
         return;
     }
+
+    // The ray's unit direction: the shading's V^, and what a missing lane sees along it
+    // (not needed when every lane hit); normalised once for both.
+    const V3<F> v_hat = normalize(d);
+    const V3<F> sky = all_hit ? V3<F>{zero, zero, zero} : background_unit(s, v_hat);
 
     // Hit point and geometric normal (reference: ReferenceTracer::intersect): sphere
     // normalize(P - c), or -V^ for a hit at the very center; plane N.
@@ -110,7 +121,6 @@ template <class Arch>
         plane_n = {gather<F>(record + kRecordNx, records),
                    gather<F>(record + kRecordNy, records),
                    gather<F>(record + kRecordNz, records)};
-    const V3<F> v_hat = normalize(d);
     const V3<F> pc = sub(p, center);
     const V3<F> sphere_n = select(dot(pc, pc) > zero, normalize(pc), neg(v_hat));
     const V3<F> normal = select(is_plane, plane_n, sphere_n);
