@@ -13,9 +13,10 @@
 namespace octray {
 
 struct CpuFeatures {
-    bool avx2 = false;  // AVX2
-    bool f16c = false;  // F16C: float to half and back
-    bool sha = false;   // the SHA extensions, with the SSSE3 and SSE4.1 their code uses
+    bool avx2 = false;    // AVX2
+    bool f16c = false;    // F16C: float to half and back
+    bool sha = false;     // the SHA extensions, with the SSSE3 and SSE4.1 their code uses
+    bool avx512 = false;  // AVX-512 F, with the ZMM registers saved by the OS
 };
 
 inline CpuFeatures read_cpu_features() {
@@ -24,16 +25,18 @@ inline CpuFeatures read_cpu_features() {
     if (__get_cpuid(1, &eax, &ebx, &ecx, &edx) == 0) return f;
     const bool ssse3 = (ecx & bit_SSSE3) != 0, sse41 = (ecx & bit_SSE4_1) != 0;
     const bool avx = (ecx & bit_AVX) != 0, f16c = (ecx & bit_F16C) != 0;
-    bool ymm_saved = false;
+    bool ymm_saved = false, zmm_saved = false;
     if (avx && (ecx & bit_OSXSAVE) != 0) {
         unsigned xcr0_lo = 0, xcr0_hi = 0;
         __asm__("xgetbv" : "=a"(xcr0_lo), "=d"(xcr0_hi) : "c"(0));
-        ymm_saved = (xcr0_lo & 0x6u) == 0x6u;  // the XMM and YMM state
+        ymm_saved = (xcr0_lo & 0x6u) == 0x6u;    // the XMM and YMM state
+        zmm_saved = (xcr0_lo & 0xe6u) == 0xe6u;  // and the opmask and ZMM state
     }
     f.f16c = f16c && ymm_saved;
     if (__get_cpuid_count(7, 0, &eax, &ebx, &ecx, &edx) == 0) return f;
     f.avx2 = (ebx & bit_AVX2) != 0 && ymm_saved;
     f.sha = (ebx & bit_SHA) != 0 && ssse3 && sse41;
+    f.avx512 = (ebx & bit_AVX512F) != 0 && zmm_saved;
     return f;
 }
 
