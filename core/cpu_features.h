@@ -1,10 +1,11 @@
 #pragma once
 // What this CPU runs of the instructions octray's hand-written intrinsics use outside the
 // kernels (whose ISA is chosen through xsimd: kernels/dispatch.h), read from CPUID once per
-// process; for the VEX-encoded ones, also whether the OS saves the YMM registers (XCR0).
-// One reading for every such choice: the preview's sRGB gathers (render/image/png.cpp), the
-// float-to-half conversion (render/image/half_bits.cpp), the scene digest
-// (render/batch/digest.cpp) and the BVH builder's AVX binning (render/prepare/bvh_sah.cpp).
+// process; for the VEX- and EVEX-encoded ones, also whether the OS saves the YMM and ZMM
+// registers (XCR0). One reading for every such choice: the preview's sRGB gathers
+// (render/image/png.cpp), the float-to-half conversion (render/image/half_bits.cpp), the
+// scene digest (render/batch/digest.cpp), the BVH builder's AVX binning
+// (render/prepare/bvh_sah.cpp) and the width of a tile's row stores (render/stream_row.h).
 // __builtin_cpu_supports would do, but clang 14 (the asan preset's compiler) knows neither
 // "f16c" nor "sha".
 
