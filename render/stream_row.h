@@ -60,8 +60,8 @@ struct StreamRow<16> {
     }
 };
 
-// The loop, compiled once per width with that width's instructions (`Target` names them:
-// the attribute must sit on the function whose loop uses the registers).
+// The loop, written once and compiled three times, each inside a function whose target
+// attribute gives it its width's instructions (a template cannot carry the attribute).
 #define OCTRAY_STREAM_ROW_BODY(kWidth)                                                         \
     const bool divide = divisor != 1.0f;                                                       \
     const auto sample = [&](int x) { return divide ? in[x] / divisor : in[x]; };               \
