@@ -23,70 +23,35 @@ namespace octray {
 // with SSE2. A line's non-temporal stores hold a fill buffer until the line is complete,
 // so fewer, wider stores free it sooner: the rows' writing took 6.4 % of a random:1024
 // frame in 16-byte stores, 4.9 % in 32-byte and 3.9 % in 64-byte ones (an Intel Xeon, the
-// same run's profiles; docs/performance-log.md, session 29). kWidth is the floats per
-// store; the function's target attribute gives it the instructions.
-template <int kWidth>
-struct StreamRow;
-
+// same run's profiles; docs/performance-log.md, session 29).
 #if defined(__x86_64__)
-template <>
-struct StreamRow<4> {
-    static __m128 load(const float* p) { return _mm_loadu_ps(p); }
-    static __m128 div(__m128 v, float d) { return _mm_div_ps(v, _mm_set1_ps(d)); }
-    static void stream(float* p, __m128 v) { _mm_stream_ps(p, v); }
-};
-template <>
-struct StreamRow<8> {
-    __attribute__((target("avx2"))) static __m256 load(const float* p) {
-        return _mm256_loadu_ps(p);
-    }
-    __attribute__((target("avx2"))) static __m256 div(__m256 v, float d) {
-        return _mm256_div_ps(v, _mm256_set1_ps(d));
-    }
-    __attribute__((target("avx2"))) static void stream(float* p, __m256 v) {
-        _mm256_stream_ps(p, v);
-    }
-};
-template <>
-struct StreamRow<16> {
-    __attribute__((target("avx512f"))) static __m512 load(const float* p) {
-        return _mm512_loadu_ps(p);
-    }
-    __attribute__((target("avx512f"))) static __m512 div(__m512 v, float d) {
-        return _mm512_div_ps(v, _mm512_set1_ps(d));
-    }
-    __attribute__((target("avx512f"))) static void stream(float* p, __m512 v) {
-        _mm512_stream_ps(p, v);
-    }
-};
-
 // The loop, written once and compiled three times, each inside a function whose target
-// attribute gives it its width's instructions (a template cannot carry the attribute).
-#define OCTRAY_STREAM_ROW_BODY(kWidth)                                                         \
+// attribute gives it its width's instructions (a template cannot carry the attribute):
+// kWidth floats a store, the width's load, division, non-temporal store and broadcast.
+#define OCTRAY_STREAM_ROW_BODY(kWidth, load, div, stream, set1)                                \
     const bool divide = divisor != 1.0f;                                                       \
     const auto sample = [&](int x) { return divide ? in[x] / divisor : in[x]; };               \
-    using Row = StreamRow<kWidth>;                                                             \
     int x = 0;                                                                                 \
     for (; x < n && (reinterpret_cast<std::uintptr_t>(out + x) & (4u * kWidth - 1)) != 0; ++x) \
         out[x] = sample(x);                                                                    \
     if (divide) {                                                                              \
         for (; x + kWidth <= n; x += kWidth)                                                   \
-            Row::stream(out + x, Row::div(Row::load(in + x), divisor));                        \
+            stream(out + x, div(load(in + x), set1(divisor)));                                 \
     } else {                                                                                   \
-        for (; x + kWidth <= n; x += kWidth) Row::stream(out + x, Row::load(in + x));          \
+        for (; x + kWidth <= n; x += kWidth) stream(out + x, load(in + x));                    \
     }                                                                                          \
     for (; x < n; ++x) out[x] = sample(x);
 
 inline void stream_row_sse2(float* out, const float* in, int n, float divisor) {
-    OCTRAY_STREAM_ROW_BODY(4)
+    OCTRAY_STREAM_ROW_BODY(4, _mm_loadu_ps, _mm_div_ps, _mm_stream_ps, _mm_set1_ps)
 }
 __attribute__((target("avx2"))) inline void stream_row_avx2(float* out, const float* in, int n,
                                                             float divisor) {
-    OCTRAY_STREAM_ROW_BODY(8)
+    OCTRAY_STREAM_ROW_BODY(8, _mm256_loadu_ps, _mm256_div_ps, _mm256_stream_ps, _mm256_set1_ps)
 }
 __attribute__((target("avx512f"))) inline void stream_row_avx512(float* out, const float* in,
                                                                  int n, float divisor) {
-    OCTRAY_STREAM_ROW_BODY(16)
+    OCTRAY_STREAM_ROW_BODY(16, _mm512_loadu_ps, _mm512_div_ps, _mm512_stream_ps, _mm512_set1_ps)
 }
 #undef OCTRAY_STREAM_ROW_BODY
 #endif
