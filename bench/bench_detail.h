@@ -28,9 +28,9 @@ namespace octray::bench::detail {
 // One way of tracing a ray set into a hit set.
 using Tracer = std::function<void(const RaySet&, HitSet&)>;
 
-// The set traced in repetitions (repeat_timed); the hits of the last run stay in `hits`.
-Repetitions time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits,
-                      const BenchOptions& o);
+// One run of `trace` over the set, for repeat_timed(_in_rounds): it returns the run's wall
+// seconds; the hits of the last run stay in `hits`.
+std::function<double()> timed_trace(const Tracer& trace, const RaySet& rays, HitSet& hits);
 
 // octray's packet kernels over the set: closest_hit, or any_hit into the occluded flags.
 Tracer octray_simd_tracer(tbb::task_arena& arena, const kernels::KernelTable& table,

@@ -403,50 +403,70 @@ struct RaySetRun {
     const RaySet& set;
 };
 
-// Times `trace` on the set, validates its hits against `truth` and adds the row.
-void measure_ray_set(BenchRun& run, const RaySetRun& rs, BenchRow row, const Tracer& trace,
-                     const OracleHits& truth, const ValidationRule& rule, bool octray_any_hit) {
+// A row of a ray set waiting for its repetitions: how it traces, and what its hits are
+// checked against.
+struct RaySetRow {
+    BenchRow row;
+    detail::Tracer trace;
+    const OracleHits* truth;
+    ValidationRule rule;
+    bool octray_any_hit;  // octray's any_hit flags, mapped to hits after timing
+};
+
+// Times every row of the set in rounds (repeat_timed_in_rounds: octray's and Embree's
+// repetitions alternate), then validates each row's hits against its truth and adds it.
+void measure_ray_set_rows(BenchRun& run, const RaySetRun& rs, std::vector<RaySetRow> rows) {
     const RaySet& set = rs.set;
     const Workload w = rs.workload;
-    HitSet hits;
-    hits.resize(static_cast<std::uint32_t>(set.ox.size()));
-    row.rays = set.count;
-    (w == Workload::primary  ? row.counts.primary
-     : w == Workload::shadow ? row.counts.shadow
-                             : row.counts.reflected) = set.count;
+    std::vector<HitSet> hits(rows.size());
+    std::vector<std::function<double()>> runs;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+        hits[k].resize(static_cast<std::uint32_t>(set.ox.size()));
+        runs.push_back(detail::timed_trace(rows[k].trace, set, hits[k]));
+    }
+    std::vector<Repetitions> reps;
     {
         detail::Stopwatch timed(run.report.context.timed_seconds);
-        Repetitions reps = detail::time_runs(trace, set, hits, run.o);
-        row.seconds = std::move(reps.seconds);
-        row.runs = std::move(reps.runs);
+        reps = repeat_timed_in_rounds(runs, run.o);
     }
-    if (octray_any_hit) detail::occluded_to_hits(hits, set.count);
-    detail::set_timing(row, run.o);
-    row.hit_fraction = hit_fraction(hits, set.count);
-    Validation val;
-    {
-        detail::Stopwatch checking(run.report.context.validation_seconds);
-        val = validate_hits(hits, truth, rule);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+        BenchRow& row = rows[k].row;
+        row.rays = set.count;
+        (w == Workload::primary  ? row.counts.primary
+         : w == Workload::shadow ? row.counts.shadow
+                                 : row.counts.reflected) = set.count;
+        row.seconds = std::move(reps[k].seconds);
+        row.runs = std::move(reps[k].runs);
+        if (rows[k].octray_any_hit) detail::occluded_to_hits(hits[k], set.count);
+        detail::set_timing(row, run.o);
+        row.hit_fraction = hit_fraction(hits[k], set.count);
+        Validation val;
+        {
+            detail::Stopwatch checking(run.report.context.validation_seconds);
+            val = validate_hits(hits[k], *rows[k].truth, rows[k].rule);
+        }
+        row.valid = val.valid;
+        ++run.rows_done;
+        row.validation =
+            std::string(rows[k].rule.exact ? "exact vs scalar oracle, "
+                                           : "tolerance vs double-precision oracle, ") +
+            val.summary();
+        log_line(run.log,
+                 "  " + std::string(workload_name(w)) + " " + row.system + " " + row.mode +
+                     " " + row.isa + " " + row.accel_label() + " " + row.order + " " +
+                     row.tile + ": " + format("%.2f Mrays/s", row.timing.mrays_median) +
+                     (row.valid ? "" : " (INVALID: " + val.summary() + ")") + progress(run));
+        run.report.rows.push_back(std::move(row));
     }
-    row.valid = val.valid;
-    ++run.rows_done;
-    row.validation = std::string(rule.exact ? "exact vs scalar oracle, "
-                                            : "tolerance vs double-precision oracle, ") +
-                     val.summary();
-    log_line(run.log, "  " + std::string(workload_name(w)) + " " + row.system + " " + row.mode +
-                          " " + row.isa + " " + row.accel_label() + " " + row.order + " " +
-                          row.tile + ": " + format("%.2f Mrays/s", row.timing.mrays_median) +
-                          (row.valid ? "" : " (INVALID: " + val.summary() + ")") +
-                          progress(run));
-    run.report.rows.push_back(std::move(row));
 }
 
 #if OCTRAY_HAVE_EMBREE
 // Embree's rows of a ray set: user geometry (16-, 8-wide packets and single rays) and its
-// built-in spheres (8-wide and single), within tolerance of the double-precision oracle.
-void measure_embree_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun& rs,
-                            const Variant& v, const OracleHits& oracle) {
-    OracleHits truth;
+// built-in spheres (8-wide and single), within tolerance of the double-precision oracle
+// (`truth`, made here; it must outlive the rows).
+void add_embree_rows(BenchRun& run, const BenchScene& bs, const RaySetRun& rs, const Variant& v,
+                     const OracleHits& oracle, OracleHits& truth,
+                     std::vector<RaySetRow>& rows) {
     {
         detail::Stopwatch checking(run.report.context.validation_seconds);
         run.arena.execute([&] {
@@ -463,8 +483,8 @@ void measure_embree_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun
             row.system = "embree";
             row.mode = embree_mode_name(mode);
             row.isa = embree_geometry_name(e->geometry());
-            measure_ray_set(run, rs, std::move(row), detail::embree_tracer(run.arena, *e, mode),
-                            truth, kToleranceRule, false);
+            rows.push_back({std::move(row), detail::embree_tracer(run.arena, *e, mode), &truth,
+                            kToleranceRule, false});
         }
     }
 }
@@ -472,8 +492,8 @@ void measure_embree_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun
 
 // octray's rows of a ray set: the scalar reference and the packet kernels (each ISA and
 // SIMD configuration), exactly as the scalar oracle.
-void measure_octray_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun& rs,
-                            const Variant& v, const OracleHits& oracle) {
+void add_octray_rows(BenchRun& run, const BenchScene& bs, const RaySetRun& rs, const Variant& v,
+                     const OracleHits& oracle, std::vector<RaySetRow>& rows) {
     for (RenderPath path : run.o.paths) {
         if (path == RenderPath::scalar) {
             BenchRow row = base_row(run, bs.spec, rs.workload, v);
@@ -481,9 +501,9 @@ void measure_octray_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun
             row.mode = "single";
             row.isa = "scalar";
             row.accel = "bvh";  // the reference's own
-            measure_ray_set(run, rs, std::move(row),
-                            detail::octray_scalar_tracer(run.arena, bs.reference), oracle,
-                            kExactRule, false);
+            rows.push_back({std::move(row),
+                            detail::octray_scalar_tracer(run.arena, bs.reference), &oracle,
+                            kExactRule, false});
             continue;
         }
         for (Isa isa : run.isas) {
@@ -497,10 +517,10 @@ void measure_octray_ray_set(BenchRun& run, const BenchScene& bs, const RaySetRun
                 row.packet_min_lanes = config.bvh && rs.workload == Workload::secondary
                                            ? config.view.bvh_secondary_min_lanes
                                            : config.lanes;
-                measure_ray_set(
-                    run, rs, std::move(row),
-                    detail::octray_simd_tracer(run.arena, kernel_table(isa), config.view),
-                    oracle, kExactRule, rs.workload == Workload::shadow);
+                rows.push_back(
+                    {std::move(row),
+                     detail::octray_simd_tracer(run.arena, kernel_table(isa), config.view),
+                     &oracle, kExactRule, rs.workload == Workload::shadow});
             }
         }
     }
@@ -536,10 +556,13 @@ void measure_ray_sets(BenchRun& run, BenchScene& bs, const Variant& v) {
                 [&] { oracle = oracle_hits(bs.reference, set, bs.validate_rays); });
         }
         const RaySetRun rs{w, set};
+        std::vector<RaySetRow> rows;
 #if OCTRAY_HAVE_EMBREE
-        if (bs.embree) measure_embree_ray_set(run, bs, rs, v, oracle);
+        OracleHits embree_truth;
+        if (bs.embree) add_embree_rows(run, bs, rs, v, oracle, embree_truth, rows);
 #endif
-        measure_octray_ray_set(run, bs, rs, v, oracle);
+        add_octray_rows(run, bs, rs, v, oracle, rows);
+        measure_ray_set_rows(run, rs, std::move(rows));
     }
 }
 

@@ -98,6 +98,13 @@ struct Repetitions {
 // figure). A repetition also ends after 2 * o.min_time + 1 s of wall clock, should the
 // runs count (nearly) nothing.
 Repetitions repeat_timed(const std::function<double()>& run, const BenchOptions& o);
+// repeat_timed for several rows at once, in rounds: the warm-up runs of every row, then
+// o.reps rounds, each timing one repetition of every row in turn (the first row of a round
+// is the one after the last round's first). A host that slows down or speeds up during
+// the run then charges every row alike, so the rows' ratios (octray against Embree on one
+// ray set) are measured side by side rather than seconds or minutes apart.
+std::vector<Repetitions> repeat_timed_in_rounds(
+    const std::vector<std::function<double()>>& runs, const BenchOptions& o);
 
 struct BenchRow {
     std::string scene;

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "bench/bench_detail.h"
 
@@ -51,21 +53,39 @@ void for_chunks(tbb::task_arena& arena, std::uint32_t count,
 
 namespace octray::bench {
 
+namespace {
+
+// One timed repetition of `run` into `reps`: runs until the seconds they count reach
+// o.min_time (repeat_timed).
+void time_repetition(const std::function<double()>& run, const BenchOptions& o,
+                     Repetitions& reps) {
+    const auto start = detail::Clock::now();
+    double counted = 0.0;
+    std::uint32_t runs = 0;
+    do {
+        counted += run();
+        ++runs;
+    } while (counted < o.min_time && detail::seconds_since(start) < 2.0 * o.min_time + 1.0);
+    reps.seconds.push_back(counted / runs);
+    reps.runs.push_back(runs);
+}
+
+}  // namespace
+
 Repetitions repeat_timed(const std::function<double()>& run, const BenchOptions& o) {
-    using detail::Clock;
-    for (int i = 0; i < o.warmup; ++i) (void)run();
-    Repetitions reps;
-    for (int i = 0; i < o.reps; ++i) {
-        const auto start = Clock::now();
-        double counted = 0.0;
-        std::uint32_t runs = 0;
-        do {
-            counted += run();
-            ++runs;
-        } while (counted < o.min_time && detail::seconds_since(start) < 2.0 * o.min_time + 1.0);
-        reps.seconds.push_back(counted / runs);
-        reps.runs.push_back(runs);
-    }
+    return std::move(repeat_timed_in_rounds({run}, o).front());
+}
+
+std::vector<Repetitions> repeat_timed_in_rounds(
+    const std::vector<std::function<double()>>& runs, const BenchOptions& o) {
+    for (const auto& run : runs)
+        for (int i = 0; i < o.warmup; ++i) (void)run();
+    std::vector<Repetitions> reps(runs.size());
+    for (int round = 0; round < o.reps; ++round)
+        for (std::size_t k = 0; k < runs.size(); ++k) {
+            const std::size_t row = (k + static_cast<std::size_t>(round)) % runs.size();
+            time_repetition(runs[row], o, reps[row]);
+        }
     return reps;
 }
 
@@ -73,15 +93,12 @@ Repetitions repeat_timed(const std::function<double()>& run, const BenchOptions&
 
 namespace octray::bench::detail {
 
-Repetitions time_runs(const Tracer& trace, const RaySet& rays, HitSet& hits,
-                      const BenchOptions& o) {
-    return repeat_timed(
-        [&] {
-            const auto start = Clock::now();
-            trace(rays, hits);
-            return seconds_since(start);
-        },
-        o);
+std::function<double()> timed_trace(const Tracer& trace, const RaySet& rays, HitSet& hits) {
+    return [&trace, &rays, &hits] {
+        const auto start = Clock::now();
+        trace(rays, hits);
+        return seconds_since(start);
+    };
 }
 
 // octray's packet kernels over the set: closest_hit, or any_hit into the occluded flags.

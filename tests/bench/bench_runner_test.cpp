@@ -7,9 +7,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "bench/bench_detail.h"
@@ -57,6 +59,39 @@ TEST(RepeatTimed, EachRepetitionRunsUntilTheMinimumTime) {
     calls = 0;
     EXPECT_EQ(repeat_timed(run, o).runs, (std::vector<std::uint32_t>{1, 1, 1}));
     EXPECT_EQ(calls, 2 + 3);
+}
+
+// Issue 42: the rows of one ray set are timed in rounds, one repetition of every row per
+// round, the round's first row moving on by one each round; each repetition still runs
+// until the minimum time, and the warm-up runs come first.
+TEST(RepeatTimed, RowsAreTimedInRoundsOneRepetitionOfEachPerRound) {
+    BenchOptions o;
+    o.warmup = 1;
+    o.reps = 3;
+    o.min_time = 0.005;
+    std::string order;
+    std::vector<std::function<double()>> runs;
+    for (const char name : {'a', 'b', 'c'})
+        runs.push_back([&order, name] {
+            order += name;
+            return name == 'b' ? 0.003 : 0.005;  // b needs two runs a repetition
+        });
+    const std::vector<Repetitions> reps = repeat_timed_in_rounds(runs, o);
+    EXPECT_EQ(order,
+              "abc"
+              "abbc"
+              "bbca"
+              "cabb");
+    ASSERT_EQ(reps.size(), 3u);
+    EXPECT_EQ(reps[0].runs, (std::vector<std::uint32_t>{1, 1, 1}));
+    EXPECT_EQ(reps[1].runs, (std::vector<std::uint32_t>{2, 2, 2}));
+    EXPECT_EQ(reps[2].seconds, (std::vector<double>{0.005, 0.005, 0.005}));
+    // One row is repeat_timed's own schedule.
+    order.clear();
+    EXPECT_EQ(repeat_timed(runs[1], o).runs, (std::vector<std::uint32_t>{2, 2, 2}));
+    EXPECT_EQ(order,
+              "b"
+              "bbbbbb");
 }
 
 // Issue 42: a `frame` row renders each frame into the storage of the frame before (as
