@@ -51,6 +51,15 @@ Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMod
 // is nullptr and every frame maps fresh storage (a still's one picture).
 void time_frames(BenchRow& row, const std::function<RenderResult(Image* spare)>& render,
                  const BenchOptions& o, bool reuse_storage);
+// A whole-frame row waiting for its repetitions: its `render` and storage as time_frames's.
+struct FrameRow {
+    BenchRow row;
+    std::function<RenderResult(Image* spare)> render;
+    bool reuse_storage = false;
+};
+// time_frames for several rows at once, their repetitions in rounds
+// (repeat_timed_in_rounds), so that octray's and Embree's frames are timed side by side.
+void time_frames_in_rounds(std::vector<FrameRow>& rows, const BenchOptions& o);
 // The row's timing from its seconds and rays, its spread against o.max_spread.
 void set_timing(BenchRow& row, const BenchOptions& o);
 

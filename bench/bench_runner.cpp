@@ -604,11 +604,14 @@ void log_frame_row(BenchRun& run, const BenchRow& row) {
 
 // octray's whole-frame rows of one tile size and workload: each path, ISA and --accel
 // value. A still renders the Scene (render_packet compiles it and builds the BVH, both
-// inside its seconds); a frame renders a PreparedScene made once. The scalar reference is
-// measured as a still only (it has no prepared form).
-void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile, Workload w,
-                            RenderValidation& render_validation) {
+// inside its seconds); a frame renders a PreparedScene made once per --accel value (the
+// ISAs share it). The scalar reference is measured as a still only (it has no prepared
+// form).
+void add_octray_render_rows(BenchRun& run, const BenchScene& bs, TileSize tile, Workload w,
+                            RenderValidation& render_validation,
+                            std::vector<detail::FrameRow>& rows) {
     const BenchOptions& o = run.o;
+    std::map<Accel, std::shared_ptr<const PreparedScene>> prepared_by_accel;
     for (RenderPath path : o.paths) {
         if (path == RenderPath::scalar && w == Workload::frame) continue;
         const std::vector<Isa> path_isas =
@@ -644,23 +647,24 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile, 
                 }
                 RenderOptions ro = frame_options(run, tile);
                 ro.accel = accel;
-                std::optional<PreparedScene> prepared;
-                if (w == Workload::frame)
-                    run.arena.execute([&] { prepared.emplace(bs.scene, accel, ro.threads); });
-                const auto render = [&](Image* spare) {
+                std::shared_ptr<const PreparedScene> prepared;
+                if (w == Workload::frame) {
+                    std::shared_ptr<const PreparedScene>& made = prepared_by_accel[accel];
+                    if (!made)
+                        run.arena.execute([&] {
+                            made = std::make_shared<const PreparedScene>(bs.scene, accel,
+                                                                         ro.threads);
+                        });
+                    prepared = made;
+                }
+                auto render = [&bs, ro, path, isa, prepared](Image* spare) {
                     RenderOptions frame_ro = ro;
                     frame_ro.spare_image = spare;
                     if (path == RenderPath::scalar) return render_reference(bs.scene, frame_ro);
                     return prepared ? render_packet(*prepared, frame_ro, isa)
                                     : render_packet(bs.scene, frame_ro, isa);
                 };
-                {
-                    detail::Stopwatch timed(run.report.context.timed_seconds);
-                    detail::time_frames(row, render, o, w == Workload::frame);
-                }
-                run.report.rows.push_back(std::move(row));
-                ++run.rows_done;
-                log_frame_row(run, run.report.rows.back());
+                rows.push_back({std::move(row), std::move(render), w == Workload::frame});
             }
     }
 }
@@ -670,11 +674,12 @@ void measure_octray_renders(BenchRun& run, const BenchScene& bs, TileSize tile, 
 // packets of each generation's rays). A still is charged what octray's is: compiling the
 // scene, then Embree's BVH build at its faster quality for this scene (EmbreeScene::rebuild,
 // every repetition), then the frame. A frame traces the HIGH-quality scene built before.
-void measure_embree_renders(BenchRun& run, BenchScene& bs, TileSize tile, Workload w) {
+void add_embree_render_rows(BenchRun& run, BenchScene& bs, TileSize tile, Workload w,
+                            std::vector<detail::FrameRow>& rows) {
     const Scene small = detail::validation_scene(bs.spec, run.o);
     EmbreeScene& scene = w == Workload::still ? *bs.embree_still : *bs.embree;
     for (EmbreeMode mode : {EmbreeMode::packet16, EmbreeMode::packet8}) {
-        const EmbreeFrames frames(scene, mode, run.isas.back());
+        const auto frames = std::make_shared<const EmbreeFrames>(scene, mode, run.isas.back());
         BenchRow row = base_row(run, bs.spec, w, Variant{PixelOrder::tiled, tile});
         row.system = "embree";
         row.mode = embree_mode_name(mode);
@@ -684,33 +689,27 @@ void measure_embree_renders(BenchRun& run, BenchScene& bs, TileSize tile, Worklo
         bool ok = false;
         {
             detail::Stopwatch checking(run.report.context.validation_seconds);
-            row.validation = detail::validate_embree_render(small, frames, run.o, ok);
+            row.validation = detail::validate_embree_render(small, *frames, run.o, ok);
         }
         row.valid = ok;
         const RenderOptions ro = frame_options(run, tile);
-        const auto render = [&](Image* spare) {
+        auto render = [&run, &bs, &scene, ro, w, frames](Image* spare) {
             RenderOptions frame_ro = ro;
             frame_ro.spare_image = spare;
-            if (w == Workload::frame) return frames.render(bs.compiled, frame_ro);
+            if (w == Workload::frame) return frames->render(bs.compiled, frame_ro);
             const auto start = std::chrono::steady_clock::now();
             const CompiledScene compiled = compile_scene(bs.scene);  // as octray's still
             const double compile =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             double build = 0.0;
             run.arena.execute([&] { build = scene.rebuild(); });
-            RenderResult r = frames.render(bs.compiled, frame_ro);
+            RenderResult r = frames->render(bs.compiled, frame_ro);
             r.compile_seconds = compile;
             r.bvh_seconds = build;
             r.seconds += compile + build;
             return r;
         };
-        {
-            detail::Stopwatch timed(run.report.context.timed_seconds);
-            detail::time_frames(row, render, run.o, w == Workload::frame);
-        }
-        run.report.rows.push_back(std::move(row));
-        ++run.rows_done;
-        log_frame_row(run, run.report.rows.back());
+        rows.push_back({std::move(row), std::move(render), w == Workload::frame});
     }
 }
 #endif
@@ -722,10 +721,21 @@ void measure_whole_renders(BenchRun& run, BenchScene& bs) {
     for (TileSize tile : run.o.tiles)
         for (Workload w : {Workload::still, Workload::frame}) {
             if (!run.wants(w)) continue;
-            measure_octray_renders(run, bs, tile, w, render_validation);
+            std::vector<detail::FrameRow> rows;
+            add_octray_render_rows(run, bs, tile, w, render_validation, rows);
 #if OCTRAY_HAVE_EMBREE
-            if (bs.embree) measure_embree_renders(run, bs, tile, w);
+            if (bs.embree) add_embree_render_rows(run, bs, tile, w, rows);
 #endif
+            // octray's and Embree's frames in rounds (repeat_timed_in_rounds).
+            {
+                detail::Stopwatch timed(run.report.context.timed_seconds);
+                detail::time_frames_in_rounds(rows, run.o);
+            }
+            for (detail::FrameRow& r : rows) {
+                run.report.rows.push_back(std::move(r.row));
+                ++run.rows_done;
+                log_frame_row(run, run.report.rows.back());
+            }
         }
 }
 

@@ -164,23 +164,34 @@ Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMod
 // seconds), the last frame's ray counts, the rates and frames per second.
 void time_frames(BenchRow& row, const std::function<RenderResult(Image* spare)>& render,
                  const BenchOptions& o, bool reuse_storage) {
-    RenderResult last;
-    Image spare;
-    Repetitions reps = repeat_timed(
-        [&] {
-            last = render(reuse_storage ? &spare : nullptr);
-            if (reuse_storage) spare = std::move(last.image);
-            return last.seconds;
-        },
-        o);
-    row.seconds = std::move(reps.seconds);
-    row.runs = std::move(reps.runs);
-    row.counts = last.rays;
-    row.rays = last.rays.total();
-    row.hit_fraction = std::nan("");
-    set_timing(row, o);
-    row.frames_per_second =
-        row.timing.seconds_median > 0.0 ? 1.0 / row.timing.seconds_median : 0.0;
+    std::vector<FrameRow> rows{{std::move(row), render, reuse_storage}};
+    time_frames_in_rounds(rows, o);
+    row = std::move(rows.front().row);
+}
+
+void time_frames_in_rounds(std::vector<FrameRow>& rows, const BenchOptions& o) {
+    std::vector<RenderResult> last(rows.size());
+    std::vector<Image> spare(rows.size());
+    std::vector<std::function<double()>> runs;
+    for (std::size_t k = 0; k < rows.size(); ++k)
+        runs.push_back([&rows, &last, &spare, k] {
+            const FrameRow& r = rows[k];
+            last[k] = r.render(r.reuse_storage ? &spare[k] : nullptr);
+            if (r.reuse_storage) spare[k] = std::move(last[k].image);
+            return last[k].seconds;
+        });
+    std::vector<Repetitions> reps = repeat_timed_in_rounds(runs, o);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+        BenchRow& row = rows[k].row;
+        row.seconds = std::move(reps[k].seconds);
+        row.runs = std::move(reps[k].runs);
+        row.counts = last[k].rays;
+        row.rays = last[k].rays.total();
+        row.hit_fraction = std::nan("");
+        set_timing(row, o);
+        row.frames_per_second =
+            row.timing.seconds_median > 0.0 ? 1.0 / row.timing.seconds_median : 0.0;
+    }
 }
 
 void set_timing(BenchRow& row, const BenchOptions& o) {

@@ -9,13 +9,17 @@
 #include "render/packet_renderer.h"
 
 namespace octray::bench {
-namespace {
 
-struct Slot {
+struct EmbreeFramesSlot {
     const EmbreeScene* scene;
     EmbreeMode mode;
 };
-// The live EmbreeFrames' scene and mode, read by the kernel table's two entries below.
+
+namespace {
+
+using Slot = EmbreeFramesSlot;
+// The scene and mode of the EmbreeFrames rendering now, read by the kernel table's two
+// entries below.
 std::atomic<const Slot*> g_slot{nullptr};
 
 // Primary rays are the only ones traced from t_min = ε_s > 0: they get the coherent hint.
@@ -38,20 +42,22 @@ void any_hit(const kernels::SceneView&, const kernels::ShadowStream& rays, std::
 }  // namespace
 
 EmbreeFrames::EmbreeFrames(const EmbreeScene& scene, EmbreeMode mode, Isa isa)
-    : table_(kernel_table(resolve_isa(isa))) {
-    const Slot* slot = new Slot{&scene, mode};
-    const Slot* expected = nullptr;
-    if (!g_slot.compare_exchange_strong(expected, slot, std::memory_order_acq_rel)) {
-        delete slot;
-        throw std::logic_error("EmbreeFrames: only one may exist at a time");
-    }
+    : table_(kernel_table(resolve_isa(isa))),
+      slot_(std::make_unique<Slot>(Slot{&scene, mode})) {
     table_.closest_hit = closest_hit;
     table_.any_hit = any_hit;
 }
 
-EmbreeFrames::~EmbreeFrames() { delete g_slot.exchange(nullptr, std::memory_order_acq_rel); }
+EmbreeFrames::~EmbreeFrames() = default;
 
 RenderResult EmbreeFrames::render(const CompiledScene& compiled, RenderOptions options) const {
+    // This object's scene and mode in the slot for the frame, released whatever happens.
+    const Slot* expected = nullptr;
+    if (!g_slot.compare_exchange_strong(expected, slot_.get(), std::memory_order_acq_rel))
+        throw std::logic_error("EmbreeFrames: one frame at a time (another is rendering)");
+    struct Release {
+        ~Release() { g_slot.store(nullptr, std::memory_order_release); }
+    } release;
     options.accel = Accel::none;  // no octray BVH: Embree traverses its own
     return render_packet(compiled, options, table_);
 }

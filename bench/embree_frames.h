@@ -7,7 +7,10 @@
 // queries differ; its image is validated against the scalar reference's.
 //
 // Kernel tables hold plain function pointers, so the Embree scene is reached through one
-// process-wide slot: one EmbreeFrames may exist at a time (a second throws).
+// process-wide slot, which a frame holds while it renders: several EmbreeFrames may exist
+// (the bench times their frames in rounds), but one renders at a time (a second throws).
+
+#include <memory>
 
 #include "bench/embree_baseline.h"
 #include "kernels/isa.h"
@@ -16,6 +19,8 @@
 #include "scene/compile.h"
 
 namespace octray::bench {
+
+struct EmbreeFramesSlot;
 
 class EmbreeFrames {
   public:
@@ -30,6 +35,7 @@ class EmbreeFrames {
 
   private:
     kernels::KernelTable table_;
+    std::unique_ptr<const EmbreeFramesSlot> slot_;  // this object's scene and mode
 };
 
 }  // namespace octray::bench

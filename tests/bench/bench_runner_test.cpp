@@ -131,6 +131,44 @@ TEST(TimeFrames, FramesRenderIntoTheLastFramesStorageStillsIntoFreshStorage) {
     }
 }
 
+// Issue 42: whole-frame rows timed together go in rounds, and each row keeps its own
+// storage: a frame row is handed the storage of its own frame before, never another row's.
+TEST(TimeFrames, RowsInRoundsEachRenderIntoTheirOwnLastFrame) {
+    const PreparedScene prepared(load_scene("whitted,width=16,height=8"), Accel::automatic, 1);
+    BenchOptions o;
+    o.warmup = 1;
+    o.reps = 2;
+    o.min_time = 0.0;
+    std::string order;
+    std::vector<std::vector<const float*>> planes(2);
+    std::vector<detail::FrameRow> rows;
+    for (const int k : {0, 1})
+        rows.push_back({BenchRow{},
+                        [&, k](Image* spare) {
+                            order += static_cast<char>('a' + k);
+                            RenderOptions ro;
+                            ro.threads = 1;
+                            ro.spare_image = spare;
+                            RenderResult r = render_packet(prepared, ro);
+                            planes[k].push_back(r.image.plane(0));
+                            return r;
+                        },
+                        true});
+    detail::time_frames_in_rounds(rows, o);
+    EXPECT_EQ(order,
+              "ab"
+              "ab"
+              "ba");  // warm-up, then two rounds, the second from b
+    for (const int k : {0, 1}) {
+        ASSERT_EQ(planes[k].size(), 3u);
+        EXPECT_EQ(planes[k][1], planes[k][0]);
+        EXPECT_EQ(planes[k][2], planes[k][0]);
+        EXPECT_EQ(rows[k].row.seconds.size(), 2u);
+        EXPECT_GE(rows[k].row.rays, 16u * 8u);
+    }
+    EXPECT_NE(planes[0][0], planes[1][0]);
+}
+
 BenchRow row(std::string system, Workload w, double mrays, bool valid = true) {
     // Scene, order and tile stay empty: equal on every row, so one comparison group per
     // workload.
