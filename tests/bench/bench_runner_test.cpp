@@ -94,15 +94,34 @@ TEST(RepeatTimed, RowsAreTimedInRoundsOneRepetitionOfEachPerRound) {
               "bbbbbb");
 }
 
+// The frames the TimeFrames tests time: a 16x8 whitted prepared once, one warm-up frame and
+// two timed repetitions of one frame each.
+struct TinyFrames {
+    PreparedScene prepared{load_scene("whitted,width=16,height=8"), Accel::automatic, 1};
+    BenchOptions o = [] {
+        BenchOptions options;
+        options.warmup = 1;
+        options.reps = 2;
+        options.min_time = 0.0;
+        return options;
+    }();
+    // A frame into `spare` (nullptr: fresh storage); its first plane's storage goes to
+    // `planes`.
+    RenderResult render(Image* spare, std::vector<const float*>& planes) const {
+        RenderOptions ro;
+        ro.threads = 1;
+        ro.spare_image = spare;
+        RenderResult r = render_packet(prepared, ro);
+        planes.push_back(r.image.plane(0));
+        return r;
+    }
+};
+
 // Issue 42: a `frame` row renders each frame into the storage of the frame before (as
 // octray render's frame loop does with RenderOptions::spare_image); a `still` row maps
 // fresh storage for every frame, as a one-picture render does.
 TEST(TimeFrames, FramesRenderIntoTheLastFramesStorageStillsIntoFreshStorage) {
-    const PreparedScene prepared(load_scene("whitted,width=16,height=8"), Accel::automatic, 1);
-    BenchOptions o;
-    o.warmup = 1;
-    o.reps = 2;
-    o.min_time = 0.0;
+    const TinyFrames tiny;
     for (const bool reuse : {true, false}) {
         SCOPED_TRACE(reuse ? "frame" : "still");
         std::vector<const float*> planes;
@@ -112,14 +131,9 @@ TEST(TimeFrames, FramesRenderIntoTheLastFramesStorageStillsIntoFreshStorage) {
             row,
             [&](Image* spare) {
                 given_spare.push_back(spare != nullptr);
-                RenderOptions ro;
-                ro.threads = 1;
-                ro.spare_image = spare;
-                RenderResult r = render_packet(prepared, ro);
-                planes.push_back(r.image.plane(0));
-                return r;
+                return tiny.render(spare, planes);
             },
-            o, reuse);
+            tiny.o, reuse);
         ASSERT_EQ(planes.size(), 3u);   // one warm-up frame, two timed
         EXPECT_GE(row.rays, 16u * 8u);  // the last frame's rays, its primary rays at least
         for (std::size_t i = 0; i < planes.size(); ++i) {
@@ -134,11 +148,7 @@ TEST(TimeFrames, FramesRenderIntoTheLastFramesStorageStillsIntoFreshStorage) {
 // Issue 42: whole-frame rows timed together go in rounds, and each row keeps its own
 // storage: a frame row is handed the storage of its own frame before, never another row's.
 TEST(TimeFrames, RowsInRoundsEachRenderIntoTheirOwnLastFrame) {
-    const PreparedScene prepared(load_scene("whitted,width=16,height=8"), Accel::automatic, 1);
-    BenchOptions o;
-    o.warmup = 1;
-    o.reps = 2;
-    o.min_time = 0.0;
+    const TinyFrames tiny;
     std::string order;
     std::vector<std::vector<const float*>> planes(2);
     std::vector<detail::FrameRow> rows;
@@ -146,15 +156,10 @@ TEST(TimeFrames, RowsInRoundsEachRenderIntoTheirOwnLastFrame) {
         rows.push_back({BenchRow{},
                         [&, k](Image* spare) {
                             order += static_cast<char>('a' + k);
-                            RenderOptions ro;
-                            ro.threads = 1;
-                            ro.spare_image = spare;
-                            RenderResult r = render_packet(prepared, ro);
-                            planes[k].push_back(r.image.plane(0));
-                            return r;
+                            return tiny.render(spare, planes[k]);
                         },
                         true});
-    detail::time_frames_in_rounds(rows, o);
+    detail::time_frames_in_rounds(rows, tiny.o);
     EXPECT_EQ(order,
               "ab"
               "ab"
