@@ -5,7 +5,7 @@
 // Comparing the files byte for byte asks more than octray can promise: igzip, which
 // compresses the ZIP chunks and the PNG's stream (render/image/deflate.h), now and then
 // encodes the same bytes differently inside one test process (a chunk of 230 KB came out 2
-// bytes longer, a few times in 10,000 chunks, never with address randomisation off and
+// bytes longer, in at least 8 of 300 test processes, never with address randomisation off and
 // never in a program of its own; docs/performance-log.md, "igzip's output is not always the
 // same"). Both encodings inflate to the same bytes, so these helpers compare what the files
 // say: every byte that is not compressed data, and the compressed data inflated.
