@@ -57,7 +57,9 @@ void add_bench_command(CLI::App& app, CommandRunner& run) {
         ->transform(decimal_integer(0, kMaxThreadCount));
     cmd->add_option("--reps", a->reps,
                     "Timed repetitions per row, " + integer_range_text(1, kNoIntegerLimit) +
-                        " [default: 5]")
+                        "; the rows of a ray set (or of a tile size's stills or frames) take "
+                        "theirs in rounds, one of each row per round, so that octray and "
+                        "Embree are timed side by side [default: 5]")
         ->transform(decimal_integer(1, kNoIntegerLimit));
     cmd->add_option("--warmup", a->warmup,
                     "Untimed runs before them, " + integer_range_text(0, kNoIntegerLimit) +
