@@ -28,7 +28,7 @@ namespace octray::bench::detail {
 // One way of tracing a ray set into a hit set.
 using Tracer = std::function<void(const RaySet&, HitSet&)>;
 
-// One run of `trace` over the set, for repeat_timed(_in_rounds): it returns the run's wall
+// One run of `trace` over the set, for repeat_timed_in_rounds: it returns the run's wall
 // seconds; the hits of the last run stay in `hits`.
 std::function<double()> timed_trace(const Tracer& trace, const RaySet& rays, HitSet& hits);
 
@@ -43,22 +43,19 @@ Tracer octray_scalar_tracer(tbb::task_arena& arena, const ReferenceTracer& trace
 Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMode mode);
 #endif
 
-// A whole-frame row: warm-up frames, then o.reps timed repetitions of frames (each
-// frame's own seconds, repeat_timed), the last frame's ray counts, the rates and frames
-// per second, the spread. `render(spare)` renders one frame; with `reuse_storage` `spare`
-// holds the frame before's pixels, for RenderOptions::spare_image (a sequence's frames
-// render into the last one's storage, as octray render's frame loop does), otherwise it
-// is nullptr and every frame maps fresh storage (a still's one picture).
-void time_frames(BenchRow& row, const std::function<RenderResult(Image* spare)>& render,
-                 const BenchOptions& o, bool reuse_storage);
-// A whole-frame row waiting for its repetitions: its `render` and storage as time_frames's.
+// A whole-frame row waiting for its repetitions. `render(spare)` renders one frame; with
+// `reuse_storage` `spare` holds the row's frame before's pixels, for
+// RenderOptions::spare_image (a sequence's frames render into the last one's storage, as
+// octray render's frame loop does), otherwise it is nullptr and every frame maps fresh
+// storage (a still's one picture).
 struct FrameRow {
     BenchRow row;
     std::function<RenderResult(Image* spare)> render;
     bool reuse_storage = false;
 };
-// time_frames for several rows at once, their repetitions in rounds
-// (repeat_timed_in_rounds), so that octray's and Embree's frames are timed side by side.
+// Whole-frame rows timed together, their repetitions in rounds (repeat_timed_in_rounds:
+// each frame's own seconds), so that octray's and Embree's frames are timed side by side;
+// each row gets the last frame's ray counts, the rates and frames per second, the spread.
 void time_frames_in_rounds(std::vector<FrameRow>& rows, const BenchOptions& o);
 // The row's timing from its seconds and rays, its spread against o.max_spread.
 void set_timing(BenchRow& row, const BenchOptions& o);

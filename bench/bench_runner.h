@@ -92,17 +92,16 @@ struct Repetitions {
     std::vector<double> seconds;
     std::vector<std::uint32_t> runs;
 };
-// o.warmup untimed runs, then o.reps repetitions, each repeating `run` until the seconds
-// its runs count add up to o.min_time (at least one run; Google Benchmark's min time).
-// `run` does one run and returns the seconds it counts (its wall clock, or a render's own
-// figure). A repetition also ends after 2 * o.min_time + 1 s of wall clock, should the
-// runs count (nearly) nothing.
-Repetitions repeat_timed(const std::function<double()>& run, const BenchOptions& o);
-// repeat_timed for several rows at once, in rounds: the warm-up runs of every row, then
+// Timed repetitions of several rows, in rounds: o.warmup untimed runs of every row, then
 // o.reps rounds, each timing one repetition of every row in turn (the first row of a round
-// is the one after the last round's first). A host that slows down or speeds up during
-// the run then charges every row alike, so the rows' ratios (octray against Embree on one
-// ray set) are measured side by side rather than seconds or minutes apart.
+// is the one after the last round's first). A repetition repeats its row's run until the
+// seconds its runs count add up to o.min_time (at least one run; Google Benchmark's min
+// time); it also ends after 2 * o.min_time + 1 s of wall clock, should the runs count
+// (nearly) nothing. Each `runs[k]` does one run and returns the seconds it counts (its wall
+// clock, or a render's own figure). A host that slows down or speeds up during the run
+// then charges every row alike, so the rows' ratios (octray against Embree on one ray set)
+// are measured side by side rather than seconds or minutes apart. One row alone is timed
+// the same way, its repetitions back to back.
 std::vector<Repetitions> repeat_timed_in_rounds(
     const std::vector<std::function<double()>>& runs, const BenchOptions& o);
 

@@ -56,7 +56,7 @@ namespace octray::bench {
 namespace {
 
 // One timed repetition of `run` into `reps`: runs until the seconds they count reach
-// o.min_time (repeat_timed).
+// o.min_time (repeat_timed_in_rounds).
 void time_repetition(const std::function<double()>& run, const BenchOptions& o,
                      Repetitions& reps) {
     const auto start = detail::Clock::now();
@@ -71,10 +71,6 @@ void time_repetition(const std::function<double()>& run, const BenchOptions& o,
 }
 
 }  // namespace
-
-Repetitions repeat_timed(const std::function<double()>& run, const BenchOptions& o) {
-    return std::move(repeat_timed_in_rounds({run}, o).front());
-}
 
 std::vector<Repetitions> repeat_timed_in_rounds(
     const std::vector<std::function<double()>>& runs, const BenchOptions& o) {
@@ -159,15 +155,6 @@ Tracer embree_tracer(tbb::task_arena& arena, const EmbreeScene& scene, EmbreeMod
     };
 }
 #endif
-
-// A whole-frame row: warm-up frames, then o.reps timed repetitions (each frame's own
-// seconds), the last frame's ray counts, the rates and frames per second.
-void time_frames(BenchRow& row, const std::function<RenderResult(Image* spare)>& render,
-                 const BenchOptions& o, bool reuse_storage) {
-    std::vector<FrameRow> rows{{std::move(row), render, reuse_storage}};
-    time_frames_in_rounds(rows, o);
-    row = std::move(rows.front().row);
-}
 
 void time_frames_in_rounds(std::vector<FrameRow>& rows, const BenchOptions& o) {
     std::vector<RenderResult> last(rows.size());

@@ -49,7 +49,7 @@ TEST(RepeatTimed, EachRepetitionRunsUntilTheMinimumTime) {
         ++calls;
         return 0.003;
     };
-    const Repetitions reps = repeat_timed(run, o);
+    const Repetitions reps = repeat_timed_in_rounds({run}, o).front();
     EXPECT_EQ(reps.runs, (std::vector<std::uint32_t>{4, 4, 4}));  // 4 x 3 ms >= 10 ms
     ASSERT_EQ(reps.seconds.size(), 3u);
     for (double s : reps.seconds) EXPECT_DOUBLE_EQ(s, 0.003);
@@ -57,7 +57,8 @@ TEST(RepeatTimed, EachRepetitionRunsUntilTheMinimumTime) {
 
     o.min_time = 0.0;  // one run per repetition
     calls = 0;
-    EXPECT_EQ(repeat_timed(run, o).runs, (std::vector<std::uint32_t>{1, 1, 1}));
+    EXPECT_EQ(repeat_timed_in_rounds({run}, o).front().runs,
+              (std::vector<std::uint32_t>{1, 1, 1}));
     EXPECT_EQ(calls, 2 + 3);
 }
 
@@ -86,9 +87,10 @@ TEST(RepeatTimed, RowsAreTimedInRoundsOneRepetitionOfEachPerRound) {
     EXPECT_EQ(reps[0].runs, (std::vector<std::uint32_t>{1, 1, 1}));
     EXPECT_EQ(reps[1].runs, (std::vector<std::uint32_t>{2, 2, 2}));
     EXPECT_EQ(reps[2].seconds, (std::vector<double>{0.005, 0.005, 0.005}));
-    // One row is repeat_timed's own schedule.
+    // One row alone: its repetitions back to back.
     order.clear();
-    EXPECT_EQ(repeat_timed(runs[1], o).runs, (std::vector<std::uint32_t>{2, 2, 2}));
+    EXPECT_EQ(repeat_timed_in_rounds({runs[1]}, o).front().runs,
+              (std::vector<std::uint32_t>{2, 2, 2}));
     EXPECT_EQ(order,
               "b"
               "bbbbbb");
@@ -126,14 +128,14 @@ TEST(TimeFrames, FramesRenderIntoTheLastFramesStorageStillsIntoFreshStorage) {
         SCOPED_TRACE(reuse ? "frame" : "still");
         std::vector<const float*> planes;
         std::vector<bool> given_spare;
-        BenchRow row;
-        detail::time_frames(
-            row,
-            [&](Image* spare) {
-                given_spare.push_back(spare != nullptr);
-                return tiny.render(spare, planes);
-            },
-            tiny.o, reuse);
+        std::vector<detail::FrameRow> rows{{BenchRow{},
+                                            [&](Image* spare) {
+                                                given_spare.push_back(spare != nullptr);
+                                                return tiny.render(spare, planes);
+                                            },
+                                            reuse}};
+        detail::time_frames_in_rounds(rows, tiny.o);
+        const BenchRow& row = rows.front().row;
         ASSERT_EQ(planes.size(), 3u);   // one warm-up frame, two timed
         EXPECT_GE(row.rays, 16u * 8u);  // the last frame's rays, its primary rays at least
         for (std::size_t i = 0; i < planes.size(); ++i) {
