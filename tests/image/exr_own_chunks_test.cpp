@@ -17,8 +17,6 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -38,11 +36,6 @@ fs::path test_dir() {
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
-}
-
-std::string file_bytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 // A pseudo-random sample stream (a fixed LCG): noise does not compress.
@@ -143,9 +136,9 @@ TEST(ExrOwnChunks, AnUncompressedFileIsOpenExrsOwnByteForByte) {
         const Image image = test_image(display, data, ExrCompression::none, false);
         write_exr((dir / "ours.exr").string(), image);
         detail::write_exr_by_openexr((dir / "openexr.exr").string(), image);
-        const std::string ours = file_bytes(dir / "ours.exr");
+        const std::string ours = test::whole_file(dir / "ours.exr");
         EXPECT_GT(ours.size(), 4 * data.pixel_count());
-        EXPECT_TRUE(ours == file_bytes(dir / "openexr.exr"))
+        EXPECT_TRUE(ours == test::whole_file(dir / "openexr.exr"))
             << "data window x " << data.x0 << ".." << data.x1 << ", y " << data.y0 << ".."
             << data.y1;
         // The long channel name sets the version field's long-names flag.

@@ -29,7 +29,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -647,9 +646,7 @@ TEST_F(ImageIoTest, PngsCarryTheirSrgbChunks) {
     }
     // libpng derives gAMA and cHRM from sRGB when reading, so the chunks are listed.
     const auto chunk_types = [](const fs::path& path) {
-        std::ifstream in(path, std::ios::binary);
-        const std::string b((std::istreambuf_iterator<char>(in)),
-                            std::istreambuf_iterator<char>());
+        const std::string b = test::whole_file(path);
         std::vector<std::string> types;
         for (std::size_t at = 8; at + 12 <= b.size();) {
             const std::size_t length =

@@ -4,11 +4,12 @@
 //
 // Comparing the files byte for byte asks more than octray can promise: igzip, which
 // compresses the ZIP chunks and the PNG's stream (render/image/deflate.h), now and then
-// encodes the same bytes differently inside one test process (a chunk of 230 KB came out 2
-// bytes longer, in at least 8 of 300 test processes, never with address randomisation off and
-// never in a program of its own; docs/performance-log.md, "igzip's output is not always the
-// same"). Both encodings inflate to the same bytes, so these helpers compare what the files
-// say: every byte that is not compressed data, and the compressed data inflated.
+// encodes the same bytes differently (a chunk of 230 KB came out 1-4 bytes longer or
+// shorter, about one compression in 10,000 to 20,000) when octray's writer runs on two
+// CPUs, never with the process pinned to one; docs/performance-log.md, "igzip's output is
+// not always the same". Both encodings inflate to the same bytes, so these helpers compare
+// what the files say: every byte that is not compressed data, and the compressed data
+// inflated.
 
 #include <zlib.h>
 
