@@ -138,18 +138,18 @@ def main():
               f"{os.path.getsize(scene) / 1e6:.1f} MB of JSON")
         print(f"{'binary':8} {'run':>3} {'wall s':>8} {'load s':>8} {'prepare s':>9} "
               f"{'render s':>9}  (wall - load) / sum render")
-        results = {b: [] for b in binaries}
+        # Each binary's ratios, by its place on the command line (the two may be one file).
+        ratios = [[] for _ in binaries]
         for run in range(1, args.runs + 1):
-            for label, b in zip("AB", binaries):
+            for k, (label, b) in enumerate(zip("AB", binaries)):
                 r = run_once(b, scene, args.frames, args.threads, out_dir)
-                results[b].append(r)
+                ratios[k].append(r["ratio"])
                 print(f"{label:8} {run:>3} {r['wall']:8.3f} {r['load']:8.3f} "
                       f"{r['prepare']:9.3f} {r['render']:9.3f}  {r['ratio']:.3f}", flush=True)
-        for label, b in zip("AB", binaries):
-            ratios = [r["ratio"] for r in results[b]]
+        for label, b, mine in zip("AB", binaries, ratios):
             print(f"{label} = {b}: (wall - load) / sum render median "
-                  f"{statistics.median(ratios):.3f} (min {min(ratios):.3f}, "
-                  f"max {max(ratios):.3f}), {len(ratios)} runs")
+                  f"{statistics.median(mine):.3f} (min {min(mine):.3f}, "
+                  f"max {max(mine):.3f}), {len(mine)} runs")
     finally:
         if not args.dir:
             shutil.rmtree(work, ignore_errors=True)

@@ -49,7 +49,12 @@ class OrbitBenchTest(unittest.TestCase):
             low = (wall - load - 2 * e) / (render + e) - e
             high = (wall - load + 2 * e) / (render - e) + e
             self.assertTrue(low <= ratio <= high, (ratio, low, high))
-        self.assertEqual(done.stdout.count("(wall - load) / sum render median"), 2)
+        # A summary for each binary, of its own runs (the same file given twice included).
+        summaries = [line for line in done.stdout.splitlines() if " median " in line]
+        self.assertEqual(len(summaries), 2)
+        for label, line in zip("AB", summaries):
+            self.assertTrue(line.startswith(label + " = "), line)
+            self.assertTrue(line.endswith(", 2 runs"), line)
         # Each frame's EXR is there, the last run's.
         frames = sorted(os.listdir(os.path.join(self.dir, "frames")))
         self.assertEqual(frames, ["o.0000.exr", "o.0001.exr", "o.0002.exr"])
