@@ -270,11 +270,12 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
     using F = xsimd::batch<float, RayArch<Arch>>;  // the packet's rays
     constexpr std::uint32_t K = kTraversalWidth / F::size;
     std::uint32_t done = 0, sp = 0;
+    const PacketRays<F, K> r(p);  // best_t: each lane's t_max
     // The sphere that occluded the packet before first: neighbouring shadow rays are
     // often blocked by the same sphere, and a lane it occludes needs no traversal. Any
     // occluder answers a lane, so the answer is the same whichever is found.
     if (st.occluder != kBvhEmpty) {
-        done = packet_occluding_sphere(s, st.occluder, PacketRays<F, K>(p)) & live;
+        done = packet_occluding_sphere(s, st.occluder, r) & live;
         if (done == live) return done;
         if (done == 0) st.occluder = kBvhEmpty;
     }
@@ -296,7 +297,6 @@ std::uint32_t bvh_occluded_packet(const SceneView& s, const BvhPacket& p, std::u
                                             st, sp);
             continue;
         }
-        const PacketRays<F, K> r(p);  // best_t: each lane's t_max
         const std::uint32_t first = leaf_first(node), end = first + leaf_count(node);
         for (std::uint32_t i = first; i < end && (done & mask) != mask; ++i) {
             const std::uint32_t bits = packet_occluding_sphere(s, i, r) & mask;

@@ -202,6 +202,55 @@ void shadow_keys(const SceneView& s, const ShadowStream& rays, std::uint32_t at,
     code.store_unaligned(reinterpret_cast<std::int32_t*>(key));
 }
 
+// One stable pass of a counting sort of `n` words by the digit (word >> shift) & 511, from
+// `from` into `to`. The four quarters of `from` are counted and scattered in turn, each
+// with counters of its own: neighbouring rays often share a digit, and one counter's
+// increments (a load, an add, a store) would wait on each other through memory, where four
+// quarters make four independent chains. Quarter by quarter in order within each digit,
+// so the pass stays stable.
+inline void sort_pass(const std::uint32_t* from, std::uint32_t* to, std::uint32_t n,
+                      std::uint32_t shift) {
+    const std::uint32_t q = (n + 3) / 4;
+    // Quarter k is [k q, (k + 1) q) clipped to n; the last is the shortest.
+    const std::uint32_t* const f1 = from + (q < n ? q : n);
+    const std::uint32_t* const f2 = from + (2 * q < n ? 2 * q : n);
+    const std::uint32_t* const f3 = from + (3 * q < n ? 3 * q : n);
+    const std::uint32_t common = static_cast<std::uint32_t>(from + n - f3);
+    alignas(64) std::uint32_t at[4][512] = {};
+    const auto digit = [shift](std::uint32_t w) { return (w >> shift) & 511u; };
+    const auto tails = [&](auto&& f) {
+        for (std::uint32_t j = common; j < q; ++j) {
+            if (from + j < f1) f(0, from[j]);
+            if (f1 + j < f2) f(1, f1[j]);
+            if (f2 + j < f3) f(2, f2[j]);
+        }
+    };
+    for (std::uint32_t j = 0; j < common; ++j) {
+        ++at[0][digit(from[j])];
+        ++at[1][digit(f1[j])];
+        ++at[2][digit(f2[j])];
+        ++at[3][digit(f3[j])];
+    }
+    tails([&](std::uint32_t k, std::uint32_t w) { ++at[k][digit(w)]; });
+    std::uint32_t sum = 0;
+    for (std::uint32_t d = 0; d < 512; ++d) {
+        const std::uint32_t c0 = at[0][d], c1 = at[1][d], c2 = at[2][d], c3 = at[3][d];
+        at[0][d] = sum;
+        at[1][d] = sum + c0;
+        at[2][d] = sum + c0 + c1;
+        at[3][d] = sum + c0 + c1 + c2;
+        sum += c0 + c1 + c2 + c3;
+    }
+    for (std::uint32_t j = 0; j < common; ++j) {
+        const std::uint32_t w0 = from[j], w1 = f1[j], w2 = f2[j], w3 = f3[j];
+        to[at[0][digit(w0)]++] = w0;
+        to[at[1][digit(w1)]++] = w1;
+        to[at[2][digit(w2)]++] = w2;
+        to[at[3][digit(w3)]++] = w3;
+    }
+    tails([&](std::uint32_t k, std::uint32_t w) { to[at[k][digit(w)]++] = w; });
+}
+
 template <class Arch>
 void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t count,
              std::uint32_t* occluded) {
@@ -250,6 +299,8 @@ void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t cou
         alignas(64) float t_max[N], term[N];
         std::uint32_t parent[N];
     } g;
+    // Only the arrays occluded_packet reads are gathered: the rest stay as set here.
+    for (std::uint32_t l = 0; l < N; ++l) g.term[l] = 0.0f, g.parent[l] = 0;
     const ShadowStream packet{g.ox,    g.oy,   g.oz,   g.dx,   g.dy,    g.dz,
                               g.t_max, g.term, g.term, g.term, g.parent};
     for (std::uint32_t first = 0; first < count; first += kShadowBatch) {
@@ -265,24 +316,34 @@ void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t cou
             shadow_keys<FW>(s, rays, first + at, order + at);
         for (; at < n; at += F::size) shadow_keys<F>(s, rays, first + at, order + at);
         for (std::uint32_t i = 0; i < n; ++i) order[i] = order[i] << 12 | i;
-        std::uint32_t* from = order;
-        std::uint32_t* to = sorted;
-        for (std::uint32_t shift = 12; shift < 30; shift += 9, std::swap(from, to)) {
-            std::uint32_t start[513] = {};
-            for (std::uint32_t i = 0; i < n; ++i) ++start[((from[i] >> shift) & 511u) + 1];
-            for (std::uint32_t k = 1; k < 513; ++k) start[k] += start[k - 1];
-            for (std::uint32_t i = 0; i < n; ++i)
-                to[start[(from[i] >> shift) & 511u]++] = from[i];
-        }
-        for (std::uint32_t i = 0; i < n; ++i) order[i] = from[i] & 4095u;  // from == order
+        sort_pass(order, sorted, n, 12);
+        sort_pass(sorted, order, n, 21);
+        for (std::uint32_t i = 0; i < n; ++i) order[i] &= 4095u;
         for (std::uint32_t k = 0; k < n; k += N) {
             const std::uint32_t live = live_bits(k, n);
-            for (std::uint32_t l = 0; l < N; ++l) {
+#if defined(__AVX512F__)
+            if constexpr (N == 16) {
                 // Dead lanes repeat the first ray: finite values, never read back.
-                const std::uint32_t r = first + order[(live >> l & 1u) != 0 ? k + l : k];
-                g.ox[l] = rays.ox[r], g.oy[l] = rays.oy[r], g.oz[l] = rays.oz[r];
-                g.dx[l] = rays.dx[r], g.dy[l] = rays.dy[r], g.dz[l] = rays.dz[r];
-                g.t_max[l] = rays.t_max[r], g.term[l] = 0.0f, g.parent[l] = 0;
+                const __m512i idx = _mm512_add_epi32(
+                    _mm512_mask_loadu_epi32(_mm512_set1_epi32(static_cast<int>(order[k])),
+                                            static_cast<__mmask16>(live), order + k),
+                    _mm512_set1_epi32(static_cast<int>(first)));
+                const auto gather = [&](const float* from, float* to) {
+                    _mm512_store_ps(to, _mm512_i32gather_ps(idx, from, 4));
+                };
+                gather(rays.ox, g.ox), gather(rays.oy, g.oy), gather(rays.oz, g.oz);
+                gather(rays.dx, g.dx), gather(rays.dy, g.dy), gather(rays.dz, g.dz);
+                gather(rays.t_max, g.t_max);
+            } else
+#endif
+            {
+                for (std::uint32_t l = 0; l < N; ++l) {
+                    // Dead lanes repeat the first ray: finite values, never read back.
+                    const std::uint32_t r = first + order[(live >> l & 1u) != 0 ? k + l : k];
+                    g.ox[l] = rays.ox[r], g.oy[l] = rays.oy[r], g.oz[l] = rays.oz[r];
+                    g.dx[l] = rays.dx[r], g.dy[l] = rays.dy[r], g.dz[l] = rays.dz[r];
+                    g.t_max[l] = rays.t_max[r];
+                }
             }
             const std::uint32_t bits = occluded_packet<Arch>(s, packet, 0, N, live, p, st);
             for (std::uint32_t l = 0; l < N && k + l < n; ++l)
