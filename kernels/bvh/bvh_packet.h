@@ -99,6 +99,10 @@ struct BvhStacks {
     std::uint16_t packet_mask[kBvhStackSize];  // lanes, one bit each
     std::uint32_t ray_node[kBvhStackSize];
     std::uint32_t ray_node_b[kBvhStackSize];  // a second ray's (bvh_closest_rays)
+    // Where the closest-hit walks' ray enters each stacked node, at most (push_children):
+    // a node entered beyond the hit found since is dropped without a visit.
+    float ray_entry[kBvhStackSize];
+    float ray_entry_b[kBvhStackSize];
     // The sphere (BVH index) that last occluded a lane of a packet, or kBvhEmpty: the
     // next packet of shadow rays tests it first (bvh_occluded_packet). Valid for the
     // SceneView of the stacks' caller only.

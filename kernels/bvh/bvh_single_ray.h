@@ -130,11 +130,12 @@ inline __m256i sort8_descending(__m256i v) {
 // push_children without a branch per child: each child's key is its entry distance (a
 // non-negative float, so its bits order as integers) with its slot in the low 3 bits, and
 // 0 for a child the ray misses. Sorted in descending order, the hit children come first,
-// farthest first; all eight references are stored, the stack grows by the hits less the
-// nearest, which is returned. Ties (entries equal but for their 3 low bits) fall in any
-// order, which changes no hit (the closest-hit rule does not depend on the order).
+// farthest first; all eight references are stored, and beside them in `entries` the keys
+// with their slot bits cleared (never above the entry), the stack grows by the hits less
+// the nearest, which is returned. Ties (entries equal but for their 3 low bits) fall in
+// any order, which changes no hit (the closest-hit rule does not depend on the order).
 inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
-                                   std::uint32_t* stack, std::uint32_t& sp) {
+                                   std::uint32_t* stack, float* entries, std::uint32_t& sp) {
     const __m256i slot = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     const __m256i hit = _mm256_castps_si256(lane_mask8<__m256>(bits));
     const __m256i bits_of_entry = _mm256_castps_si256(_mm256_load_ps(entry));
@@ -151,14 +152,16 @@ inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const 
     const __m256i child = _mm256_permutevar8x32_epi32(
         _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)), order);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack + sp), child);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(entries + sp),
+                        _mm256_andnot_si256(_mm256_set1_epi32(7), order));
     sp += static_cast<std::uint32_t>(__builtin_popcount(bits)) - 1;
     return nearest;
 }
 #else
 // Children of `n` in `bits`, nearest first by `entry`: the nearest is returned, the rest
-// pushed farthest first.
+// pushed farthest first, each with its entry in `entries`.
 inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const float* entry,
-                                   std::uint32_t* stack, std::uint32_t& sp) {
+                                   std::uint32_t* stack, float* entries, std::uint32_t& sp) {
     std::uint32_t order[kBvhWidth];
     std::uint32_t count = 0;
     while (bits != 0) {
@@ -168,7 +171,8 @@ inline std::uint32_t push_children(const BvhNode8& n, std::uint32_t bits, const 
         for (; k > 0 && entry[order[k - 1]] < entry[j]; --k) order[k] = order[k - 1];
         order[k] = j;  // descending entry
     }
-    for (std::uint32_t k = 0; k + 1 < count; ++k) stack[sp++] = n.child[order[k]];
+    for (std::uint32_t k = 0; k + 1 < count; ++k)
+        entries[sp] = entry[order[k]], stack[sp++] = n.child[order[k]];
     return n.child[order[count - 1]];
 }
 
@@ -206,12 +210,13 @@ struct ClosestWalk {
     float best_t, best_id;
     std::uint32_t node, sp;
     std::uint32_t* stack;
+    float* entries;  // beside stack: where the ray enters each node, at most
 
     void begin(const BvhPacket& p, std::uint32_t lane, std::uint32_t start,
-               std::uint32_t* stack_) {
+               std::uint32_t* stack_, float* entries_) {
         ray = BvhRay<F>(p, lane);
         best_t = p.best_t[lane], best_id = p.best_id[lane];
-        node = start, sp = 0, stack = stack_;
+        node = start, sp = 0, stack = stack_, entries = entries_;
     }
 
     // Visits `node`; false once the walk is over.
@@ -223,7 +228,7 @@ struct ClosestWalk {
             const std::uint32_t bits = ray.test(n, tmin, F(best_t), entry);
             if (bits != 0) {
                 prefetch_children(s, n, bits);
-                node = push_children(n, bits, entry, stack, sp);
+                node = push_children(n, bits, entry, stack, entries, sp);
                 return true;
             }
         } else {
@@ -247,8 +252,13 @@ struct ClosestWalk {
                 }
             }
         }
-        if (sp == 0) return false;
-        node = stack[--sp];
+        // The next node the ray enters no farther than its hit so far (entered exactly at
+        // best_t, it may hold a tie of a lower index): the box test would drop the others.
+        do {
+            if (sp == 0) return false;
+            --sp;
+        } while (entries[sp] > best_t);
+        node = stack[sp];
         return true;
     }
 };
@@ -256,11 +266,11 @@ struct ClosestWalk {
 // Closest hit of lane `lane` of `p` in the subtree `start`, on (t_min, best_t].
 template <class Arch>
 void bvh_closest_ray(const SceneView& s, BvhPacket& p, std::uint32_t lane, std::uint32_t start,
-                     float t_min, std::uint32_t* stack) {
+                     float t_min, BvhStacks& st) {
     using F = xsimd::batch<float, Arch>;
     const F tmin(t_min);
     ClosestWalk<F> w;
-    w.begin(p, lane, start, stack);
+    w.begin(p, lane, start, st.ray_node, st.ray_entry);
     while (w.step(s, tmin)) {
     }
     p.best_t[lane] = w.best_t, p.best_id[lane] = w.best_id;
@@ -276,7 +286,7 @@ void bvh_closest_rays(const SceneView& s, BvhPacket& p, std::uint32_t lanes,
     if (__builtin_popcount(lanes) < 2) {
         if (lanes != 0)
             bvh_closest_ray<Arch>(s, p, static_cast<std::uint32_t>(__builtin_ctz(lanes)), start,
-                                  t_min, st.ray_node);
+                                  t_min, st);
         return;
     }
     const F tmin(t_min);
@@ -287,20 +297,20 @@ void bvh_closest_rays(const SceneView& s, BvhPacket& p, std::uint32_t lanes,
     };
     std::uint32_t la = next(), lb = next();
     ClosestWalk<F> a, b;
-    a.begin(p, la, start, st.ray_node);
-    b.begin(p, lb, start, st.ray_node_b);
+    a.begin(p, la, start, st.ray_node, st.ray_entry);
+    b.begin(p, lb, start, st.ray_node_b, st.ray_entry_b);
     bool live_a = true, live_b = true;
     // A walk that ends hands in its hit and takes the next lane, if any.
-    const auto end = [&](ClosestWalk<F>& w, std::uint32_t& lane, std::uint32_t* stack) {
+    const auto end = [&](ClosestWalk<F>& w, std::uint32_t& lane) {
         p.best_t[lane] = w.best_t, p.best_id[lane] = w.best_id;
         if (lanes == 0) return false;
         lane = next();
-        w.begin(p, lane, start, stack);
+        w.begin(p, lane, start, w.stack, w.entries);
         return true;
     };
     while (live_a || live_b) {
-        if (live_a && !a.step(s, tmin)) live_a = end(a, la, st.ray_node);
-        if (live_b && !b.step(s, tmin)) live_b = end(b, lb, st.ray_node_b);
+        if (live_a && !a.step(s, tmin)) live_a = end(a, la);
+        if (live_b && !b.step(s, tmin)) live_b = end(b, lb);
     }
 }
 
