@@ -29,6 +29,18 @@ enum class CameraKind : std::int32_t {
 };
 enum class BackgroundKind : std::int32_t { constant = 0, gradient = 1 };
 
+// The sphere and plane arrays of a SceneView hold a multiple of this many entries, those
+// past the count with NaN geometry that no comparison accepts (scene/compile.h), so that
+// a kernel may load them a register at a time.
+inline constexpr std::uint32_t kSceneArrayPadding = 8;
+
+// Brute-force shadow rays skip the spheres far from a packet's segments
+// (kernels/stream/brute_force.h, SegmentBox) in scenes of this many spheres or more. Below,
+// every sphere is tested: the box costs a packet about as much as
+// three or four sphere tests. Measured (docs/performance-log.md): random:16's shadow rays
+// 15-25 % faster with the cull, random:12 level, random:8 10 % and random:4 45 % slower.
+inline constexpr std::uint32_t kShadowCullMinSpheres = 12;
+
 // A view of a CompiledScene (scene/compile.h) in plain pointers.
 struct SceneView {
     // Spheres and planes in file order within their kind; `object` is the file index.

@@ -8,6 +8,8 @@
 #error "define OCTRAY_KERNEL_NAMESPACE (one per ISA translation unit) before including"
 #endif
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "kernels/bvh/bvh_packet.h"
@@ -101,6 +103,69 @@ void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t co
 }
 
 // ---------------------------------------------------------------------------------------
+// The cull of brute-force shadow rays. A shadow ray occludes only through a root t of
+// (0, t_max), whose point O + t V lies on the segment [O, O + t_max V]; the packet's
+// segments lie in one box (of each segment's ends). A sphere occludes only if it comes
+// within about r of that point, so one whose box, widened, misses the segments' box is
+// skipped. The widening covers the sphere test's rounding many times over: a computed
+// root lies within a few ulps (near a tangent, within sqrt(disc)'s rounding, some 2^-11 r)
+// of the exact point, and the near misses it may count as hits pass within 40u |O - C| of
+// the surface (sphere_test.h, u = 2^-24), where the margin here is 2^-10 (r + |C| + the
+// box's largest coordinate). Unbounded segments (directional lights) cull nothing.
+
+struct SegmentBox {
+    bool bounded = false;
+    float lo[3], hi[3];
+    float scale;  // the largest |coordinate| of the box
+};
+
+template <class F, class M, std::uint32_t K>
+SegmentBox segment_box(const V3<F> (&o)[K], const V3<F> (&d)[K], const F (&t_max)[K],
+                       const M (&done)[K]) {
+    SegmentBox box;
+    float scale = 0.0f;
+    for (int axis = 0; axis < 3; ++axis) {
+        F lo(kInf), hi(-kInf);
+        for (std::uint32_t k = 0; k < K; ++k) {
+            const F from = axis == 0 ? o[k].x : axis == 1 ? o[k].y : o[k].z;
+            const F step = axis == 0 ? d[k].x : axis == 1 ? d[k].y : d[k].z;
+            const F to = xsimd::fma(step, t_max[k], from);
+            lo = xsimd::select(done[k], lo, xsimd::min(lo, xsimd::min(from, to)));
+            hi = xsimd::select(done[k], hi, xsimd::max(hi, xsimd::max(from, to)));
+        }
+        alignas(64) float lanes[F::size];
+        lo.store_aligned(lanes);
+        box.lo[axis] = masked_min<F>(lanes, (1u << F::size) - 1u);
+        hi.store_aligned(lanes);
+        box.hi[axis] = masked_max<F>(lanes, (1u << F::size) - 1u);
+        // Not finite (an unbounded or NaN segment, or no lane left): no cull.
+        if (!(box.hi[axis] - box.lo[axis] < kInf)) return box;
+        scale = std::max(scale, std::max(std::fabs(box.lo[axis]), std::fabs(box.hi[axis])));
+    }
+    box.bounded = scale < kInf;
+    box.scale = scale;
+    return box;
+}
+
+// Spheres [block, block + FS::size) that may occlude a segment of `box`, as bits (all of
+// them when the box is unbounded). The arrays' padding (NaN) fails every comparison.
+template <class FS>
+std::uint32_t spheres_near(const SceneView& s, std::uint32_t block, const SegmentBox& box) {
+    if (!box.bounded) return (1u << FS::size) - 1u;
+    const FS cx = FS::load_aligned(s.sphere_cx + block),
+             cy = FS::load_aligned(s.sphere_cy + block),
+             cz = FS::load_aligned(s.sphere_cz + block);
+    const FS r = xsimd::sqrt(FS::load_aligned(s.sphere_r2 + block));
+    const FS pad =
+        xsimd::fma(FS(0x1.0p-10f),
+                   r + xsimd::abs(cx) + xsimd::abs(cy) + xsimd::abs(cz) + FS(box.scale), r);
+    const auto near = [&](const FS& c, int axis) {
+        return c + pad >= FS(box.lo[axis]) && c - pad <= FS(box.hi[axis]);
+    };
+    return mask_bits<FS>(near(cx, 0) && near(cy, 1) && near(cz, 2));
+}
+
+// ---------------------------------------------------------------------------------------
 // Any hit for shadow rays on (0, t_max), brute force (reference: ReferenceTracer::occluded);
 // any_hit() in kernels/stream/hit_kernels.h calls it when the scene has no BVH. A packet
 // stops testing objects once every live lane is occluded. occluded[i] is 1 or 0.
@@ -109,8 +174,11 @@ void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t cou
                  std::uint32_t* occluded) {
     using F = xsimd::batch<float, RayArch<Arch>>;
     using M = xsimd::batch_bool<float, RayArch<Arch>>;
+    using FS = xsimd::batch<float, Arch>;  // spheres, a block at a time, for the cull
     constexpr std::uint32_t W = F::size;
     constexpr std::uint32_t K = kTraversalWidth / W;
+    constexpr std::uint32_t WS = FS::size;
+    static_assert(kSceneArrayPadding % WS == 0);
     const F zero(0.0f);
     for (std::uint32_t base = 0; base < count; base += kTraversalWidth) {
         const std::uint32_t left = count - base;
@@ -133,20 +201,28 @@ void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t cou
                 if (!xsimd::all(done[k])) return false;
             return true;
         };
-        for (std::uint32_t i = 0; i < s.sphere_count && !all_done(); ++i) {
-            const V3<F> c{F(s.sphere_cx[i]), F(s.sphere_cy[i]), F(s.sphere_cz[i])};
-            const F r2(s.sphere_r2[i]);
-            SphereQuadratic<F> quad[K];
-            M any_root = zero != zero;
-            for (std::uint32_t k = 0; k < K; ++k) {
-                quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
-                any_root = any_root || (quad[k].disc >= zero && !done[k]);
-            }
-            if (xsimd::none(any_root)) continue;
-            for (std::uint32_t k = 0; k < K; ++k) {
-                const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
-                done[k] = done[k] || (t_near > zero && t_near < t_max[k]) ||
-                          (t_far > zero && t_far < t_max[k]);
+        const SegmentBox box = s.sphere_count >= kShadowCullMinSpheres
+                                   ? segment_box(o, d, t_max, done)
+                                   : SegmentBox{};
+        for (std::uint32_t block = 0; block < s.sphere_count && !all_done(); block += WS) {
+            std::uint32_t keep = spheres_near<FS>(s, block, box);
+            if (s.sphere_count - block < WS) keep &= (1u << (s.sphere_count - block)) - 1u;
+            for (; keep != 0 && !all_done(); keep &= keep - 1) {
+                const std::uint32_t i = block + static_cast<std::uint32_t>(__builtin_ctz(keep));
+                const V3<F> c{F(s.sphere_cx[i]), F(s.sphere_cy[i]), F(s.sphere_cz[i])};
+                const F r2(s.sphere_r2[i]);
+                SphereQuadratic<F> quad[K];
+                M any_root = zero != zero;
+                for (std::uint32_t k = 0; k < K; ++k) {
+                    quad[k] = sphere_quadratic(sub(o[k], c), d[k], a[k], r2);
+                    any_root = any_root || (quad[k].disc >= zero && !done[k]);
+                }
+                if (xsimd::none(any_root)) continue;
+                for (std::uint32_t k = 0; k < K; ++k) {
+                    const auto [t_near, t_far] = sphere_roots(quad[k], a[k]);
+                    done[k] = done[k] || (t_near > zero && t_near < t_max[k]) ||
+                              (t_far > zero && t_far < t_max[k]);
+                }
             }
         }
         if (!all_done())

@@ -6,6 +6,8 @@
 
 namespace octray {
 
+static_assert(kCompiledPadding % kernels::kSceneArrayPadding == 0);
+
 kernels::SceneView make_scene_view(const CompiledScene& c) {
     kernels::SceneView v{};
     const CompiledSpheres& s = c.spheres;

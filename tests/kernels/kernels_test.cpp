@@ -313,6 +313,57 @@ TYPED_TEST(KernelTest, NearMissesAtEveryScale) {
     }
 }
 
+// Shadow rays are segments [O, O + t_max V]; brute force skips spheres whose widened box
+// misses the box of a packet's segments (kernels/stream/brute_force.h, SegmentBox). Segments
+// that graze a sphere at every scale (as above), ending short of it, at its closest point
+// to within an ulp or two, or past it, each one sixteen times in a row so that a packet's
+// box is one segment's (flat along the axes for axis-aligned rays), among enough spheres
+// for the cull to run: the occlusion bit for bit the reference's.
+TYPED_TEST(KernelTest, ShadowSegmentsGrazingSpheresAtEveryScale) {
+    std::mt19937 rng(2027);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    const auto random_unit = [&] {
+        for (;;) {
+            const Vec3 v{unit(rng), unit(rng), unit(rng)};
+            if (length(v) > 0.1f) return normalize(v);
+        }
+    };
+    Scene scene;
+    scene.materials.push_back({"m", Material{}});
+    std::vector<Ray> rays;
+    for (const float radius : {1e-6f, 1e-3f, 1.0f, 1e3f}) {
+        Object sphere;
+        sphere.radius = radius;
+        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * (radius * 50.0f);
+        scene.objects.push_back(sphere);
+        for (const float delta : {-0x1.0p-8f, -0x1.0p-22f, 0.0f, 0x1.0p-22f, 0x1.0p-12f})
+            for (const float away : {0.0f, 3.0f, 1e4f, 1e6f})
+                for (const bool axis_aligned : {false, true}) {
+                    const Vec3 u = axis_aligned ? Vec3{0, 0, 1} : random_unit();
+                    const Vec3 side =
+                        axis_aligned ? Vec3{1, 0, 0} : normalize(cross(u, random_unit()));
+                    const Vec3 origin =
+                        sphere.center + side * (radius * (1.0f + delta)) - u * (radius * away);
+                    const Vec3 v = u * 2.0f;
+                    // Where the line passes the center.
+                    const float t_ca = dot(sphere.center - origin, v) / dot(v, v);
+                    for (const float end :
+                         {0.5f, 1.0f - 0x1.0p-20f, 1.0f, 1.0f + 0x1.0p-20f, 2.0f})
+                        for (int copy = 0; copy < 16; ++copy)
+                            rays.push_back(
+                                {origin, v, 0.0f, t_ca * end + radius * (end - 1.0f)});
+                }
+    }
+    for (int i = 0; i < 20; ++i) {
+        Object sphere;
+        sphere.radius = 0.5f;
+        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * 2e5f;
+        scene.objects.push_back(sphere);
+    }
+    ASSERT_GE(scene.objects.size(), kernels::kShadowCullMinSpheres);
+    this->expect_any_hits_match(scene, rays);
+}
+
 // A sphere and a plane hit at exactly the same t: the one listed first in the file wins,
 // whichever kind it is.
 TYPED_TEST(KernelTest, TiesGoToTheObjectListedFirst) {
