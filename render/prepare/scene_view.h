@@ -21,8 +21,11 @@ inline constexpr std::uint32_t kBvhPacketMinLanes = 2;
 
 // From this many spheres on, the BVH's any-hit regroups shadow rays into packets of
 // neighbouring origins and one direction octant: below, the sort costs more than it saves
-// (measured: docs/performance-log.md, "BVH: millions of spheres against Embree").
-inline constexpr std::uint32_t kBvhShadowSortMinSpheres = 32768;
+// and shadow beams win (measured: docs/performance-log.md, "BVH: millions of spheres
+// against Embree"; since the sort's four quarters, session 32, sorted against beams:
+// random:4096 level, random:8192 20-30 % and random:16384 40-60 % faster, sphereflake:4
+// level, random:2048 and random:1024 15-40 % slower).
+inline constexpr std::uint32_t kBvhShadowSortMinSpheres = 8192;
 
 // In BVHs of at most this many spheres, shadow rays, and closest-hit rays that form no beam
 // (kernels/bvh/bvh_beam.h: primary rays from one origin do), test every sphere as without a
