@@ -112,7 +112,6 @@ void closest_hit_all(const SceneView& s, const RayStream& rays, std::uint32_t co
 // of the exact point, and the near misses it may count as hits pass within 40u |O - C| of
 // the surface (sphere_test.h, u = 2^-24), where the margin here is 2^-10 (r + |C| + the
 // box's largest coordinate). Unbounded segments (directional lights) cull nothing.
-
 struct SegmentBox {
     bool bounded = false;
     float lo[3], hi[3];
@@ -138,7 +137,8 @@ SegmentBox segment_box(const V3<F> (&o)[K], const V3<F> (&d)[K], const F (&t_max
         box.lo[axis] = masked_min<F>(lanes, (1u << F::size) - 1u);
         hi.store_aligned(lanes);
         box.hi[axis] = masked_max<F>(lanes, (1u << F::size) - 1u);
-        // Not finite (an unbounded or NaN segment, or no lane left): no cull.
+        // An unbounded segment: no cull. (No lane left makes the scale infinite: none
+        // either. A lane with NaN drops out of the box, and a NaN ray hits nothing.)
         if (!(box.hi[axis] - box.lo[axis] < kInf)) return box;
         scale = std::max(scale, std::max(std::fabs(box.lo[axis]), std::fabs(box.hi[axis])));
     }
