@@ -102,6 +102,52 @@ Scene random_scene(std::mt19937& rng, int spheres, int planes) {
     return s;
 }
 
+// A unit vector in a random direction.
+Vec3 random_unit_vector(std::mt19937& rng) {
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    for (;;) {
+        const Vec3 v{unit(rng), unit(rng), unit(rng)};
+        if (length(v) > 0.1f) return normalize(v);
+    }
+}
+
+// A scene of one material and no objects yet.
+Scene one_material_scene() {
+    Scene scene;
+    scene.materials.push_back({"m", Material{}});
+    return scene;
+}
+
+// A sphere of `radius` at a random place within 50 radii of the origin, added to `scene`.
+Object add_sphere_near_origin(Scene& scene, std::mt19937& rng, float radius) {
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    Object sphere;
+    sphere.radius = radius;
+    sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * (radius * 50.0f);
+    scene.objects.push_back(sphere);
+    return sphere;
+}
+
+// `count` spheres of radius 1/2 up to 2e5 from the origin, added to `scene`: far from the
+// grazed ones, so that a BVH has inner nodes and leaves to skip.
+void add_far_spheres(Scene& scene, std::mt19937& rng, int count) {
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    for (int i = 0; i < count; ++i) {
+        Object sphere;
+        sphere.radius = 0.5f;
+        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * 2e5f;
+        scene.objects.push_back(sphere);
+    }
+}
+
+// Spheres of radius 1e-6, 1e-3, 1 and 1e3, each added to `scene` within 50 radii of the
+// origin and handed to f, for rays that graze them.
+template <class F>
+void for_spheres_at_every_scale(Scene& scene, std::mt19937& rng, F&& f) {
+    for (const float radius : {1e-6f, 1e-3f, 1.0f, 1e3f})
+        f(add_sphere_near_origin(scene, rng, radius));
+}
+
 Ray random_ray(std::mt19937& rng, float t_min) {
     std::uniform_real_distribution<float> pos(-4.0f, 4.0f), unit(-1.0f, 1.0f);
     Ray r;
@@ -269,21 +315,11 @@ TYPED_TEST(KernelTest, GrazingAndTangentRays) {
 // bit for bit.
 TYPED_TEST(KernelTest, NearMissesAtEveryScale) {
     std::mt19937 rng(2026);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-    const auto random_unit = [&] {
-        for (;;) {
-            const Vec3 v{unit(rng), unit(rng), unit(rng)};
-            if (length(v) > 0.1f) return normalize(v);
-        }
-    };
-    Scene scene;
-    scene.materials.push_back({"m", Material{}});
+    const auto random_unit = [&] { return random_unit_vector(rng); };
+    Scene scene = one_material_scene();
     std::vector<Ray> rays;
-    for (const float radius : {1e-6f, 1e-3f, 1.0f, 1e3f}) {
-        Object sphere;
-        sphere.radius = radius;
-        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * (radius * 50.0f);
-        scene.objects.push_back(sphere);
+    for_spheres_at_every_scale(scene, rng, [&](const Object& sphere) {
+        const float radius = sphere.radius;
         for (const float delta :
              {-0x1.0p-8f, -0x1.0p-16f, -0x1.0p-22f, 0.0f, 0x1.0p-22f, 0x1.0p-18f, 0x1.0p-14f,
               0x1.0p-10f, 0x1.0p-8f, 0x1.0p-7f, 0x1.0p-6f, 0x1.0p-5f, 0x1.0p-4f})
@@ -295,14 +331,9 @@ TYPED_TEST(KernelTest, NearMissesAtEveryScale) {
                         sphere.center + side * (radius * (1.0f + delta)) - u * (radius * away);
                     rays.push_back({origin, u * speed, 0.0f, kInfinity});
                 }
-    }
+    });
     // Spheres elsewhere, so the BVH has inner nodes and leaves to skip.
-    for (int i = 0; i < 60; ++i) {
-        Object sphere;
-        sphere.radius = 0.5f;
-        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * 2e5f;
-        scene.objects.push_back(sphere);
-    }
+    add_far_spheres(scene, rng, 60);
     this->expect_closest_hits_match(scene, rays, 0.0f);
     this->expect_any_hits_match(scene, rays);
     for (const std::uint32_t lanes : {0u, 9u}) {
@@ -321,21 +352,11 @@ TYPED_TEST(KernelTest, NearMissesAtEveryScale) {
 // for the cull to run: the occlusion bit for bit the reference's.
 TYPED_TEST(KernelTest, ShadowSegmentsGrazingSpheresAtEveryScale) {
     std::mt19937 rng(2027);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-    const auto random_unit = [&] {
-        for (;;) {
-            const Vec3 v{unit(rng), unit(rng), unit(rng)};
-            if (length(v) > 0.1f) return normalize(v);
-        }
-    };
-    Scene scene;
-    scene.materials.push_back({"m", Material{}});
+    const auto random_unit = [&] { return random_unit_vector(rng); };
+    Scene scene = one_material_scene();
     std::vector<Ray> rays;
-    for (const float radius : {1e-6f, 1e-3f, 1.0f, 1e3f}) {
-        Object sphere;
-        sphere.radius = radius;
-        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * (radius * 50.0f);
-        scene.objects.push_back(sphere);
+    for_spheres_at_every_scale(scene, rng, [&](const Object& sphere) {
+        const float radius = sphere.radius;
         for (const float delta : {-0x1.0p-8f, -0x1.0p-22f, 0.0f, 0x1.0p-22f, 0x1.0p-12f})
             for (const float away : {0.0f, 3.0f, 1e4f, 1e6f})
                 for (const bool axis_aligned : {false, true}) {
@@ -353,13 +374,8 @@ TYPED_TEST(KernelTest, ShadowSegmentsGrazingSpheresAtEveryScale) {
                             rays.push_back(
                                 {origin, v, 0.0f, t_ca * end + radius * (end - 1.0f)});
                 }
-    }
-    for (int i = 0; i < 20; ++i) {
-        Object sphere;
-        sphere.radius = 0.5f;
-        sphere.center = Vec3{unit(rng), unit(rng), unit(rng)} * 2e5f;
-        scene.objects.push_back(sphere);
-    }
+    });
+    add_far_spheres(scene, rng, 20);
     ASSERT_GE(scene.objects.size(), kernels::kShadowCullMinSpheres);
     this->expect_any_hits_match(scene, rays);
 }
