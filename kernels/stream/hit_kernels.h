@@ -11,6 +11,7 @@
 #endif
 
 #include <cstdint>
+#include <utility>
 
 #include "kernels/bvh/bvh_beam.h"
 #include "kernels/bvh/bvh_packet.h"
@@ -321,29 +322,31 @@ void any_hit(const SceneView& scene, const ShadowStream& rays, std::uint32_t cou
         for (std::uint32_t i = 0; i < n; ++i) order[i] &= 4095u;
         for (std::uint32_t k = 0; k < n; k += N) {
             const std::uint32_t live = live_bits(k, n);
-#if defined(__AVX512F__)
-            if constexpr (N == 16) {
-                // Dead lanes repeat the first ray: finite values, never read back.
-                const __m512i idx = _mm512_add_epi32(
-                    _mm512_mask_loadu_epi32(_mm512_set1_epi32(static_cast<int>(order[k])),
-                                            static_cast<__mmask16>(live), order + k),
-                    _mm512_set1_epi32(static_cast<int>(first)));
-                const auto gather = [&](const float* from, float* to) {
-                    _mm512_store_ps(to, _mm512_i32gather_ps(idx, from, 4));
-                };
-                gather(rays.ox, g.ox), gather(rays.oy, g.oy), gather(rays.oz, g.oz);
-                gather(rays.dx, g.dx), gather(rays.dy, g.dy), gather(rays.dz, g.dz);
-                gather(rays.t_max, g.t_max);
-            } else
-#endif
-            {
-                for (std::uint32_t l = 0; l < N; ++l) {
-                    // Dead lanes repeat the first ray: finite values, never read back.
-                    const std::uint32_t r = first + order[(live >> l & 1u) != 0 ? k + l : k];
-                    g.ox[l] = rays.ox[r], g.oy[l] = rays.oy[r], g.oz[l] = rays.oz[r];
-                    g.dx[l] = rays.dx[r], g.dy[l] = rays.dy[r], g.dz[l] = rays.dz[r];
-                    g.t_max[l] = rays.t_max[r];
-                }
+            // The sorted rays into the packet, a traversal register at a time (gather:
+            // AVX2 and AVX-512 in one instruction). Dead lanes repeat the first ray:
+            // finite values, never read back.
+            LaneIndex ix[N / FW::size];
+            if (live == live_bits(0, N)) {
+                // Whole registers (a store the gather's load can take as it is).
+                using I = xsimd::batch<std::int32_t, RayArch<Arch>>;
+                for (std::uint32_t at = 0; at < N; at += I::size)
+                    (I::load_unaligned(reinterpret_cast<const std::int32_t*>(order) + k + at) +
+                     I(static_cast<std::int32_t>(first)))
+                        .store_aligned(ix[at / I::size].index);
+            } else {
+                for (std::uint32_t l = 0; l < N; ++l)
+                    ix[l / FW::size].index[l % FW::size] = static_cast<std::int32_t>(
+                        first + order[(live >> l & 1u) != 0 ? k + l : k]);
+            }
+            for (std::uint32_t r = 0; r < N / FW::size; ++r) {
+                ix[r].uniform = false;
+                const std::uint32_t at = r * FW::size;
+                for (const auto& [from, to] :
+                     {std::pair{rays.ox, g.ox}, std::pair{rays.oy, g.oy},
+                      std::pair{rays.oz, g.oz}, std::pair{rays.dx, g.dx},
+                      std::pair{rays.dy, g.dy}, std::pair{rays.dz, g.dz},
+                      std::pair{rays.t_max, g.t_max}})
+                    gather<FW>(from, ix[r]).store_aligned(to + at);
             }
             const std::uint32_t bits = occluded_packet<Arch>(s, packet, 0, N, live, p, st);
             for (std::uint32_t l = 0; l < N && k + l < n; ++l)
