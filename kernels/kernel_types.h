@@ -34,13 +34,6 @@ enum class BackgroundKind : std::int32_t { constant = 0, gradient = 1 };
 // a kernel may load them a register at a time.
 inline constexpr std::uint32_t kSceneArrayPadding = 8;
 
-// Brute-force shadow rays skip the spheres far from a packet's segments
-// (kernels/stream/brute_force.h, SegmentBox) in scenes of this many spheres or more. Below,
-// every sphere is tested: the box costs a packet about as much as
-// three or four sphere tests. Measured (docs/performance-log.md): random:16's shadow rays
-// 15-25 % faster with the cull, random:12 level, random:8 10 % and random:4 45 % slower.
-inline constexpr std::uint32_t kShadowCullMinSpheres = 12;
-
 // A view of a CompiledScene (scene/compile.h) in plain pointers.
 struct SceneView {
     // Spheres and planes in file order within their kind; `object` is the file index.
@@ -105,6 +98,10 @@ struct SceneView {
     // beam, test every sphere as without a BVH (stream/hit_kernels.h;
     // render/prepare/scene_view.h).
     std::uint32_t bvh_brute_force_max_spheres;
+    // Brute-force shadow rays skip the spheres far from a packet's segments
+    // (stream/brute_force.h, SegmentBox) in scenes of at least this many spheres, with a BVH
+    // or without (render/prepare/scene_view.h).
+    std::uint32_t shadow_cull_min_spheres;
 };
 
 // Film positions of camera samples, in [-1, 1]^2 with y up, plus the thin-lens aperture

@@ -201,7 +201,7 @@ void any_hit_all(const SceneView& s, const ShadowStream& rays, std::uint32_t cou
                 if (!xsimd::all(done[k])) return false;
             return true;
         };
-        const SegmentBox box = s.sphere_count >= kShadowCullMinSpheres
+        const SegmentBox box = s.sphere_count >= s.shadow_cull_min_spheres
                                    ? segment_box(o, d, t_max, done)
                                    : SegmentBox{};
         for (std::uint32_t block = 0; block < s.sphere_count && !all_done(); block += WS) {

@@ -65,6 +65,7 @@ kernels::SceneView make_scene_view(const CompiledScene& c) {
     put_rgb(v.ambient, c.ambient);
     v.epsilon = c.epsilon;
     v.max_depth = c.max_depth;
+    v.shadow_cull_min_spheres = kShadowCullMinSpheres;
     return v;
 }
 

@@ -376,7 +376,7 @@ TYPED_TEST(KernelTest, ShadowSegmentsGrazingSpheresAtEveryScale) {
                 }
     });
     add_far_spheres(scene, rng, 20);
-    ASSERT_GE(scene.objects.size(), kernels::kShadowCullMinSpheres);
+    ASSERT_GE(scene.objects.size(), kShadowCullMinSpheres);
     this->expect_any_hits_match(scene, rays);
 }
 
